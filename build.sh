@@ -1,0 +1,46 @@
+#!/usr/bin/env bash
+# One entry point for a fresh Debian 12 machine: install what grainlab needs, build, then
+#   ./build.sh demo       run the main job (scripts/demo.lua)
+#   ./build.sh test       run the whole test suite (ctest)
+#   ./build.sh sanitize   build with AddressSanitizer + UBSan into build-asan/ and run the suite
+#   ./build.sh build      only install and build
+set -euo pipefail
+cd "$(dirname "$0")"
+
+# Debian packages: compiler and build tools, the libraries grainlab links, and jq (tests read
+# report JSON with it).
+packages=(build-essential cmake pkg-config liblua5.4-dev libreadline-dev libosmesa6-dev
+          libpng-dev libcmocka-dev jq)
+
+install_packages() {
+    local missing=()
+    for p in "${packages[@]}"; do
+        dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed' || missing+=("$p")
+    done
+    [ ${#missing[@]} -eq 0 ] && return 0
+    echo "build.sh: installing Debian packages: ${missing[*]}"
+    local sudo=""
+    [ "$(id -u)" -eq 0 ] || sudo="sudo"
+    $sudo apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
+}
+
+jobs=$(nproc 2>/dev/null || echo 2)
+
+build() {  # build DIR [cmake options…]
+    local dir=$1; shift
+    cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=Release -DGRAINLAB_WERROR=ON "$@" >/dev/null
+    cmake --build "$dir" -j "$jobs"
+}
+
+cmd=${1:-build}
+[ $# -gt 0 ] && shift
+install_packages
+case "$cmd" in
+    build)    build build ;;
+    demo)     build build && ./build/grainlab scripts/demo.lua "$@" ;;
+    test)     build build && ctest --test-dir build --output-on-failure -j "$jobs" "$@" ;;
+    sanitize) build build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DGRAINLAB_SANITIZE=ON &&
+              ctest --test-dir build-asan --output-on-failure -j "$jobs" "$@" ;;
+    *) echo "usage: ./build.sh [build|demo|test|sanitize]" >&2; exit 2 ;;
+esac

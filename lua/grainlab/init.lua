@@ -1,0 +1,13 @@
+-- Completes the grainlab table with its Lua-side parts (report, check) and defines help().
+local grainlab = grainlab
+
+grainlab.report = require("grainlab.report").report
+grainlab.check = require("grainlab.check")
+help = require("grainlab.help")
+
+grainlab.doc(grainlab, { name = "grainlab",
+  doc = [[Core: report, check, rng, progress, clock, elapsed, threads, write_file, doc, version.]] })
+grainlab.doc(params, { name = "params",
+  doc = [[Command-line pairs: `grainlab FILE.lua n=100 name=run1` gives params.n == 100 and
+params.name == "run1" (numbers converted, true/false as booleans, other text kept as strings).]] })
+return grainlab

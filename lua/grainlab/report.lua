@@ -1,0 +1,203 @@
+-- grainlab.report{…}: the one way a scenario hands its figures to people, tests and benchmarks.
+-- Prints a readable table; with --report FILE.json (or GRAINLAB_REPORT=FILE) also writes
+--   {"scenario", "params", "metrics", "checks": [{"name","value","limit","op","pass"}], "wall_s"}
+-- whole (temporary file, then rename). Failed checks make the process exit non-zero.
+local json = require "grainlab.json"
+
+local M = { failed = 0, written = nil }
+
+local OPS = {
+  ["<="] = function(v, l) return v <= l end,
+  ["<"]  = function(v, l) return v < l end,
+  [">="] = function(v, l) return v >= l end,
+  [">"]  = function(v, l) return v > l end,
+  ["=="] = function(v, l) return v == l end,
+}
+
+local function describe(v)
+  if type(v) == "string" then return "'" .. v .. "'" end
+  if type(v) == "number" or type(v) == "boolean" then return tostring(v) end
+  return type(v)
+end
+
+-- Validation errors are raised without a position here; report() re-raises them at the caller.
+local function bad(field, expected, got)
+  error(string.format("bad field '%s' in argument #1 to 'report' (%s expected, got %s)",
+                      field, expected, describe(got)), 0)
+end
+
+local function only(t, where, allowed)
+  for k in pairs(t) do
+    if not allowed[k] then
+      local names = {}
+      for name in pairs(allowed) do names[#names + 1] = name end
+      table.sort(names)
+      local unknown = string.format("(unknown field %s; valid fields: %s)", describe(k),
+                                    table.concat(names, ", "))
+      if where then
+        error(string.format("bad field '%s' in argument #1 to 'report' %s", where, unknown), 0)
+      end
+      error("bad argument #1 to 'report' " .. unknown, 0)
+    end
+  end
+end
+
+local function is_name(s) return type(s) == "string" and s:match("^[a-z][a-z0-9_]*$") ~= nil end
+
+local function check_value(v, field)
+  local tv = type(v)
+  if tv == "number" or tv == "string" or tv == "boolean" then return end
+  if tv == "table" then
+    for k, x in pairs(v) do check_value(x, field .. "." .. tostring(k)) end
+    return
+  end
+  bad(field, "number, string, boolean or table", v)
+end
+
+local function fmt(v)
+  if math.type(v) == "integer" then return string.format("%d", v) end
+  if type(v) == "number" then return string.format("%.6g", v) end
+  if type(v) == "table" then
+    local n = 0
+    for _ in pairs(v) do n = n + 1 end
+    return string.format("(table of %d)", n)
+  end
+  return tostring(v)
+end
+
+local function sorted_keys(t)
+  local keys = {}
+  for k in pairs(t) do keys[#keys + 1] = k end
+  table.sort(keys, function(a, b) return tostring(a) < tostring(b) end)
+  return keys
+end
+
+local function normalise_checks(list)
+  if list == nil then return {} end
+  if type(list) ~= "table" then bad("checks", "array of checks", list) end
+  local out, names = {}, {}
+  for i, c in ipairs(list) do
+    local where = "checks[" .. i .. "]"
+    if type(c) ~= "table" then bad(where, "table {name=, value=, limit=}", c) end
+    only(c, where, { name = true, value = true, limit = true, op = true, pass = true })
+    if not is_name(c.name) then bad(where .. ".name", "snake_case name", c.name) end
+    if names[c.name] then bad(where .. ".name", "unique name", c.name) end
+    names[c.name] = true
+    local op = c.op or "<="
+    if not OPS[op] then bad(where .. ".op", "one of '<=', '<', '>=', '>', '=='", op) end
+    local pass = c.pass
+    if pass ~= nil and type(pass) ~= "boolean" then bad(where .. ".pass", "boolean", pass) end
+    if c.value ~= nil and type(c.value) ~= "number" then bad(where .. ".value", "number", c.value) end
+    if c.limit ~= nil and type(c.limit) ~= "number" then bad(where .. ".limit", "number", c.limit) end
+    if pass == nil then
+      if c.value == nil then bad(where .. ".value", "number (or give pass=)", nil) end
+      if c.limit == nil then bad(where .. ".limit", "number (or give pass=)", nil) end
+      -- NaN compares false with everything, so a NaN value always fails.
+      pass = OPS[op](c.value, c.limit)
+    end
+    out[i] = { name = c.name, value = c.value, limit = c.limit, op = op, pass = pass }
+  end
+  for k in pairs(list) do
+    if math.type(k) ~= "integer" or k < 1 or k > #list then
+      bad("checks", "array of checks (found key " .. describe(k) .. ")", list)
+    end
+  end
+  return out
+end
+
+local function print_table(r)
+  local w = 24
+  for _, section in ipairs { r.params, r.metrics } do
+    for k in pairs(section) do w = math.max(w, #tostring(k)) end
+  end
+  for _, c in ipairs(r.checks) do w = math.max(w, #c.name) end
+  local lines = { string.format("== %s ==%s", r.scenario,
+                                string.rep(" ", math.max(1, w + 8 - #r.scenario)) ..
+                                string.format("wall %.3g s", r.wall_s)) }
+  for _, sec in ipairs { { "params", r.params }, { "metrics", r.metrics } } do
+    if next(sec[2]) then
+      lines[#lines + 1] = sec[1]
+      for _, k in ipairs(sorted_keys(sec[2])) do
+        lines[#lines + 1] = string.format("  %-" .. w .. "s  %s", k, fmt(sec[2][k]))
+      end
+    end
+  end
+  if #r.checks > 0 then
+    local failed = 0
+    lines[#lines + 1] = "checks"
+    for _, c in ipairs(r.checks) do
+      if not c.pass then failed = failed + 1 end
+      local cond = ""
+      if c.value ~= nil and c.limit ~= nil then
+        cond = string.format("%s %s %s", fmt(c.value), c.op, fmt(c.limit))
+      elseif c.value ~= nil then
+        cond = fmt(c.value)
+      end
+      lines[#lines + 1] = string.format("  %-4s  %-" .. w .. "s  %s", c.pass and "ok" or "FAIL",
+                                        c.name, cond)
+    end
+    lines[#lines + 1] = string.format("%d passed, %d failed", #r.checks - failed, failed)
+  end
+  io.stdout:write(table.concat(lines, "\n"), "\n")
+  io.stdout:flush()
+end
+
+local function report_impl(t)
+  if type(t) ~= "table" then
+    error("bad argument #1 to 'report' (table expected, got " .. type(t) .. ")", 0)
+  end
+  only(t, nil, { scenario = true, params = true, metrics = true, checks = true })
+  if type(t.scenario) ~= "string" or t.scenario == "" then bad("scenario", "non-empty string", t.scenario) end
+  if M.written then
+    error("report: this run already reported scenario '" .. M.written ..
+          "' (one report per run; put all figures in one call)", 0)
+  end
+  local params = t.params or {}
+  if type(params) ~= "table" then bad("params", "table", params) end
+  for k, v in pairs(params) do
+    if type(k) ~= "string" then bad("params", "table with string keys", k) end
+    check_value(v, "params." .. k)
+  end
+  local metrics = t.metrics or {}
+  if type(metrics) ~= "table" then bad("metrics", "table", metrics) end
+  for k, v in pairs(metrics) do
+    if not is_name(k) then bad("metrics", "snake_case metric names (e.g. wall_s)", k) end
+    check_value(v, "metrics." .. k)
+  end
+  local r = { scenario = t.scenario, params = params, metrics = metrics,
+              checks = normalise_checks(t.checks), wall_s = grainlab.elapsed(),
+              version = grainlab.version }
+  M.written = t.scenario
+
+  local failed = 0
+  for _, c in ipairs(r.checks) do if not c.pass then failed = failed + 1 end end
+  M.failed = M.failed + failed
+  print_table(r)
+
+  local path = grainlab.options.report or os.getenv("GRAINLAB_REPORT")
+  if path and path ~= "" then
+    local ok, msg = grainlab.write_file(path, json.encode(r))
+    if not ok then error("report: " .. msg, 0) end
+  end
+  return failed == 0, r
+end
+
+local function report(t)
+  local ok, passed, r = pcall(report_impl, t)
+  if not ok then error(passed, 2) end
+  return passed, r
+end
+
+M.report = report
+grainlab.doc(report, {
+  name = "grainlab.report",
+  usage = "grainlab.report{ scenario = 'name', params = {…}, metrics = {…}, checks = {{ name =, value =, limit =, op = '<=' }, …} }",
+  doc = [[Reports a scenario's figures: prints a readable table and, with --report FILE.json or
+GRAINLAB_REPORT=FILE, writes them as JSON (written whole; keys sorted):
+  {"scenario", "params", "metrics", "checks": [{"name","value","limit","op","pass"}], "wall_s", "version"}
+Metric and check names are snake_case with the unit in the name where useful (wall_s,
+particle_steps_per_s). A check passes when `value op limit` holds (op defaults to '<='; a NaN
+value fails), or give pass = true/false directly. Any failed check makes grainlab exit with
+status 1 at the end of the run. One report per run. Returns all_passed, record.]] })
+
+return M

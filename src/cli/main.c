@@ -1,0 +1,321 @@
+/* grainlab's command line: options, name=value params, then -e chunks, a script, standard input
+ * or the REPL. Exit status: 0 ok, 1 a Lua error or a failed report check, 2 bad usage. */
+#define _POSIX_C_SOURCE 200809L
+#include <ctype.h>
+#include <errno.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include <lauxlib.h>
+
+#include "cli/cli.h"
+#include "core/interrupt.h"
+#include "core/progress.h"
+#include "core/threads.h"
+#include "lua/bind.h"
+
+static const char *USAGE =
+    "usage: grainlab [options] [FILE.lua] [name=value ...]\n"
+    "\n"
+    "  grainlab                    interactive REPL (standard input is run as a chunk when it is\n"
+    "                              not a terminal)\n"
+    "  grainlab FILE.lua a=1 b=x   run a script; the pairs arrive in the global table `params`\n"
+    "                              (numbers converted, true/false as booleans, text as strings);\n"
+    "                              FILE '-' reads the script from standard input\n"
+    "\n"
+    "options:\n"
+    "  -i               enter the REPL after running the script and -e chunks\n"
+    "  -e CODE          run the Lua chunk CODE (repeatable; runs before the script)\n"
+    "  --threads N      worker threads for the kernels (default: all processors)\n"
+    "  --quiet, -q      no progress output\n"
+    "  --report FILE    also write the run's grainlab.report as JSON to FILE\n"
+    "                   (environment: GRAINLAB_REPORT)\n"
+    "  --version, -v    print version and libraries, then exit\n"
+    "  --help, -h       print this help, then exit\n"
+    "  --               end of options\n"
+    "\n"
+    "In the REPL, help() gives an overview and help(x) documents any API object.\n"
+    "Exit status: 0 success, 1 Lua error or failed report check, 2 bad command line.\n";
+
+typedef struct cli_args {
+    int interactive, quiet, version, help;
+    long threads;
+    const char *report;
+    const char *script;
+    int nchunks, nparams;
+    const char **chunks;
+    const char **params;
+} cli_args;
+
+static int usage_error(const char *fmt, const char *what)
+{
+    fprintf(stderr, "grainlab: ");
+    fprintf(stderr, fmt, what);
+    fprintf(stderr, " (see grainlab --help)\n");
+    return 2;
+}
+
+static int valid_name(const char *s, size_t len)
+{
+    if (len == 0 || !(isalpha((unsigned char)s[0]) || s[0] == '_'))
+        return 0;
+    for (size_t i = 1; i < len; i++)
+        if (!(isalnum((unsigned char)s[i]) || s[i] == '_'))
+            return 0;
+    return 1;
+}
+
+/* Reads the value of an option given as "--opt VALUE" or "--opt=VALUE". */
+static const char *option_value(int argc, char **argv, int *i, const char *name)
+{
+    size_t n = strlen(name);
+    if (argv[*i][n] == '=')
+        return argv[*i] + n + 1;
+    if (*i + 1 < argc)
+        return argv[++*i];
+    return NULL;
+}
+
+static int parse_args(int argc, char **argv, cli_args *a)
+{
+    int options_done = 0;
+    for (int i = 1; i < argc; i++) {
+        const char *s = argv[i];
+        if (options_done || s[0] != '-' || strcmp(s, "-") == 0) {
+            const char *eq = strchr(s, '=');
+            if (!a->script && !eq && a->nparams == 0) {
+                a->script = s;
+            } else if (eq) {
+                if (!valid_name(s, (size_t)(eq - s)))
+                    return usage_error("bad parameter '%s': the name must be a Lua identifier", s);
+                a->params[a->nparams++] = s;
+            } else {
+                return usage_error("argument '%s' is not name=value", s);
+            }
+        } else if (strcmp(s, "--") == 0) {
+            options_done = 1;
+        } else if (strcmp(s, "-i") == 0) {
+            a->interactive = 1;
+        } else if (strcmp(s, "-q") == 0 || strcmp(s, "--quiet") == 0) {
+            a->quiet = 1;
+        } else if (strcmp(s, "-v") == 0 || strcmp(s, "--version") == 0) {
+            a->version = 1;
+        } else if (strcmp(s, "-h") == 0 || strcmp(s, "--help") == 0) {
+            a->help = 1;
+        } else if (strcmp(s, "-e") == 0) {
+            if (i + 1 >= argc)
+                return usage_error("%s needs a Lua chunk", "-e");
+            a->chunks[a->nchunks++] = argv[++i];
+        } else if (strncmp(s, "--threads", 9) == 0 && (s[9] == '\0' || s[9] == '=')) {
+            const char *v = option_value(argc, argv, &i, "--threads");
+            char *end;
+            errno = 0;
+            a->threads = v ? strtol(v, &end, 10) : 0;
+            if (!v || *end || errno || a->threads < 1 || a->threads > 4096)
+                return usage_error("--threads needs an integer in [1, 4096], got '%s'",
+                                   v ? v : "nothing");
+        } else if (strncmp(s, "--report", 8) == 0 && (s[8] == '\0' || s[8] == '=')) {
+            a->report = option_value(argc, argv, &i, "--report");
+            if (!a->report || !*a->report)
+                return usage_error("%s needs a file name", "--report");
+        } else {
+            return usage_error("unknown option '%s'", s);
+        }
+    }
+    return 0;
+}
+
+/* ---- running Lua with a traceback and Ctrl-C ---------------------------------------------- */
+static lua_State *running_L;
+
+static void stop_hook(lua_State *L, lua_Debug *ar)
+{
+    (void)ar;
+    lua_sethook(L, NULL, 0, 0);
+    luaL_error(L, "interrupted by Ctrl-C");
+}
+
+/* Only async-signal-safe work: a flag for the kernels and a hook for the Lua VM (lua.c does the
+ * same). A second Ctrl-C before the first is handled ends the process. */
+static void on_sigint(int sig)
+{
+    signal(sig, SIG_DFL);
+    interrupt_request();
+    lua_sethook(running_L, stop_hook, LUA_MASKCALL | LUA_MASKRET | LUA_MASKCOUNT, 1);
+}
+
+static int message_handler(lua_State *L)
+{
+    const char *msg = lua_tostring(L, 1);
+    if (msg == NULL) {
+        if (luaL_callmeta(L, 1, "__tostring") && lua_type(L, -1) == LUA_TSTRING)
+            return 1;
+        msg = lua_pushfstring(L, "(error object is a %s value)", luaL_typename(L, 1));
+    }
+    luaL_traceback(L, L, msg, 1);
+    return 1;
+}
+
+int cli_docall(lua_State *L, int narg, int nres)
+{
+    int base = lua_gettop(L) - narg;
+    lua_pushcfunction(L, message_handler);
+    lua_insert(L, base);
+    running_L = L;
+    struct sigaction sa = {0}, old;
+    sa.sa_handler = on_sigint;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, &old);
+    int status = lua_pcall(L, narg, nres, base);
+    sigaction(SIGINT, &old, NULL);
+    if (lua_gethook(L) == stop_hook)
+        lua_sethook(L, NULL, 0, 0);
+    interrupt_clear();
+    lua_remove(L, base);
+    return status;
+}
+
+void cli_print_error(lua_State *L)
+{
+    const char *msg = lua_tostring(L, -1);
+    fprintf(stderr, "grainlab: %s\n", msg ? msg : "(error object is not a string)");
+    fflush(stderr);
+    lua_pop(L, 1);
+}
+
+static int run_chunk(lua_State *L, int load_status)
+{
+    if (load_status == LUA_OK)
+        load_status = cli_docall(L, 0, 0);
+    if (load_status != LUA_OK) {
+        cli_print_error(L);
+        return 1;
+    }
+    return 0;
+}
+
+/* ---- globals from the command line ------------------------------------------------------- */
+static void push_param_value(lua_State *L, const char *v)
+{
+    if (strcmp(v, "true") == 0)
+        lua_pushboolean(L, 1);
+    else if (strcmp(v, "false") == 0)
+        lua_pushboolean(L, 0);
+    else if (*v == '\0' || lua_stringtonumber(L, v) == 0)
+        lua_pushstring(L, v);
+}
+
+static void set_params(lua_State *L, const cli_args *a, char *argv0)
+{
+    lua_getglobal(L, "params");
+    for (int i = 0; i < a->nparams; i++) {
+        const char *eq = strchr(a->params[i], '=');
+        lua_pushlstring(L, a->params[i], (size_t)(eq - a->params[i]));
+        push_param_value(L, eq + 1);
+        lua_settable(L, -3);
+    }
+    lua_pop(L, 1);
+    /* arg as in lua: arg[0] the script, arg[-1] the interpreter, arg[1..] the pairs. */
+    lua_createtable(L, a->nparams, 2);
+    lua_pushstring(L, argv0);
+    lua_rawseti(L, -2, -1);
+    if (a->script) {
+        lua_pushstring(L, a->script);
+        lua_rawseti(L, -2, 0);
+    }
+    for (int i = 0; i < a->nparams; i++) {
+        lua_pushstring(L, a->params[i]);
+        lua_rawseti(L, -2, i + 1);
+    }
+    lua_setglobal(L, "arg");
+}
+
+/* Lets a scenario script require helpers that sit beside it. */
+static void add_script_dir_to_path(lua_State *L, const char *script)
+{
+    const char *slash = strrchr(script, '/');
+    lua_getglobal(L, "package");
+    if (slash)
+        lua_pushlstring(L, script, (size_t)(slash - script + 1));
+    else
+        lua_pushliteral(L, "./");
+    lua_pushliteral(L, "?.lua;");
+    lua_getfield(L, -3, "path");
+    lua_concat(L, 3);
+    lua_setfield(L, -2, "path");
+    lua_pop(L, 1);
+}
+
+static int run_script(lua_State *L, const char *script)
+{
+    int status;
+    if (strcmp(script, "-") == 0) {
+        status = luaL_loadfilex(L, NULL, "t");
+    } else {
+        add_script_dir_to_path(L, script);
+        status = luaL_loadfilex(L, script, "t");
+    }
+    return run_chunk(L, status);
+}
+
+int main(int argc, char **argv)
+{
+    /* Line-buffered even into a pipe, so printed results and progress lines on stderr
+     * interleave in logs the way they happened. */
+    setvbuf(stdout, NULL, _IOLBF, 0);
+    cli_args a = {0};
+    a.chunks = calloc((size_t)argc, sizeof *a.chunks);
+    a.params = calloc((size_t)argc, sizeof *a.params);
+    if (!a.chunks || !a.params) {
+        fprintf(stderr, "grainlab: out of memory\n");
+        return 1;
+    }
+    int status = parse_args(argc, argv, &a);
+    if (status == 0 && a.help)
+        fputs(USAGE, stdout);
+    else if (status == 0 && a.version)
+        printf("grainlab %s (%s; %d threads available)\n", GRAINLAB_VERSION, GRAINLAB_DEPS,
+               threads_available());
+    if (status != 0 || a.help || a.version) {
+        free(a.chunks);
+        free(a.params);
+        return status;
+    }
+    if (a.quiet)
+        progress_set_default_style(PROGRESS_QUIET);
+    if (a.threads)
+        threads_set((int)a.threads);
+
+    bind_options opt = {.report_path = a.report, .quiet = a.quiet};
+    lua_State *L = bind_newstate(&opt);
+    if (!L)
+        return 1;
+    set_params(L, &a, argv[0]);
+
+    for (int i = 0; i < a.nchunks && status == 0; i++)
+        status = run_chunk(L, luaL_loadbufferx(L, a.chunks[i], strlen(a.chunks[i]),
+                                               "=(command line)", "t"));
+    if (status == 0 && a.script)
+        status = run_script(L, a.script);
+    else if (status == 0 && a.nchunks == 0 && !a.interactive) {
+        if (isatty(STDIN_FILENO))
+            repl_run(L);
+        else
+            status = run_chunk(L, luaL_loadfilex(L, NULL, "t"));
+    }
+    if (a.interactive) /* also after an error: the state is there to inspect */
+        repl_run(L);
+
+    int failed = bind_failed_checks(L);
+    if (failed) {
+        fprintf(stderr, "grainlab: %d report check%s failed\n", failed, failed == 1 ? "" : "s");
+        status = 1;
+    }
+    lua_close(L);
+    free(a.chunks);
+    free(a.params);
+    return status;
+}

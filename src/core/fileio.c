@@ -1,0 +1,79 @@
+/* Whole-file writes through a temporary file and rename(2). */
+#define _POSIX_C_SOURCE 200809L
+#include "core/fileio.h"
+
+#include <errno.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+core_status atomic_open(atomic_file *f, const char *path, core_error *err)
+{
+    f->fp = NULL;
+    if (!path || !*path)
+        return core_fail(err, CORE_ERR_ARG, "empty file name");
+    if (strlen(path) >= sizeof f->path)
+        return core_fail(err, CORE_ERR_ARG, "file name too long (%zu characters)", strlen(path));
+    strcpy(f->path, path);
+    snprintf(f->tmp, sizeof f->tmp, "%s.tmp.XXXXXX", path);
+    int fd = mkstemp(f->tmp);
+    if (fd < 0)
+        return core_fail(err, CORE_ERR_IO, "cannot write '%s': %s", path, strerror(errno));
+    f->fp = fdopen(fd, "wb");
+    if (!f->fp) {
+        int e = errno;
+        close(fd);
+        unlink(f->tmp);
+        return core_fail(err, CORE_ERR_IO, "cannot write '%s': %s", path, strerror(e));
+    }
+    return CORE_OK;
+}
+
+core_status atomic_commit(atomic_file *f, core_error *err)
+{
+    if (!f->fp)
+        return core_fail(err, CORE_ERR_STATE, "file '%s' is not open", f->path);
+    /* mkstemp creates 0600; give the file the permissions an ordinary fopen would. */
+    mode_t mask = umask(0);
+    umask(mask);
+    int bad = ferror(f->fp) || fflush(f->fp) != 0 || fchmod(fileno(f->fp), 0666 & ~mask) != 0;
+    int e = errno;
+    if (fclose(f->fp) != 0 && !bad) {
+        bad = 1;
+        e = errno;
+    }
+    f->fp = NULL;
+    if (!bad && rename(f->tmp, f->path) != 0) {
+        bad = 1;
+        e = errno;
+    }
+    if (bad) {
+        unlink(f->tmp);
+        return core_fail(err, CORE_ERR_IO, "cannot write '%s': %s", f->path, strerror(e));
+    }
+    return CORE_OK;
+}
+
+void atomic_abort(atomic_file *f)
+{
+    if (f->fp) {
+        fclose(f->fp);
+        f->fp = NULL;
+        unlink(f->tmp);
+    }
+}
+
+core_status atomic_write(const char *path, const void *data, size_t len, core_error *err)
+{
+    atomic_file f;
+    core_status st = atomic_open(&f, path, err);
+    if (st != CORE_OK)
+        return st;
+    if (len && fwrite(data, 1, len, f.fp) != len) {
+        int e = errno;
+        atomic_abort(&f);
+        return core_fail(err, CORE_ERR_IO, "cannot write '%s': %s", path, strerror(e));
+    }
+    return atomic_commit(&f, err);
+}

@@ -1,0 +1,28 @@
+/* Output files are written whole: data goes to a temporary file beside the target, which is
+ * renamed over it only when complete, so a failed or interrupted write never leaves half a file. */
+#ifndef GRAINLAB_CORE_FILEIO_H
+#define GRAINLAB_CORE_FILEIO_H
+
+#include <stdio.h>
+
+#include "core/error.h"
+
+typedef struct atomic_file {
+    FILE *fp;           /* write here */
+    char path[4096];    /* final name */
+    char tmp[4096 + 32];
+} atomic_file;
+
+/* Opens a temporary file in the target's directory. */
+core_status atomic_open(atomic_file *f, const char *path, core_error *err);
+
+/* Flushes, closes and renames into place; on any failure removes the temporary file. */
+core_status atomic_commit(atomic_file *f, core_error *err);
+
+/* Closes and removes the temporary file (for a writer that failed half-way). */
+void atomic_abort(atomic_file *f);
+
+/* Writes len bytes to path whole. */
+core_status atomic_write(const char *path, const void *data, size_t len, core_error *err);
+
+#endif

@@ -1,0 +1,178 @@
+/* Argument and table-field checking: every error names the call, the field and the value. */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "lua/bind.h"
+
+/* The argument number the user sees: a method's self is not counted, as in luaL_argerror. */
+static int user_arg(lua_State *L, int arg)
+{
+    lua_Debug ar;
+    if (lua_getstack(L, 0, &ar) && lua_getinfo(L, "n", &ar) && ar.namewhat &&
+        strcmp(ar.namewhat, "method") == 0)
+        return arg - 1;
+    return arg;
+}
+
+void bind_describe(lua_State *L, int idx, char *buf, size_t size)
+{
+    switch (lua_type(L, idx)) {
+    case LUA_TNUMBER: /* as print shows it: 3, 1.5, 1e+09, -nan */
+        snprintf(buf, size, "%s", luaL_tolstring(L, idx, NULL));
+        lua_pop(L, 1);
+        break;
+    case LUA_TSTRING: {
+        size_t len;
+        const char *s = lua_tolstring(L, idx, &len);
+        snprintf(buf, size, len > 40 ? "'%.37s...'" : "'%s'", s);
+        break;
+    }
+    case LUA_TBOOLEAN:
+        snprintf(buf, size, "%s", lua_toboolean(L, idx) ? "true" : "false");
+        break;
+    default:
+        snprintf(buf, size, "%s", luaL_typename(L, idx));
+    }
+}
+
+int bind_field_error(lua_State *L, int arg, const char *call, const char *field,
+                     const char *expected)
+{
+    char got[64];
+    bind_describe(L, -1, got, sizeof got);
+    return luaL_error(L, "bad field '%s' in argument #%d to '%s' (%s expected, got %s)", field,
+                      user_arg(L, arg), call, expected, got);
+}
+
+void bind_check_table(lua_State *L, int arg, const char *call)
+{
+    if (lua_type(L, arg) != LUA_TTABLE)
+        luaL_error(L, "bad argument #%d to '%s' (table expected, got %s)", user_arg(L, arg), call,
+                   luaL_typename(L, arg));
+}
+
+void bind_check_fields(lua_State *L, int arg, const char *call, const char *const fields[])
+{
+    arg = lua_absindex(L, arg);
+    lua_pushnil(L);
+    while (lua_next(L, arg)) {
+        lua_pop(L, 1);
+        int known = 0;
+        if (lua_type(L, -1) == LUA_TSTRING) {
+            const char *key = lua_tostring(L, -1);
+            for (int i = 0; fields[i] && !known; i++)
+                known = strcmp(key, fields[i]) == 0;
+        }
+        if (!known) {
+            char key[64], list[512] = "";
+            bind_describe(L, -1, key, sizeof key);
+            for (int i = 0; fields[i]; i++) {
+                if (i)
+                    strncat(list, ", ", sizeof list - strlen(list) - 1);
+                strncat(list, fields[i], sizeof list - strlen(list) - 1);
+            }
+            luaL_error(L, "bad argument #%d to '%s' (unknown field %s; valid fields: %s)",
+                       user_arg(L, arg), call, key, list);
+        }
+    }
+}
+
+/* Pushes t[field]; returns 0 (with nothing pushed) when absent and not required. */
+static int get_field(lua_State *L, int arg, const char *call, const char *field, unsigned flags,
+                     const char *expected)
+{
+    if (lua_getfield(L, arg, field) == LUA_TNIL) {
+        if (flags & BIND_REQUIRED)
+            bind_field_error(L, arg, call, field, expected);
+        lua_pop(L, 1);
+        return 0;
+    }
+    return 1;
+}
+
+static const char *number_kind(unsigned flags)
+{
+    if (flags & BIND_POSITIVE)
+        return "positive number";
+    if (flags & BIND_NONNEG)
+        return "non-negative number";
+    return (flags & BIND_ALLOW_INF) ? "number" : "finite number";
+}
+
+double bind_field_number(lua_State *L, int arg, const char *call, const char *field, double def,
+                         unsigned flags)
+{
+    const char *expected = number_kind(flags);
+    if (!get_field(L, arg, call, field, flags, expected))
+        return def;
+    int isnum;
+    double v = lua_tonumberx(L, -1, &isnum);
+    if (!isnum || lua_type(L, -1) != LUA_TNUMBER || isnan(v) ||
+        (!(flags & BIND_ALLOW_INF) && isinf(v)) || ((flags & BIND_POSITIVE) && !(v > 0)) ||
+        ((flags & BIND_NONNEG) && !(v >= 0)))
+        bind_field_error(L, arg, call, field, expected);
+    lua_pop(L, 1);
+    return v;
+}
+
+lua_Integer bind_field_integer(lua_State *L, int arg, const char *call, const char *field,
+                               lua_Integer def, lua_Integer min, lua_Integer max, unsigned flags)
+{
+    char expected[96];
+    if (min == 0 && max == LUA_MAXINTEGER)
+        snprintf(expected, sizeof expected, "non-negative integer");
+    else if (min == 1 && max == LUA_MAXINTEGER)
+        snprintf(expected, sizeof expected, "positive integer");
+    else
+        snprintf(expected, sizeof expected, "integer in [%lld, %lld]", (long long)min,
+                 (long long)max);
+    if (!get_field(L, arg, call, field, flags, expected))
+        return def;
+    int isint;
+    lua_Integer v = lua_tointegerx(L, -1, &isint);
+    if (!isint || lua_type(L, -1) != LUA_TNUMBER || v < min || v > max)
+        bind_field_error(L, arg, call, field, expected);
+    lua_pop(L, 1);
+    return v;
+}
+
+const char *bind_field_string(lua_State *L, int arg, const char *call, const char *field,
+                              const char *def, unsigned flags)
+{
+    if (!get_field(L, arg, call, field, flags, "string"))
+        return def;
+    if (lua_type(L, -1) != LUA_TSTRING)
+        bind_field_error(L, arg, call, field, "string");
+    const char *s = lua_tostring(L, -1);
+    lua_pop(L, 1); /* still referenced by the table */
+    return s;
+}
+
+int bind_field_option(lua_State *L, int arg, const char *call, const char *field,
+                      const char *const names[], int def, unsigned flags)
+{
+    char expected[256] = "one of ";
+    for (int i = 0; names[i]; i++) {
+        size_t n = strlen(expected);
+        snprintf(expected + n, sizeof expected - n, "%s'%s'", i ? ", " : "", names[i]);
+    }
+    if (!get_field(L, arg, call, field, flags, expected))
+        return def;
+    if (lua_type(L, -1) == LUA_TSTRING) {
+        const char *s = lua_tostring(L, -1);
+        for (int i = 0; names[i]; i++)
+            if (strcmp(s, names[i]) == 0) {
+                lua_pop(L, 1);
+                return i;
+            }
+    }
+    return bind_field_error(L, arg, call, field, expected);
+}
+
+int bind_raise(lua_State *L, const char *call, const core_error *err)
+{
+    if (err->msg[0])
+        return luaL_error(L, "%s: %s", call, err->msg);
+    return luaL_error(L, "%s: %s", call, core_status_name(err->status));
+}

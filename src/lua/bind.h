@@ -1,0 +1,87 @@
+/* grainlab's Lua bindings: the state, argument checking with field-naming errors, the doc registry
+ * behind help(), and the one place where a kernel's core_error becomes a Lua error. */
+#ifndef GRAINLAB_LUA_BIND_H
+#define GRAINLAB_LUA_BIND_H
+
+#include <lauxlib.h>
+#include <lua.h>
+
+#include "core/error.h"
+
+typedef struct bind_options {
+    const char *report_path; /* --report FILE.json, or NULL (then GRAINLAB_REPORT applies) */
+    int quiet;               /* --quiet */
+} bind_options;
+
+/* A new Lua state with the standard libraries, the embedded grainlab.* modules on
+ * package.preload, and the globals grainlab, help and params (empty). NULL if out of memory. */
+lua_State *bind_newstate(const bind_options *opt);
+
+/* Number of failed report checks so far (the CLI turns a nonzero count into exit status 1). */
+int bind_failed_checks(lua_State *L);
+
+/* Raises err as a Lua error "call: message". Never returns. */
+int bind_raise(lua_State *L, const char *call, const core_error *err);
+
+/* ---- argument checking -------------------------------------------------------------------
+ * `arg` is the stack index of the argument; messages number it as the user sees it (a method's
+ * self does not count) and follow lauxlib's grammar:
+ *   bad argument #1 to 'rng' (table expected, got nil)
+ *   bad field 'seed' in argument #1 to 'rng' (non-negative integer expected, got -1)
+ */
+enum {
+    BIND_REQUIRED = 1u << 0, /* the field must be present */
+    BIND_POSITIVE = 1u << 1, /* > 0 */
+    BIND_NONNEG = 1u << 2,   /* >= 0 */
+    BIND_ALLOW_INF = 1u << 3 /* numbers are finite unless this is set; NaN is always refused */
+};
+
+void bind_check_table(lua_State *L, int arg, const char *call);
+
+/* Refuses any key of the table at arg not in the NULL-terminated list `fields`. */
+void bind_check_fields(lua_State *L, int arg, const char *call, const char *const fields[]);
+
+double bind_field_number(lua_State *L, int arg, const char *call, const char *field, double def,
+                         unsigned flags);
+lua_Integer bind_field_integer(lua_State *L, int arg, const char *call, const char *field,
+                               lua_Integer def, lua_Integer min, lua_Integer max, unsigned flags);
+/* The returned string lives in the table at arg. */
+const char *bind_field_string(lua_State *L, int arg, const char *call, const char *field,
+                              const char *def, unsigned flags);
+/* Index of the field's value in the NULL-terminated `names`, or def when absent. */
+int bind_field_option(lua_State *L, int arg, const char *call, const char *field,
+                      const char *const names[], int def, unsigned flags);
+
+/* Raises "bad field 'F' in argument #N to 'call' (EXPECTED expected, got VALUE)" for the value
+ * on top of the stack. */
+int bind_field_error(lua_State *L, int arg, const char *call, const char *field,
+                     const char *expected);
+
+/* Writes a short description of the value at idx: "-0.1", "'xyz'", "nil", "table". */
+void bind_describe(lua_State *L, int idx, char *buf, size_t size);
+
+/* ---- documentation for help() ------------------------------------------------------------ */
+typedef struct bind_fn {
+    const char *name;
+    lua_CFunction fn;
+    const char *usage; /* "grainlab.rng{ seed = 0, stream = 0 }" */
+    const char *doc;   /* what it does, arguments, what it returns */
+} bind_fn;
+
+/* Sets each function as a field of the table at idx and records its doc. */
+void bind_register(lua_State *L, int idx, const bind_fn *fns);
+
+/* Records the doc of the value at idx (a function, a module table, or a type's metatable). */
+void bind_doc(lua_State *L, int idx, const char *name, const char *usage, const char *doc);
+
+/* Creates the metatable `tname` for a userdata type: methods (with docs) in __index, the
+ * metamethods in `meta` (no docs), and a doc for the type itself. Leaves nothing on the stack. */
+void bind_new_type(lua_State *L, const char *tname, const bind_fn *methods, const luaL_Reg *meta,
+                   const char *doc);
+
+/* Open the C parts of the grainlab table onto the table at idx: lua_core.c (version, clocks,
+ * threads, rng, progress, write_file) and help.c (doc, doc_of). */
+void bind_open_core(lua_State *L, int idx);
+void bind_open_help(lua_State *L, int idx);
+
+#endif

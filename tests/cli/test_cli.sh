@@ -1,0 +1,108 @@
+#!/usr/bin/env bash
+# The command line as scripts and CI use it: exit codes, messages on stderr, params, standard
+# input, -e, -i without a terminal, report JSON (read with jq), progress lines, Ctrl-C.
+# usage: test_cli.sh path/to/grainlab   (run from tests/cli, where the fixture scripts are)
+set -u
+G=$1
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+passed=0 failed=0
+
+# run CMD... : runs with stdin from /dev/null unless redirected; sets $out, $err, $rc
+run() { "$@" >"$tmp/out" 2>"$tmp/err"; rc=$?; out=$(cat "$tmp/out"); err=$(cat "$tmp/err"); }
+ok() { passed=$((passed + 1)); }
+bad() { failed=$((failed + 1)); echo "FAIL: $*"; echo "  rc=$rc"; echo "  stdout: $out"; echo "  stderr: $err"; }
+expect_rc() { [ "$rc" -eq "$1" ] && ok || bad "$2: exit status $rc, expected $1"; }
+has() { case "$1" in *"$2"*) ok ;; *) bad "$3: missing '$2'" ;; esac; }
+lines() { [ "$(printf '%s\n' "$1" | grep -c .)" -eq "$2" ] && ok || bad "$3: expected $2 line(s)"; }
+
+# --- flags ---
+run "$G" --version </dev/null;  expect_rc 0 version; has "$out" "grainlab 0.1.0 (Lua 5.4" version
+run "$G" --help </dev/null;     expect_rc 0 help; has "$out" "usage: grainlab" help
+run "$G" --bogus </dev/null;    expect_rc 2 unknown-flag; has "$err" "unknown option '--bogus'" unknown-flag
+lines "$err" 1 unknown-flag
+run "$G" -e </dev/null;         expect_rc 2 e-without-code; has "$err" "-e needs a Lua chunk" e-without-code
+run "$G" --threads 0 -e 'print(1)' </dev/null; expect_rc 2 threads-0; has "$err" "--threads needs an integer" threads-0
+run "$G" --threads=1 -e 'print("threads", grainlab.threads())' </dev/null
+expect_rc 0 threads-1; has "$out" "threads	1" threads-1
+run "$G" --report </dev/null;   expect_rc 2 report-no-file; has "$err" "--report needs a file name" report-no-file
+
+# --- scripts and their errors ---
+run "$G" no_such_script.lua </dev/null
+expect_rc 1 missing-script; has "$err" "cannot open no_such_script.lua" missing-script; lines "$err" 1 missing-script
+run "$G" syntax_error.lua </dev/null
+expect_rc 1 syntax; has "$err" "syntax_error.lua:4: ')' expected (to close '(' at line 3) near 'end'" syntax
+lines "$err" 1 syntax
+run "$G" runtime_error.lua </dev/null
+expect_rc 1 runtime; has "$err" "runtime_error.lua:2: attempt to index a nil value (local 'v')" runtime
+has "$err" "stack traceback:" runtime; has "$err" "runtime_error.lua:4: in main chunk" runtime
+run "$G" -e 'error({})' </dev/null
+expect_rc 1 error-object; has "$err" "(error object is a table value)" error-object
+
+# --- params ---
+run "$G" params.lua n=100 x=2.5 name=run1 flag=false on=true neg=-3 hex=0x10 empty= path=a=b </dev/null
+expect_rc 0 params
+for want in "n	integer	100" "x	float	2.5" "name	string	run1" "flag	boolean	false" \
+            "on	boolean	true" "neg	integer	-3" "hex	integer	16" "empty	string	" \
+            "path	string	a=b" "arg0	params.lua"; do
+  has "$out" "$want" params
+done
+run "$G" params.lua n=1 oops </dev/null; expect_rc 2 param-without-eq; has "$err" "argument 'oops' is not name=value" param-without-eq
+lines "$err" 1 param-without-eq
+run "$G" params.lua 1x=2 </dev/null;    expect_rc 2 param-bad-name; has "$err" "bad parameter '1x=2'" param-bad-name
+run "$G" -e 'print(params.k + 1)' k=41 </dev/null; expect_rc 0 params-with-e; has "$out" "42" params-with-e
+
+# --- standard input, -e, -i ---
+run "$G" <<<'print("from stdin", 6*7)'; expect_rc 0 stdin-chunk; has "$out" "from stdin	42" stdin-chunk
+run "$G" <<<'error("stdin boom")'; expect_rc 1 stdin-error; has "$err" "stdin:1: stdin boom" stdin-error
+run "$G" - who=pipe <<<'print("script from stdin", params.who)'
+expect_rc 0 stdin-script; has "$out" "script from stdin	pipe" stdin-script
+run "$G" -e 'x = 5' -e 'print(x * 2)' </dev/null; expect_rc 0 two-e; has "$out" "10" two-e
+run "$G" -e 'nil_call()' </dev/null; expect_rc 1 e-error; has "$err" "(command line):1: attempt to call a nil value (global 'nil_call')" e-error
+run "$G" -i -e 'y = 3' <<<$'y * 14\nfunction f()\nreturn "multi"\nend\nf()\nerror("in repl")\nprint("after error")'
+expect_rc 0 interactive-pipe; has "$out" "42" interactive-pipe; has "$out" "multi" interactive-pipe
+has "$err" "stdin:1: in repl" interactive-pipe; has "$out" "after error" interactive-pipe
+
+# --- reports ---
+run "$G" report_ok.lua n=7 --report "$tmp/ok.json" </dev/null
+expect_rc 0 report-ok; has "$out" "== cli_ok ==" report-ok; has "$out" "3 passed, 0 failed" report-ok
+if jq -e '.scenario == "cli_ok" and .params.n == 7 and .params.label == "x"
+          and .metrics.particle_steps_per_s == 1500000 and .metrics.steps == 1000
+          and (.checks | length) == 3 and all(.checks[]; .pass == true)
+          and .checks[0].name == "restitution_rel_err" and .checks[0].limit == 0.001
+          and .checks[1].op == ">=" and (.wall_s | type) == "number" and .wall_s >= 0' \
+     "$tmp/ok.json" >/dev/null; then ok; else bad "report-ok: JSON content: $(cat "$tmp/ok.json")"; fi
+[ -z "$(ls "$tmp" | grep '\.tmp\.')" ] && ok || bad "report-ok: temporary file left behind"
+
+run env GRAINLAB_REPORT="$tmp/fail.json" "$G" report_fail.lua </dev/null
+expect_rc 1 report-fail; has "$out" "FAIL  small_error" report-fail; has "$out" "1 passed, 2 failed" report-fail
+has "$out" "report returned	false" report-fail; has "$err" "2 report checks failed" report-fail
+if jq -e '.scenario == "cli_fail" and .checks[0].pass == false and .checks[1].value == null
+          and .checks[1].pass == false and .checks[2].pass == true' "$tmp/fail.json" >/dev/null
+then ok; else bad "report-fail: JSON content: $(cat "$tmp/fail.json")"; fi
+
+run "$G" report_ok.lua --report "$tmp/no/such/dir/r.json" </dev/null
+expect_rc 1 report-unwritable; has "$err" "report: cannot write '$tmp/no/such/dir/r.json'" report-unwritable
+[ ! -e "$tmp/no/such/dir/r.json" ] && ok || bad "report-unwritable: file exists"
+
+run "$G" -e 'grainlab.report{ scenario = "x", metrics = { ["Bad-Name"] = 1 } }' </dev/null
+expect_rc 1 report-bad-metric; has "$err" "bad field 'metrics' in argument #1 to 'report' (snake_case metric names" report-bad-metric
+has "$err" "(command line):1:" report-bad-metric
+
+# --- progress when not a terminal; --quiet ---
+run "$G" progress.lua </dev/null
+expect_rc 0 progress-lines
+for pct in " 10%" " 50%" " 90%"; do has "$err" "sweep: $pct" progress-lines; done
+has "$err" "sweep: done, 50 cases in" progress-lines; lines "$err" 10 progress-lines
+run "$G" --quiet progress.lua </dev/null; expect_rc 0 progress-quiet; [ -z "$err" ] && ok || bad "progress-quiet: stderr not empty"
+
+# --- Ctrl-C (SIGINT) stops a running script with an error naming it ---
+"$G" -e 'while true do end' </dev/null >"$tmp/out" 2>"$tmp/err" &
+pid=$!
+sleep 0.5
+kill -INT "$pid"
+wait "$pid"; rc=$?; out=$(cat "$tmp/out"); err=$(cat "$tmp/err")
+expect_rc 1 sigint; has "$err" "interrupted by Ctrl-C" sigint
+
+echo "cli: $passed passed, $failed failed"
+[ "$failed" -eq 0 ]

@@ -1,0 +1,287 @@
+/* The REPL as a user meets it: grainlab runs on a pseudo-terminal (forkpty), the test types
+ * lines, Tab, Ctrl-C and Ctrl-D, and reads the screen. Covers expression printing, multi-line
+ * input, error recovery, Ctrl-C in a running loop and at the prompt, tab completion, help, and
+ * the history file (written, and read back by the next session). */
+#define _DEFAULT_SOURCE
+#include <errno.h>
+#include <poll.h>
+#include <pty.h>
+#include <setjmp.h>
+#include <signal.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+#include <cmocka.h>
+
+typedef struct session {
+    pid_t pid;
+    int fd;
+    char out[1 << 16]; /* screen output, terminal escape sequences removed */
+    size_t len, mark;  /* mark: where the next expect() starts looking */
+} session;
+
+static char tmpdir[64];
+static char history[128];
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+static int wait_prompt(session *s);
+
+static void start(session *s)
+{
+    memset(s, 0, sizeof *s);
+    struct winsize ws = {.ws_row = 40, .ws_col = 120};
+    s->pid = forkpty(&s->fd, NULL, NULL, &ws);
+    assert_true(s->pid >= 0);
+    if (s->pid == 0) {
+        setenv("GRAINLAB_HISTORY", history, 1);
+        setenv("HOME", tmpdir, 1);
+        setenv("TERM", "xterm", 1);
+        unsetenv("INPUTRC");
+        execl(GRAINLAB_EXE, "grainlab", (char *)NULL);
+        _exit(127);
+    }
+    assert_true(wait_prompt(s));
+}
+
+/* Appends what the terminal shows, dropping CSI escape sequences (ESC [ ... final byte). */
+static void pump(session *s, int timeout_ms)
+{
+    struct pollfd p = {.fd = s->fd, .events = POLLIN};
+    if (poll(&p, 1, timeout_ms) <= 0)
+        return;
+    char buf[4096];
+    ssize_t n = read(s->fd, buf, sizeof buf);
+    for (ssize_t i = 0; i < n; i++) {
+        if (buf[i] == '\033' && i + 1 < n && buf[i + 1] == '[') {
+            i += 2;
+            while (i < n && !(buf[i] >= 0x40 && buf[i] <= 0x7e))
+                i++;
+            continue;
+        }
+        if (s->len + 1 < sizeof s->out)
+            s->out[s->len++] = buf[i];
+    }
+    s->out[s->len] = '\0';
+}
+
+/* Waits until `text` appears after the mark, then moves the mark past it. */
+static int expect(session *s, const char *text)
+{
+    double deadline = now() + 10;
+    while (now() < deadline) {
+        char *hit = strstr(s->out + s->mark, text);
+        if (hit) {
+            s->mark = (size_t)(hit - s->out) + strlen(text);
+            return 1;
+        }
+        pump(s, 50);
+    }
+    fprintf(stderr, "expected %s\n--- screen since mark ---\n%s\n---\n", text, s->out + s->mark);
+    return 0;
+}
+
+/* Waits until the screen ends with the primary prompt: keys typed while readline is between
+ * lines would meet a terminal in cooked mode, where a lone Ctrl-D is swallowed. */
+static int wait_prompt(session *s)
+{
+    double deadline = now() + 10;
+    while (now() < deadline) {
+        if (s->len >= 2 && strcmp(s->out + s->len - 2, "> ") == 0)
+            return 1;
+        pump(s, 20);
+    }
+    return 0;
+}
+
+static void type(session *s, const char *text)
+{
+    size_t n = strlen(text);
+    assert_int_equal(write(s->fd, text, n), (ssize_t)n);
+}
+
+/* Types `line` and Enter. */
+static void enter(session *s, const char *line)
+{
+    type(s, line);
+    type(s, "\n");
+}
+
+static int finish(session *s)
+{
+    wait_prompt(s);
+    type(s, "\004"); /* Ctrl-D at an empty prompt */
+    int status = -1;
+    double deadline = now() + 10;
+    while (now() < deadline) {
+        pump(s, 20);
+        pid_t r = waitpid(s->pid, &status, WNOHANG);
+        if (r == s->pid)
+            break;
+    }
+    close(s->fd);
+    if (!WIFEXITED(status)) {
+        fprintf(stderr, "grainlab did not exit; screen:\n%s\n", s->out);
+        kill(s->pid, SIGKILL);
+        waitpid(s->pid, &status, 0);
+        return -1;
+    }
+    return WEXITSTATUS(status);
+}
+
+static void test_expressions_and_multiline(void **state)
+{
+    (void)state;
+    session s;
+    start(&s);
+    assert_true(expect(&s, "> "));
+    enter(&s, "6*7");
+    assert_true(expect(&s, "42"));
+    enter(&s, "'a' .. 'b', 1 + 1"); /* several results, printed through print */
+    assert_true(expect(&s, "ab\t2"));
+    enter(&s, "=math.max(3, 9)"); /* =expr, as in lua */
+    assert_true(expect(&s, "9"));
+    enter(&s, "function twice(x)");
+    assert_true(expect(&s, ">> "));
+    enter(&s, "return 2*x");
+    assert_true(expect(&s, ">> "));
+    enter(&s, "end");
+    enter(&s, "twice(21.5)");
+    assert_true(expect(&s, "43.0"));
+    assert_int_equal(finish(&s), 0);
+}
+
+static void test_error_recovery(void **state)
+{
+    (void)state;
+    session s;
+    start(&s);
+    enter(&s, "kept = 'yes'");
+    enter(&s, "error('boom ' .. 6*7)");
+    assert_true(expect(&s, "stdin:1: boom 42"));
+    assert_true(expect(&s, "stack traceback"));
+    enter(&s, "x = = 1"); /* a syntax error is not a continuation */
+    assert_true(expect(&s, "unexpected symbol near '='"));
+    enter(&s, "print('still ' .. kept)");
+    assert_true(expect(&s, "still yes"));
+    assert_int_equal(finish(&s), 0);
+}
+
+static void test_ctrl_c(void **state)
+{
+    (void)state;
+    session s;
+    start(&s);
+    enter(&s, "counter = 0");
+    enter(&s, "while true do counter = counter + 1 end");
+    usleep(300 * 1000);
+    type(&s, "\003");
+    assert_true(expect(&s, "interrupted by Ctrl-C"));
+    /* State survives: the loop's variable is there and has counted. */
+    enter(&s, "print(counter > 1000 and 'counted' or 'no')");
+    assert_true(expect(&s, "counted"));
+    /* Ctrl-C at the prompt drops the line being typed and gives a fresh prompt. */
+    type(&s, "this_would_be_an_error(");
+    usleep(100 * 1000);
+    type(&s, "\003");
+    assert_true(expect(&s, "^C"));
+    enter(&s, "7*11");
+    assert_true(expect(&s, "77"));
+    /* ...also in the middle of a multi-line statement. */
+    enter(&s, "for i = 1, 3 do");
+    assert_true(expect(&s, ">> "));
+    type(&s, "\003");
+    assert_true(expect(&s, "^C"));
+    enter(&s, "8*11");
+    assert_true(expect(&s, "88"));
+    assert_int_equal(finish(&s), 0);
+}
+
+static void test_completion_and_help(void **state)
+{
+    (void)state;
+    session s;
+    start(&s);
+    enter(&s, "obj = setmetatable({}, {__index = {add_disk = function() return 'disk!' end, "
+              "add_wall = function() end}})");
+    type(&s, "obj:add_d\t");
+    assert_true(expect(&s, "obj:add_disk("));
+    enter(&s, ")");
+    assert_true(expect(&s, "disk!"));
+    type(&s, "string.rev\t");
+    assert_true(expect(&s, "string.reverse("));
+    enter(&s, "'xyz')");
+    assert_true(expect(&s, "zyx"));
+    type(&s, "grainl\t");
+    assert_true(expect(&s, "grainlab."));
+    type(&s, "rep\t"); /* grainlab.report is the only field starting with rep */
+    assert_true(expect(&s, "report("));
+    type(&s, "\003");
+    enter(&s, "help(grainlab.report)");
+    assert_true(expect(&s, "Reports a scenario's figures"));
+    enter(&s, "help()");
+    assert_true(expect(&s, "Modules:"));
+    enter(&s, "help('grainlab.rng')");
+    assert_true(expect(&s, "grainlab.rng{ seed = 0, stream = 0 }"));
+    assert_int_equal(finish(&s), 0);
+}
+
+static void test_history_persists(void **state)
+{
+    (void)state;
+    unlink(history);
+    session s;
+    start(&s);
+    enter(&s, "history_marker = 12345");
+    enter(&s, "print('marker set')");
+    assert_true(expect(&s, "marker set"));
+    assert_int_equal(finish(&s), 0);
+
+    FILE *f = fopen(history, "r");
+    assert_non_null(f);
+    char text[4096];
+    size_t n = fread(text, 1, sizeof text - 1, f);
+    text[n] = '\0';
+    fclose(f);
+    assert_non_null(strstr(text, "history_marker = 12345\n"));
+
+    /* The next session reads it: Up twice recalls the first line. */
+    start(&s);
+    assert_true(expect(&s, "> "));
+    type(&s, "\033[A\033[A");
+    assert_true(expect(&s, "history_marker = 12345"));
+    enter(&s, "");
+    enter(&s, "print(history_marker + 1)");
+    assert_true(expect(&s, "12346"));
+    assert_int_equal(finish(&s), 0);
+}
+
+int main(void)
+{
+    snprintf(tmpdir, sizeof tmpdir, "/tmp/grainlab_repl_XXXXXX");
+    if (!mkdtemp(tmpdir))
+        return 1;
+    snprintf(history, sizeof history, "%s/history", tmpdir);
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_expressions_and_multiline), cmocka_unit_test(test_error_recovery),
+        cmocka_unit_test(test_ctrl_c), cmocka_unit_test(test_completion_and_help),
+        cmocka_unit_test(test_history_persists),
+    };
+    int failed = cmocka_run_group_tests(tests, NULL, NULL);
+    char cmd[128];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
+    if (system(cmd) != 0)
+        return 1;
+    return failed;
+}
