@@ -21,8 +21,17 @@ install_packages() {
     echo "build.sh: installing Debian packages: ${missing[*]}"
     local sudo=""
     [ "$(id -u)" -eq 0 ] || sudo="sudo"
-    $sudo apt-get update -qq
-    DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
+    local log
+    log=$(mktemp)
+    if ! { $sudo apt-get update -qq &&
+           DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends \
+               "${missing[@]}"; } >"$log" 2>&1; then
+        cat "$log" >&2
+        echo "build.sh: could not install ${missing[*]} (see the apt output above)" >&2
+        rm -f "$log"
+        exit 1
+    fi
+    rm -f "$log"
 }
 
 jobs=$(nproc 2>/dev/null || echo 2)
