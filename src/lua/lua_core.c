@@ -54,8 +54,11 @@ static const char *RNG = "grainlab.rng";
 static int l_rng_new(lua_State *L)
 {
     static const char *const fields[] = {"seed", "stream", NULL};
-    if (lua_isnoneornil(L, 1))
+    lua_settop(L, 1);
+    if (lua_isnil(L, 1)) { /* grainlab.rng() and grainlab.rng(nil): all defaults */
         lua_newtable(L);
+        lua_replace(L, 1);
+    }
     bind_check_table(L, 1, "rng");
     bind_check_fields(L, 1, "rng", fields);
     lua_Integer seed = bind_field_integer(L, 1, "rng", "seed", 0, 0, LUA_MAXINTEGER, 0);

@@ -8,6 +8,7 @@ local s1 = grainlab.rng{ seed = 42, stream = 1 }
 check.eq(s1:raw(), 0x50086ef83cbf4f4a, "seed 42, stream 1, first output")
 check.eq(s1:raw(), 0xba285ec21347d703, "seed 42, stream 1, second output (negative as a Lua integer)")
 check.eq(grainlab.rng():raw(), grainlab.rng{ seed = 0 }:raw(), "default seed is 0")
+check.eq(grainlab.rng(nil):raw(), grainlab.rng{}:raw(), "nil means defaults")
 
 local a, b = grainlab.rng{ seed = 7 }, grainlab.rng{ seed = 7 }
 for i = 1, 100 do check.eq(a:normal(), b:normal(), "same seed, same normals " .. i) end
