@@ -170,6 +170,42 @@ int bind_field_option(lua_State *L, int arg, const char *call, const char *field
     return bind_field_error(L, arg, call, field, expected);
 }
 
+int bind_field_vector(lua_State *L, int arg, const char *call, const char *field, int n,
+                      double *out, unsigned flags)
+{
+    char expected[64];
+    snprintf(expected, sizeof expected, "array of %d finite numbers", n);
+    if (!get_field(L, arg, call, field, flags, expected))
+        return 0;
+    if (lua_type(L, -1) != LUA_TTABLE || luaL_len(L, -1) != n)
+        bind_field_error(L, arg, call, field, expected);
+    for (int k = 0; k < n; k++) {
+        lua_rawgeti(L, -1, k + 1);
+        int isnum;
+        double v = lua_tonumberx(L, -1, &isnum);
+        lua_pop(L, 1);
+        if (!isnum || !isfinite(v)) {
+            snprintf(expected, sizeof expected, "array of %d finite numbers (entry %d is not)", n,
+                     k + 1);
+            bind_field_error(L, arg, call, field, expected);
+        }
+        out[k] = v;
+    }
+    lua_pop(L, 1);
+    return 1;
+}
+
+int bind_field_boolean(lua_State *L, int arg, const char *call, const char *field, int def)
+{
+    if (!get_field(L, arg, call, field, 0, "boolean"))
+        return def;
+    if (lua_type(L, -1) != LUA_TBOOLEAN)
+        bind_field_error(L, arg, call, field, "boolean");
+    int v = lua_toboolean(L, -1);
+    lua_pop(L, 1);
+    return v;
+}
+
 int bind_raise(lua_State *L, const char *call, const core_error *err)
 {
     if (err->msg[0])

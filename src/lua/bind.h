@@ -52,6 +52,12 @@ const char *bind_field_string(lua_State *L, int arg, const char *call, const cha
 int bind_field_option(lua_State *L, int arg, const char *call, const char *field,
                       const char *const names[], int def, unsigned flags);
 
+/* Reads an array of n finite numbers (a position, a velocity) into out; absent: out unchanged
+ * (or an error when BIND_REQUIRED). Returns 1 when present. */
+int bind_field_vector(lua_State *L, int arg, const char *call, const char *field, int n,
+                      double *out, unsigned flags);
+int bind_field_boolean(lua_State *L, int arg, const char *call, const char *field, int def);
+
 /* Raises "bad field 'F' in argument #N to 'call' (EXPECTED expected, got VALUE)" for the value
  * on top of the stack. */
 int bind_field_error(lua_State *L, int arg, const char *call, const char *field,
@@ -83,5 +89,8 @@ void bind_new_type(lua_State *L, const char *tname, const bind_fn *methods, cons
  * threads, rng, progress, write_file) and help.c (doc, doc_of). */
 void bind_open_core(lua_State *L, int idx);
 void bind_open_help(lua_State *L, int idx);
+
+/* Registers the global `dem` module (lua_dem.c). */
+void bind_open_dem(lua_State *L);
 
 #endif

@@ -1,0 +1,210 @@
+/* grainlab DEM: soft-sphere discrete elements in 2D (disks) and 3D (spheres).
+ * Physics: Herrmann & Mueller (2000) Sec. 2 (Eqs. 1a, 1b, 2a, 2b, Gear predictor-corrector) and
+ * Padbidri (2010) Ch. 1-2 (Hertz + Brilliantov Eq. 2.16, regularised Coulomb Eq. 2.18, slip with
+ * rotation Eq. 2.A6, Verlet Eq. 1.6, quasistatic coefficient Eq. 2.13/2.B1, two timescales Sec. 2.4).
+ *
+ * Usage: fill a dem_scene_def from dem_default_scene_def(), create the scene, set the contact law,
+ * add materials, particles and walls, then call dem_run. Every call that can fail returns a
+ * core_status and explains itself in a core_error. Nothing here knows about Lua. */
+#ifndef GRAINLAB_DEM_H
+#define GRAINLAB_DEM_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "core/error.h"
+#include "core/progress.h"
+
+typedef struct dem_scene dem_scene;
+
+/* ---- scene ------------------------------------------------------------------------------- */
+typedef struct dem_scene_def {
+    int dim;              /* 2 (disks) or 3 (spheres) */
+    double lo[3], hi[3];  /* the domain; particles may leave it only through periodic axes */
+    bool periodic[3];
+    double gravity[3];    /* m/s^2 */
+    /* 2D only: > 0 makes disks cylinders of this thickness (m = rho pi r^2 t, I = m r^2 / 2);
+     * 0 (default) makes them spheres moving in the plane (m = rho 4/3 pi r^3, I = 2/5 m r^2). */
+    double thickness;
+    double skin;          /* Verlet-list skin, m; 0 = automatic (0.2 of the largest radius) */
+} dem_scene_def;
+
+dem_scene_def dem_default_scene_def(void);
+core_status dem_create(const dem_scene_def *def, dem_scene **out, core_error *err);
+void dem_destroy(dem_scene *s);
+int dem_dim(const dem_scene *s);
+
+/* ---- materials ----------------------------------------------------------------------------- */
+typedef struct dem_material {
+    double density;      /* kg/m^3 */
+    double young;        /* Pa (Hertz laws) */
+    double poisson;      /* [0, 0.5) */
+    double friction;     /* Coulomb mu >= 0; a pair uses the smaller of its two */
+    double restitution;  /* (0, 1]: sets the linear law's damping; 1 = none */
+} dem_material;
+
+dem_material dem_default_material(void); /* quartz: 2650, 30 GPa, 0.3, 0.45, 0.5 */
+/* Returns the material index (>= 0) or -1 with err filled. */
+int dem_add_material(dem_scene *s, const dem_material *m, core_error *err);
+
+/* ---- contact laws -------------------------------------------------------------------------- */
+typedef enum dem_normal_law {
+    DEM_NORMAL_LINEAR,  /* f = k delta (Herrmann Eq. 1a, beta = 1) */
+    DEM_NORMAL_POWER,   /* f = k delta^beta, beta in {1, 3/2, 2} (Eq. 1a) */
+    DEM_NORMAL_HERTZ    /* f = K delta^{3/2}, K = 4/3 E* sqrt(R) (Padbidri Eq. 1.1, 2.16) */
+} dem_normal_law;
+
+typedef enum dem_damping_law {
+    DEM_DAMPING_NONE,
+    DEM_DAMPING_VISCOUS,     /* f = gamma ddelta/dt (Herrmann Eq. 1b); gamma per pair from the
+                              * materials' restitution (linear law) or the given gamma_n */
+    DEM_DAMPING_BRILLIANTOV  /* f = T K delta^{1/2} ddelta/dt (Padbidri Eq. 2.16) */
+} dem_damping_law;
+
+typedef enum dem_tangential_law {
+    DEM_TANGENT_NONE,
+    DEM_TANGENT_VISCOUS,     /* f_t = -gamma_t s (Herrmann Eq. 2a) */
+    DEM_TANGENT_SPRING,      /* Cundall-Strack spring with Coulomb cap (Herrmann Eq. 2b) */
+    DEM_TANGENT_REGULARIZED  /* |f_t| = mu f_n min(1, (s/v_R)^{1/c}) (Padbidri Eq. 1.3, 2.18) */
+} dem_tangential_law;
+
+typedef struct dem_contact_def {
+    dem_normal_law normal;
+    double stiffness;        /* k for LINEAR / POWER, N/m^beta */
+    double beta;             /* POWER exponent */
+    dem_damping_law damping;
+    double gamma_n;          /* VISCOUS: N s/m; < 0 = from the materials' restitution */
+    double damping_time;     /* BRILLIANTOV: T in seconds */
+    dem_tangential_law tangential;
+    double gamma_t;          /* VISCOUS tangential, N s/m */
+    double kt;               /* SPRING stiffness, N/m; < 0 = 2/7 of the normal stiffness scale */
+    double v_r;              /* REGULARIZED characteristic velocity, m/s */
+    double exponent;         /* REGULARIZED c (large) */
+    bool clip;               /* no attractive normal force (default true) */
+    bool rolling;            /* allocate rotations even without a tangential law */
+} dem_contact_def;
+
+dem_contact_def dem_default_contact_def(void); /* Hertz, no damping, no friction, clip */
+core_status dem_set_contact(dem_scene *s, const dem_contact_def *def, core_error *err);
+const dem_contact_def *dem_contact(const dem_scene *s);
+
+/* ---- particles ----------------------------------------------------------------------------- */
+enum { DEM_FIXED = 1, DEM_PRESCRIBED = 2 }; /* flags: fixed in place / moves at its velocity */
+
+typedef struct dem_particle_def {
+    double x[3], v[3], omega[3]; /* omega: only [2] in 2D */
+    double radius;
+    int material;
+    unsigned flags;
+} dem_particle_def;
+
+/* Returns the particle index (>= 0) or -1 with err filled. */
+long dem_add_particle(dem_scene *s, const dem_particle_def *p, core_error *err);
+size_t dem_count(const dem_scene *s);
+
+/* Bulk access, in particle order: component d of positions/velocities, radii, masses;
+ * omega: angular velocity component (2D: only d = 2; NULL arrays when rotations are off). */
+const double *dem_positions(const dem_scene *s, int d);
+const double *dem_velocities(const dem_scene *s, int d);
+const double *dem_angular_velocities(const dem_scene *s, int d);
+const double *dem_radii(const dem_scene *s);
+const double *dem_masses(const dem_scene *s);
+core_status dem_set_velocity(dem_scene *s, size_t i, const double v[3], core_error *err);
+
+/* ---- walls --------------------------------------------------------------------------------- */
+typedef struct dem_wall_def {
+    double point[3], normal[3]; /* normal points into the domain */
+    double velocity[3];         /* the wall translates at this velocity */
+    double friction;            /* < 0: the particle's material friction */
+    int material;               /* < 0: the particle's material */
+} dem_wall_def;
+
+int dem_add_wall(dem_scene *s, const dem_wall_def *w, core_error *err); /* wall id or -1 */
+core_status dem_remove_wall(dem_scene *s, int id, core_error *err);
+core_status dem_set_wall_velocity(dem_scene *s, int id, const double v[3], core_error *err);
+/* Current position of the wall's reference point. */
+core_status dem_wall_point(const dem_scene *s, int id, double p[3], core_error *err);
+
+/* ---- time stepping ------------------------------------------------------------------------- */
+typedef enum dem_integrator {
+    DEM_VELOCITY_VERLET,   /* default */
+    DEM_POSITION_VERLET,   /* Padbidri Eq. 1.6 */
+    DEM_GEAR5,             /* Gear 5th-order predictor-corrector (Herrmann Sec. 2) */
+    DEM_TWO_TIMESCALES     /* Padbidri Sec. 2.4: m cycles of (one step n dt, q steps dt) */
+} dem_integrator;
+
+typedef struct dem_timestep {
+    double contact_time;   /* of the stiffest, lightest pair at the impact velocity, s */
+    double impact_velocity;
+    double limit;          /* largest dt accepted without force: contact_time / 10 */
+    double dt_auto;        /* contact_time / 50 */
+} dem_timestep;
+
+/* impact_velocity <= 0: the larger of the fastest particle and sqrt(2 |g| height), at least
+ * 0.1 m/s. */
+core_status dem_timestep_info(const dem_scene *s, double impact_velocity, dem_timestep *out,
+                              core_error *err);
+
+typedef struct dem_run_def {
+    long steps;            /* steps of dt (for TWO_TIMESCALES: small-step equivalents, a
+                            * multiple of m (n + q)) */
+    double dt;
+    dem_integrator integrator;
+    int tt_m, tt_n, tt_q;  /* TWO_TIMESCALES cycle m(n + q) */
+    progress *progress;    /* may be NULL */
+} dem_run_def;
+
+dem_run_def dem_default_run_def(void);
+
+/* Advances the scene. Stops between steps on Ctrl-C (CORE_ERR_INTERRUPTED, scene intact) and on
+ * instability (CORE_ERR_UNSTABLE naming the step and the particle). */
+core_status dem_run(dem_scene *s, const dem_run_def *run, core_error *err);
+
+double dem_time(const dem_scene *s);
+long dem_steps_done(const dem_scene *s);
+long dem_force_evaluations(const dem_scene *s);
+/* Mass scaling: multiplies every mass and moment of inertia (Padbidri Sec. 2.2). */
+core_status dem_scale_mass(dem_scene *s, double factor, core_error *err);
+
+/* ---- measurements -------------------------------------------------------------------------- */
+typedef struct dem_energy {
+    double kinetic, rotational, elastic, potential, total; /* J; potential from gravity */
+} dem_energy;
+void dem_measure_energy(dem_scene *s, dem_energy *e);
+
+typedef struct dem_contact_info {
+    long i, j;             /* j < 0: wall number -(j+1) */
+    double fn, ft;         /* normal (>= 0 repulsive) and tangential force magnitudes */
+    double normal[3];      /* from j to i */
+    double point[3];
+    double overlap;
+} dem_contact_info;
+/* Calls fn for each contact (pairs and walls) in a fixed order. */
+void dem_each_contact(dem_scene *s, void (*visit)(const dem_contact_info *c, void *ctx),
+                      void *ctx);
+
+/* Assembly stress sigma_ab = (1/V) sum_c branch_a f_b over particle pairs (V = domain volume,
+ * or area in 2D unless given). Returns the number of contacts. */
+long dem_measure_stress(dem_scene *s, double volume, double sigma[3][3]);
+/* Mean contacts per particle counting walls, and (rattlers excluded) per particle with >= 2. */
+void dem_measure_coordination(dem_scene *s, double *z_all, double *z_no_rattlers);
+/* Mean |slip velocity| over particle-particle contacts (Padbidri Fig. 2.4). */
+double dem_measure_slip(dem_scene *s);
+/* Reference state for displacements. */
+core_status dem_set_reference(dem_scene *s, core_error *err);
+/* Displacement since the reference minus the affine field grad_u . (X_ref - center); grad_u may
+ * be NULL (plain displacement). out[d] arrays of dem_count() values. */
+core_status dem_measure_displacement(const dem_scene *s, const double grad_u[3][3],
+                                     const double center[3], double *out[3], core_error *err);
+
+/* Brilliantov damping time T that gives restitution e for a head-on impact at speed v between
+ * particles of effective mass m_eff under f = K d^{3/2} + T K d^{1/2} d' (solved by bisection on
+ * an RK4 integration of the contact ODE). */
+core_status dem_brilliantov_time(double e, double m_eff, double K, double v, double *T,
+                                 core_error *err);
+
+/* The same for the scene's mean pair (mean radius and mass, the first particle's material). */
+core_status dem_damping_time_for(const dem_scene *s, double e, double v, double *T,
+                                 core_error *err);
+
+#endif

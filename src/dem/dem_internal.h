@@ -1,0 +1,106 @@
+/* The DEM scene's layout, shared by the files of src/dem/ only. Particle data is structure-of-
+ * arrays; arrays a scene does not need (rotations without a tangential law, contact history
+ * without the spring law, integrator state for other integrators) stay NULL. */
+#ifndef GRAINLAB_DEM_INTERNAL_H
+#define GRAINLAB_DEM_INTERNAL_H
+
+#include <stdint.h>
+
+#include "dem/dem.h"
+
+#define DEM_PI 3.14159265358979323846
+
+typedef struct dem_wall {
+    int active;
+    double point[3], normal[3], velocity[3];
+    double friction;
+    int material;
+    double *hist[3];       /* SPRING law: tangential displacement per particle */
+} dem_wall;
+
+/* The Verlet list: pairs (i < j) closer than r_i + r_j + skin at the last build, sorted by i then
+ * j, with per-pair law parameters, the contact history, and the force of the last evaluation. */
+typedef struct dem_pairs {
+    size_t n, cap;
+    uint32_t *i, *j;
+    double *k;        /* normal stiffness (k or K) of the pair */
+    double *gamma;    /* viscous normal damping of the pair, N s/m */
+    double *mu;       /* friction of the pair */
+    double *hist[3];  /* tangential spring displacement (SPRING law only) */
+    double *f[3];     /* force on i of the last evaluation (j gets the opposite) */
+    double *c[3];     /* n x f_t: torque on i is -r_i c, on j -r_j c (2D: c[2] only) */
+    size_t np;        /* particles when the list was built */
+    size_t *start;    /* pairs of particle i: [start[i], start[i+1]) (np + 1) */
+    size_t *jstart;   /* pairs where particle i is j: jpair[jstart[i] .. jstart[i+1]) */
+    uint32_t *jpair;
+} dem_pairs;
+
+struct dem_scene {
+    int dim;
+    double lo[3], hi[3], len[3];
+    bool periodic[3];
+    double gravity[3];
+    double thickness;
+    double skin_def;       /* as given (0 = automatic) */
+    double skin;           /* in use */
+
+    size_t n, cap;
+    double *x[3], *v[3], *f[3];
+    double *r, *m, *inv_m, *inv_inertia;
+    int *mat;
+    unsigned char *flags;
+    double r_max;
+
+    int rot;               /* rotational state allocated */
+    double *w[3], *tq[3];  /* 2D: w[2], tq[2] only */
+
+    double *x_build[3];    /* positions at the last list build (skin test) */
+    double *x_ref[3];      /* reference for displacements (NULL until set) */
+    double *x_prev[3];     /* position Verlet: previous positions */
+    double *gear[6][3];    /* Gear: scaled derivatives of positions */
+    double *gear_w[6][3];  /* Gear: scaled derivatives of rotation angles */
+    int gear_ready, prev_ready, forces_ready;
+    double gear_dt;
+
+    dem_material *mats;
+    int nmat, cap_mat;
+    dem_contact_def contact;
+
+    dem_wall *walls;
+    int nwalls, cap_walls;
+
+    dem_pairs pairs;
+    int need_rebuild;
+    int ncell[3];
+    double cell_size[3];
+    size_t *cell_start;
+    uint32_t *cell_items;
+    size_t cell_cap;
+
+    double time;
+    long steps;
+    long force_evals;
+    int last_integrator;
+    long tt_phase;
+};
+
+/* neighbor.c */
+core_status dem_build_pairs(dem_scene *s, core_error *err);
+void dem_free_pairs(dem_pairs *p);
+void dem_pair_parameters(dem_scene *s, size_t i, size_t j, double *k, double *gamma, double *mu);
+void dem_wall_parameters(const dem_scene *s, const dem_wall *w, size_t i, double *k,
+                         double *gamma, double *mu);
+
+/* forces.c: the force evaluation, instantiated for 2D and 3D. dem_compute_forces fills f and tq
+ * (pairs, walls, gravity) and returns the index of a particle that went through a wall, or
+ * (size_t)-1. */
+size_t dem_compute_forces(dem_scene *s, double dt);
+double dem_normal_force(const dem_contact_def *c, double k, double gamma, double delta,
+                        double ddelta);
+double dem_elastic_energy(const dem_contact_def *c, double k, double delta);
+
+/* scene.c */
+core_status dem_ensure_rotation(dem_scene *s, core_error *err);
+core_status dem_alloc_array(double **a, size_t n, core_error *err);
+
+#endif

@@ -1,0 +1,96 @@
+/* Contact forces: the normal laws (Herrmann Eq. 1a/1b, Padbidri Eq. 2.16), the tangential laws
+ * (Herrmann Eq. 2a/2b, Padbidri Eq. 1.3/2.18) with slip including rotation (Eq. 2.A6) and the
+ * moments they produce (Eq. 1.4). Pair forces go to per-pair storage, then each particle gathers
+ * its own in a fixed order: no atomics, and the same sums for any number of threads. */
+#include <math.h>
+#include <string.h>
+
+#include "dem/dem_internal.h"
+
+/* Normal force magnitude, positive when repulsive. ddelta is the rate of overlap, positive while
+ * the particles approach: ddelta = -(v_i - v_j).n with n from j to i. (Padbidri's Eq. 2.A3 prints
+ * +(v^k - v^j).n; with that sign the damping would push separating grains together.) */
+static inline double normal_force(const dem_contact_def *c, double k, double gamma, double delta,
+                                  double sqrt_delta, double ddelta)
+{
+    double f;
+    switch (c->normal) {
+    case DEM_NORMAL_LINEAR:
+        f = k * delta;
+        break;
+    case DEM_NORMAL_POWER:
+        f = c->beta == 1 ? k * delta : c->beta == 2 ? k * delta * delta : k * delta * sqrt_delta;
+        break;
+    default: /* Hertz */
+        f = k * delta * sqrt_delta;
+        break;
+    }
+    if (c->damping == DEM_DAMPING_VISCOUS)
+        f += gamma * ddelta; /* Eq. 1b */
+    else if (c->damping == DEM_DAMPING_BRILLIANTOV)
+        f += c->damping_time * k * sqrt_delta * ddelta; /* Eq. 2.16 */
+    if (c->clip && f < 0)
+        f = 0;
+    return f;
+}
+
+double dem_normal_force(const dem_contact_def *c, double k, double gamma, double delta,
+                        double ddelta)
+{
+    return normal_force(c, k, gamma, delta, sqrt(delta), ddelta);
+}
+
+double dem_elastic_energy(const dem_contact_def *c, double k, double delta)
+{
+    switch (c->normal) {
+    case DEM_NORMAL_LINEAR:
+        return 0.5 * k * delta * delta;
+    case DEM_NORMAL_POWER:
+        return k * pow(delta, c->beta + 1) / (c->beta + 1);
+    default:
+        return 0.4 * k * delta * delta * sqrt(delta);
+    }
+}
+
+/* Tangential spring stiffness: given, or 2/7 of the normal tangent stiffness d f_n / d delta
+ * (the ratio of a linear spring pair; for Hertz this scales like Mindlin's k_t ~ sqrt(delta)). */
+static inline double spring_stiffness(const dem_contact_def *c, double k, double delta,
+                                      double sqrt_delta)
+{
+    if (c->kt > 0)
+        return c->kt;
+    switch (c->normal) {
+    case DEM_NORMAL_LINEAR:
+        return 2.0 / 7.0 * k;
+    case DEM_NORMAL_POWER:
+        return 2.0 / 7.0 * c->beta * k * (c->beta == 1 ? 1 : c->beta == 2 ? delta : sqrt_delta);
+    default:
+        return 2.0 / 7.0 * 1.5 * k * sqrt_delta;
+    }
+}
+
+/* Magnitude of the regularised Coulomb force (Padbidri Eq. 2.18), capped at mu f_n: the paper's
+ * law is meant for slip rates near v_R; the cap keeps fast sliding Coulombic. */
+static inline double regularized(const dem_contact_def *c, double mu, double fn, double s)
+{
+    double x = s / c->v_r;
+    return x >= 1 ? mu * fn : mu * fn * pow(x, 1.0 / c->exponent);
+}
+
+#define DIM 2
+#include "dem/forces_dim.inc"
+#undef DIM
+#define DIM 3
+#include "dem/forces_dim.inc"
+#undef DIM
+
+size_t dem_compute_forces(dem_scene *s, double dt)
+{
+    s->force_evals++;
+    if (s->dim == 2) {
+        pair_forces_2(s, dt);
+        return gather_2(s, dt);
+    }
+    pair_forces_3(s, dt);
+    return gather_3(s, dt);
+}

@@ -1,0 +1,511 @@
+/* Time stepping: velocity Verlet (default), position Verlet (Padbidri Eq. 1.6), Gear's 5th-order
+ * predictor-corrector (Herrmann Sec. 2) and Padbidri's two-timescales schedule (Sec. 2.4); the
+ * run loop with Ctrl-C and instability checks; the contact-time step rule (Padbidri Sec. 2.3). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/interrupt.h"
+#include "dem/dem_internal.h"
+
+dem_run_def dem_default_run_def(void)
+{
+    return (dem_run_def){.steps = 0, .dt = 0, .integrator = DEM_VELOCITY_VERLET, .tt_m = 5,
+                         .tt_n = 5, .tt_q = 5, .progress = NULL};
+}
+
+/* Arrays the run needs that the scene may not have yet. */
+static core_status prepare(dem_scene *s, const dem_run_def *run, core_error *err)
+{
+    const int D = s->dim;
+    if (s->nmat == 0 || s->n == 0)
+        return core_fail(err, CORE_ERR_STATE, "the scene has no particles");
+    if (s->contact.tangential == DEM_TANGENT_SPRING) {
+        for (int w = 0; w < s->nwalls; w++) {
+            if (!s->walls[w].active || s->walls[w].hist[0])
+                continue;
+            for (int d = 0; d < D; d++) {
+                if (dem_alloc_array(&s->walls[w].hist[d], s->cap, err))
+                    return err->status;
+                memset(s->walls[w].hist[d], 0, s->cap * sizeof(double));
+            }
+        }
+    }
+    if (run->integrator == DEM_POSITION_VERLET && !s->x_prev[0])
+        for (int d = 0; d < D; d++)
+            if (dem_alloc_array(&s->x_prev[d], s->cap, err))
+                return err->status;
+    if (run->integrator == DEM_GEAR5 && !s->gear[0][0]) {
+        for (int k = 0; k < 6; k++) {
+            for (int d = 0; d < D; d++)
+                if (dem_alloc_array(&s->gear[k][d], s->cap, err))
+                    return err->status;
+            for (int d = (D == 2 ? 2 : 0); s->rot && d < 3; d++)
+                if (dem_alloc_array(&s->gear_w[k][d], s->cap, err))
+                    return err->status;
+        }
+        s->gear_ready = 0;
+    }
+    return CORE_OK;
+}
+
+static core_status unstable(dem_scene *s, size_t i, const char *what, core_error *err)
+{
+    return core_fail(err, CORE_ERR_UNSTABLE,
+                     "particle %zu %s at step %ld (t = %.6g s); likely cause: the time step is "
+                     "too large for the contact stiffness or the impact speed (use dt = \"auto\" "
+                     "or a smaller dt)",
+                     i + 1, what, s->steps + 1, s->time);
+}
+
+/* Forces at the current state; list rebuilt first when needed. */
+static core_status forces(dem_scene *s, double dt, core_error *err)
+{
+    double lim = 0.25 * s->skin * s->skin;
+    if (!s->need_rebuild && s->pairs.start) {
+        const int D = s->dim;
+        for (size_t i = 0; i < s->n && !s->need_rebuild; i++) {
+            double d2 = 0;
+            for (int d = 0; d < D; d++) {
+                double dx = s->x[d][i] - s->x_build[d][i];
+                d2 += dx * dx;
+            }
+            if (d2 > lim)
+                s->need_rebuild = 1;
+        }
+    } else {
+        s->need_rebuild = 1;
+    }
+    if (s->need_rebuild) {
+        core_status st = dem_build_pairs(s, err);
+        if (st)
+            return st;
+    }
+    size_t t = dem_compute_forces(s, dt);
+    if (t != (size_t)-1)
+        return unstable(s, t, "went through a wall", err);
+    s->forces_ready = 1;
+    return CORE_OK;
+}
+
+static void move_walls(dem_scene *s, double dt)
+{
+    for (int w = 0; w < s->nwalls; w++)
+        for (int d = 0; d < s->dim; d++)
+            s->walls[w].point[d] += dt * s->walls[w].velocity[d];
+}
+
+static size_t check_finite(const dem_scene *s)
+{
+    size_t bad = (size_t)-1;
+    const long n = (long)s->n;
+    const int D = s->dim;
+#pragma omp parallel for schedule(static) reduction(min : bad)
+    for (long i = 0; i < n; i++)
+        for (int d = 0; d < D; d++)
+            if (!isfinite(s->x[d][i]) || !isfinite(s->v[d][i]))
+                if ((size_t)i < bad)
+                    bad = (size_t)i;
+    return bad;
+}
+
+/* ---- velocity Verlet ---------------------------------------------------------------------- */
+static void half_kick(dem_scene *s, double h)
+{
+    const int D = s->dim, rot = s->rot;
+    const long n = (long)s->n;
+#pragma omp parallel for schedule(static)
+    for (long i = 0; i < n; i++) {
+        const double im = s->inv_m[i];
+        for (int d = 0; d < D; d++)
+            s->v[d][i] += h * s->f[d][i] * im;
+        if (rot) {
+            const double ii = s->inv_inertia[i];
+            for (int d = (D == 2 ? 2 : 0); d < 3; d++)
+                s->w[d][i] += h * s->tq[d][i] * ii;
+        }
+    }
+}
+
+static void drift(dem_scene *s, double dt)
+{
+    const int D = s->dim;
+    const long n = (long)s->n;
+#pragma omp parallel for schedule(static)
+    for (long i = 0; i < n; i++)
+        for (int d = 0; d < D; d++)
+            s->x[d][i] += dt * s->v[d][i];
+}
+
+static core_status step_velocity_verlet(dem_scene *s, double dt, core_error *err)
+{
+    core_status st;
+    if (!s->forces_ready && (st = forces(s, dt, err)))
+        return st;
+    half_kick(s, 0.5 * dt);
+    drift(s, dt);
+    move_walls(s, dt);
+    s->time += dt;
+    if ((st = forces(s, dt, err)))
+        return st;
+    half_kick(s, 0.5 * dt);
+    return CORE_OK;
+}
+
+/* ---- position Verlet (Eq. 1.6) ------------------------------------------------------------- *
+ * x(t+dt) = 2 x(t) - x(t-dt) + a dt^2. Velocities for the damping and friction laws, and the ones
+ * reported, are the backward differences (x(t) - x(t-dt))/dt, i.e. at t - dt/2. */
+static core_status step_position_verlet(dem_scene *s, double dt, core_error *err)
+{
+    const int D = s->dim;
+    const long n = (long)s->n;
+    core_status st;
+    if (!s->prev_ready) {
+        if ((st = forces(s, dt, err)))
+            return st;
+        for (long i = 0; i < n; i++)
+            for (int d = 0; d < D; d++)
+                s->x_prev[d][i] = s->x[d][i] - dt * s->v[d][i] +
+                                  0.5 * dt * dt * s->f[d][i] * s->inv_m[i];
+        s->prev_ready = 1;
+    }
+    if ((st = forces(s, dt, err)))
+        return st;
+    const int rot = s->rot;
+#pragma omp parallel for schedule(static)
+    for (long i = 0; i < n; i++) {
+        const double im = s->inv_m[i];
+        for (int d = 0; d < D; d++) {
+            double xn = (s->flags[i] & DEM_PRESCRIBED)
+                            ? s->x[d][i] + dt * s->v[d][i]
+                            : 2 * s->x[d][i] - s->x_prev[d][i] + dt * dt * s->f[d][i] * im;
+            s->x_prev[d][i] = s->x[d][i];
+            s->x[d][i] = xn;
+            if (!(s->flags[i] & DEM_PRESCRIBED))
+                s->v[d][i] = (xn - s->x_prev[d][i]) / dt;
+        }
+        if (rot)
+            for (int d = (D == 2 ? 2 : 0); d < 3; d++)
+                s->w[d][i] += dt * s->tq[d][i] * s->inv_inertia[i];
+    }
+    move_walls(s, dt);
+    s->time += dt;
+    return CORE_OK;
+}
+
+/* ---- Gear 5th-order predictor-corrector (Allen & Tildesley, Herrmann Sec. 2) ---------------- *
+ * Six scaled derivatives g_k = dt^k/k! d^k x/dt^k per degree of freedom; the corrector for second-
+ * order equations with velocity-dependent forces uses c = {3/16, 251/360, 1, 11/18, 1/6, 1/60}. */
+static const double GEAR_C[6] = {3.0 / 16, 251.0 / 360, 1, 11.0 / 18, 1.0 / 6, 1.0 / 60};
+
+static void gear_predict(double *g[6], long n)
+{
+#pragma omp parallel for schedule(static)
+    for (long i = 0; i < n; i++) {
+        g[0][i] += g[1][i] + g[2][i] + g[3][i] + g[4][i] + g[5][i];
+        g[1][i] += 2 * g[2][i] + 3 * g[3][i] + 4 * g[4][i] + 5 * g[5][i];
+        g[2][i] += 3 * g[3][i] + 6 * g[4][i] + 10 * g[5][i];
+        g[3][i] += 4 * g[4][i] + 10 * g[5][i];
+        g[4][i] += 5 * g[5][i];
+    }
+}
+
+static core_status step_gear(dem_scene *s, double dt, core_error *err)
+{
+    const int D = s->dim, rot = s->rot;
+    const long n = (long)s->n;
+    const int d0 = D == 2 ? 2 : 0;
+    core_status st;
+    if (!s->gear_ready) {
+        if ((st = forces(s, dt, err)))
+            return st;
+        for (long i = 0; i < n; i++) {
+            for (int d = 0; d < D; d++) {
+                s->gear[0][d][i] = s->x[d][i];
+                s->gear[1][d][i] = dt * s->v[d][i];
+                s->gear[2][d][i] = 0.5 * dt * dt * s->f[d][i] * s->inv_m[i];
+                s->gear[3][d][i] = s->gear[4][d][i] = s->gear[5][d][i] = 0;
+            }
+            for (int d = d0; rot && d < 3; d++) {
+                s->gear_w[0][d][i] = 0;
+                s->gear_w[1][d][i] = dt * s->w[d][i];
+                s->gear_w[2][d][i] = 0.5 * dt * dt * s->tq[d][i] * s->inv_inertia[i];
+                s->gear_w[3][d][i] = s->gear_w[4][d][i] = s->gear_w[5][d][i] = 0;
+            }
+        }
+        s->gear_ready = 1;
+        s->gear_dt = dt;
+    } else if (dt != s->gear_dt) { /* rescale the scaled derivatives to the new step */
+        double r = dt / s->gear_dt, rk = 1;
+        for (int k = 1; k < 6; k++) {
+            rk *= r;
+            for (long i = 0; i < n; i++) {
+                for (int d = 0; d < D; d++)
+                    s->gear[k][d][i] *= rk;
+                for (int d = d0; rot && d < 3; d++)
+                    s->gear_w[k][d][i] *= rk;
+            }
+        }
+        s->gear_dt = dt;
+    }
+    for (int d = 0; d < 3; d++) {
+        if (d < D) {
+            double *g[6] = {s->gear[0][d], s->gear[1][d], s->gear[2][d],
+                            s->gear[3][d], s->gear[4][d], s->gear[5][d]};
+            gear_predict(g, n);
+        }
+        if (rot && d >= d0) {
+            double *g[6] = {s->gear_w[0][d], s->gear_w[1][d], s->gear_w[2][d],
+                            s->gear_w[3][d], s->gear_w[4][d], s->gear_w[5][d]};
+            gear_predict(g, n);
+        }
+    }
+    /* The forces see the predicted positions and velocities. Fixed and prescribed particles just
+     * move at their velocity. */
+#pragma omp parallel for schedule(static)
+    for (long i = 0; i < n; i++) {
+        const int free_ = s->inv_m[i] > 0;
+        for (int d = 0; d < D; d++) {
+            if (free_) {
+                s->x[d][i] = s->gear[0][d][i];
+                s->v[d][i] = s->gear[1][d][i] / dt;
+            } else {
+                s->x[d][i] += dt * s->v[d][i];
+                s->gear[0][d][i] = s->x[d][i];
+                s->gear[1][d][i] = dt * s->v[d][i];
+                for (int k = 2; k < 6; k++)
+                    s->gear[k][d][i] = 0;
+            }
+        }
+        for (int d = d0; rot && free_ && d < 3; d++)
+            s->w[d][i] = s->gear_w[1][d][i] / dt;
+    }
+    move_walls(s, dt);
+    s->time += dt;
+    if ((st = forces(s, dt, err)))
+        return st;
+#pragma omp parallel for schedule(static)
+    for (long i = 0; i < n; i++) {
+        if (!(s->inv_m[i] > 0))
+            continue;
+        for (int d = 0; d < D; d++) {
+            double corr = 0.5 * dt * dt * s->f[d][i] * s->inv_m[i] - s->gear[2][d][i];
+            for (int k = 0; k < 6; k++)
+                s->gear[k][d][i] += GEAR_C[k] * corr;
+            s->x[d][i] = s->gear[0][d][i];
+            s->v[d][i] = s->gear[1][d][i] / dt;
+        }
+        for (int d = d0; rot && d < 3; d++) {
+            double corr = 0.5 * dt * dt * s->tq[d][i] * s->inv_inertia[i] - s->gear_w[2][d][i];
+            for (int k = 0; k < 6; k++)
+                s->gear_w[k][d][i] += GEAR_C[k] * corr;
+            s->w[d][i] = s->gear_w[1][d][i] / dt;
+        }
+    }
+    return CORE_OK;
+}
+
+/* ---- the run loop --------------------------------------------------------------------------- */
+core_status dem_run(dem_scene *s, const dem_run_def *run, core_error *err)
+{
+    if (run->steps < 0)
+        return core_fail(err, CORE_ERR_ARG, "steps must be >= 0, got %ld", run->steps);
+    if (!(run->dt > 0) || !isfinite(run->dt))
+        return core_fail(err, CORE_ERR_ARG, "dt must be > 0, got %g", run->dt);
+    if (run->integrator == DEM_TWO_TIMESCALES &&
+        (run->tt_m < 1 || run->tt_n < 1 || run->tt_q < 0))
+        return core_fail(err, CORE_ERR_ARG, "two timescales needs m >= 1, n >= 1, q >= 0 "
+                         "(got %d, %d, %d)", run->tt_m, run->tt_n, run->tt_q);
+    core_status st = prepare(s, run, err);
+    if (st)
+        return st;
+    if ((int)run->integrator != s->last_integrator) {
+        s->gear_ready = s->prev_ready = 0;
+        s->tt_phase = 0;
+        s->last_integrator = (int)run->integrator;
+    }
+    long done = 0;
+    const long cycle = run->tt_n + run->tt_q;
+    while (done < run->steps) {
+        if (interrupt_pending())
+            return core_fail(err, CORE_ERR_INTERRUPTED,
+                             "interrupted at step %ld (t = %.6g s); the scene is intact",
+                             s->steps, s->time);
+        double h = run->dt;
+        long advance = 1;
+        switch (run->integrator) {
+        case DEM_POSITION_VERLET:
+            st = step_position_verlet(s, h, err);
+            break;
+        case DEM_GEAR5:
+            st = step_gear(s, h, err);
+            break;
+        case DEM_TWO_TIMESCALES:
+            /* Padbidri Sec. 2.4: within each cycle of n + q small-step times, one large step of
+             * n dt, then q steps of dt; m cycles make the macro step m (n + q) dt. */
+            if (s->tt_phase == 0 && run->steps - done >= run->tt_n) {
+                h = run->tt_n * run->dt;
+                advance = run->tt_n;
+            }
+            st = step_velocity_verlet(s, h, err);
+            s->tt_phase = (s->tt_phase + advance) % cycle;
+            break;
+        default:
+            st = step_velocity_verlet(s, h, err);
+        }
+        if (st)
+            return st;
+        s->steps++;
+        done += advance;
+        if ((s->steps & 15) == 0 || done >= run->steps) {
+            size_t bad = check_finite(s);
+            if (bad != (size_t)-1)
+                return unstable(s, bad, "has a non-finite position or velocity", err);
+        }
+        if (run->progress)
+            progress_update(run->progress, (double)done);
+    }
+    return CORE_OK;
+}
+
+/* ---- time step (Padbidri Sec. 2.3) ---------------------------------------------------------- */
+/* 2 int_0^1 (1 - x^p)^{-1/2} dx / 2 = B(1/p, 1/2) / p: the contact time of f = k d^beta is
+ * t_c = 2 (d_max / v) I(beta + 1), with d_max from (beta+1)/2 m_eff v^2 = k d_max^{beta+1}. */
+static double contact_integral(double p)
+{
+    return tgamma(1 / p) * tgamma(0.5) / tgamma(1 / p + 0.5) / p;
+}
+
+core_status dem_timestep_info(const dem_scene *s, double v_imp, dem_timestep *out,
+                              core_error *err)
+{
+    const int D = s->dim;
+    if (s->n == 0 || s->nmat == 0)
+        return core_fail(err, CORE_ERR_STATE, "the scene has no particles: add some before "
+                         "asking for the time step");
+    if (!(v_imp > 0)) {
+        double vmax2 = 0, h = 0, g = 0;
+        for (size_t i = 0; i < s->n; i++) {
+            double v2 = 0;
+            for (int d = 0; d < D; d++)
+                v2 += s->v[d][i] * s->v[d][i];
+            vmax2 = fmax(vmax2, v2);
+        }
+        for (int d = 0; d < D; d++) {
+            g += s->gravity[d] * s->gravity[d];
+            if (s->gravity[d] != 0)
+                h = fmax(h, s->len[d]);
+        }
+        v_imp = fmax(fmax(sqrt(vmax2), sqrt(2 * sqrt(g) * h)), 0.1);
+    }
+    /* The lightest particle against itself, for each material it is made of: the shortest
+     * contact time (t_c grows with size for every law here). */
+    double tc = INFINITY, bmax = 0;
+    for (int mat = 0; mat < s->nmat; mat++) {
+        size_t i = (size_t)-1;
+        for (size_t k = 0; k < s->n; k++)
+            if (s->mat[k] == mat && (i == (size_t)-1 || s->r[k] < s->r[i]))
+                i = k;
+        if (i == (size_t)-1)
+            continue;
+        double k, gamma, mu;
+        dem_pair_parameters((dem_scene *)s, i, i, &k, &gamma, &mu);
+        double m_eff = 0.5 * s->m[i];
+        double beta = s->contact.normal == DEM_NORMAL_LINEAR ? 1
+                      : s->contact.normal == DEM_NORMAL_POWER ? s->contact.beta : 1.5;
+        double dmax = pow((beta + 1) * m_eff * v_imp * v_imp / (2 * k), 1 / (beta + 1));
+        double t = 2 * dmax / v_imp * contact_integral(beta + 1);
+        if (beta == 1)
+            t = DEM_PI * sqrt(m_eff / k); /* independent of speed */
+        tc = fmin(tc, t);
+        double b = gamma / (2 * m_eff);
+        if (s->contact.damping == DEM_DAMPING_BRILLIANTOV) /* rate T k d^{1/2} / (2 m_eff) */
+            b = s->contact.damping_time * k * sqrt(dmax) / (2 * m_eff);
+        bmax = fmax(bmax, b);
+    }
+    out->impact_velocity = v_imp;
+    out->contact_time = tc;
+    out->limit = tc / 10;
+    if (bmax > 0) /* a stiff dashpot needs b dt small, whatever the spring */
+        out->limit = fmin(out->limit, 0.2 / bmax);
+    out->dt_auto = out->limit / 5;
+    return CORE_OK;
+}
+
+/* ---- Brilliantov damping time from a restitution ------------------------------------------ */
+/* x'' = -x^{3/2} - lambda x^{1/2} x', x(0) = 0, x'(0) = 1 (lengths in d* = (m v^2/K)^{2/5}, times
+ * in units of d* / v): integrated with RK4 until x returns to 0; the force is clipped at zero, so after it
+ * vanishes the particles separate at constant speed. Returns the restitution. */
+static double brilliantov_e(double lambda)
+{
+    const double h = 2e-4;
+    double x = 0, u = 1;
+    for (int step = 0; step < 200000; step++) {
+        double kx[4], ku[4], xs = x, us = u;
+        for (int stage = 0; stage < 4; stage++) {
+            double xx = xs > 0 ? xs : 0;
+            double a = -xx * sqrt(xx) - lambda * sqrt(xx) * us;
+            if (a > 0)
+                a = 0; /* no attraction */
+            kx[stage] = us;
+            ku[stage] = a;
+            double c = stage < 2 ? 0.5 * h : h;
+            if (stage < 3) {
+                xs = x + c * kx[stage];
+                us = u + c * ku[stage];
+            }
+        }
+        double xn = x + h / 6 * (kx[0] + 2 * kx[1] + 2 * kx[2] + kx[3]);
+        double un = u + h / 6 * (ku[0] + 2 * ku[1] + 2 * ku[2] + ku[3]);
+        if (step > 0 && xn <= 0)
+            return -un;
+        x = xn;
+        u = un;
+    }
+    return 0; /* overdamped: never came back */
+}
+
+core_status dem_brilliantov_time(double e, double m_eff, double K, double v, double *T,
+                                 core_error *err)
+{
+    if (!(e > 0 && e <= 1))
+        return core_fail(err, CORE_ERR_ARG, "restitution must be in (0, 1], got %g", e);
+    if (!(m_eff > 0) || !(K > 0) || !(v > 0))
+        return core_fail(err, CORE_ERR_ARG, "mass, stiffness and speed must be > 0");
+    double dstar = pow(m_eff * v * v / K, 0.4);
+    if (e == 1) {
+        *T = 0;
+        return CORE_OK;
+    }
+    double lo = 0, hi = 1;
+    while (brilliantov_e(hi) > e && hi < 1e6)
+        hi *= 2;
+    for (int it = 0; it < 60; it++) {
+        double mid = 0.5 * (lo + hi);
+        if (brilliantov_e(mid) > e)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    *T = 0.5 * (lo + hi) * dstar / v;
+    return CORE_OK;
+}
+
+core_status dem_damping_time_for(const dem_scene *s, double e, double v, double *T,
+                                 core_error *err)
+{
+    if (s->n == 0)
+        return core_fail(err, CORE_ERR_STATE, "add particles before setting brilliantov damping "
+                         "from a restitution (T is solved for their mean pair)");
+    double rm = 0, mm = 0;
+    for (size_t i = 0; i < s->n; i++) {
+        rm += s->r[i];
+        mm += s->m[i];
+    }
+    rm /= (double)s->n;
+    mm /= (double)s->n;
+    const dem_material *mat = &s->mats[s->mat[0]];
+    double estar = mat->young / (2 * (1 - mat->poisson * mat->poisson));
+    double K = 4.0 / 3.0 * estar * sqrt(rm / 2);
+    return dem_brilliantov_time(e, mm / 2, K, v, T, err);
+}

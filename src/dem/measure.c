@@ -1,0 +1,332 @@
+/* Measurements on a DEM scene: energies, contacts, the assembly stress, coordination, slip rate
+ * at contacts (Padbidri Fig. 2.4) and displacements, plain or relative to an affine field
+ * (Padbidri Figs. 2.6-2.7). All read the state of the last force evaluation. */
+#include <math.h>
+#include <string.h>
+
+#include "dem/dem_internal.h"
+
+/* Geometry of pair q now: returns the overlap (<= 0 when apart) and fills n (from j to i). */
+static double pair_geometry(const dem_scene *s, size_t i, size_t j, double n[3], double *dist)
+{
+    double d2 = 0, dx[3] = {0, 0, 0};
+    for (int d = 0; d < s->dim; d++) {
+        dx[d] = s->x[d][i] - s->x[d][j];
+        if (s->periodic[d])
+            dx[d] -= s->len[d] * nearbyint(dx[d] / s->len[d]);
+        d2 += dx[d] * dx[d];
+    }
+    *dist = sqrt(d2);
+    for (int d = 0; d < 3; d++)
+        n[d] = *dist > 0 ? dx[d] / *dist : 0;
+    return s->r[i] + s->r[j] - *dist;
+}
+
+static double wall_overlap(const dem_scene *s, const dem_wall *w, size_t i)
+{
+    double dist = 0;
+    for (int d = 0; d < s->dim; d++)
+        dist += (s->x[d][i] - w->point[d]) * w->normal[d];
+    return s->r[i] - dist;
+}
+
+static double spring_energy(const dem_scene *s, double k, double delta, const double *h3)
+{
+    if (s->contact.tangential != DEM_TANGENT_SPRING)
+        return 0;
+    double kt = s->contact.kt > 0 ? s->contact.kt : 0;
+    if (kt == 0) { /* the same default as forces.c */
+        double sq = sqrt(delta);
+        switch (s->contact.normal) {
+        case DEM_NORMAL_LINEAR: kt = 2.0 / 7.0 * k; break;
+        case DEM_NORMAL_POWER:
+            kt = 2.0 / 7.0 * s->contact.beta * k *
+                 (s->contact.beta == 1 ? 1 : s->contact.beta == 2 ? delta : sq);
+            break;
+        default: kt = 2.0 / 7.0 * 1.5 * k * sq;
+        }
+    }
+    double h2 = h3[0] * h3[0] + h3[1] * h3[1] + h3[2] * h3[2];
+    return 0.5 * kt * h2;
+}
+
+void dem_measure_energy(dem_scene *s, dem_energy *e)
+{
+    const int D = s->dim;
+    memset(e, 0, sizeof *e);
+    for (size_t i = 0; i < s->n; i++) {
+        if (s->flags[i] & DEM_FIXED)
+            continue;
+        double v2 = 0, gx = 0;
+        for (int d = 0; d < D; d++) {
+            v2 += s->v[d][i] * s->v[d][i];
+            gx += s->gravity[d] * s->x[d][i];
+        }
+        e->kinetic += 0.5 * s->m[i] * v2;
+        if (!(s->flags[i] & DEM_PRESCRIBED))
+            e->potential -= s->m[i] * gx;
+        if (s->rot && s->inv_inertia[i] > 0) {
+            double w2 = 0;
+            for (int d = (D == 2 ? 2 : 0); d < 3; d++)
+                w2 += s->w[d][i] * s->w[d][i];
+            e->rotational += 0.5 * w2 / s->inv_inertia[i];
+        }
+    }
+    if (s->need_rebuild || !s->pairs.start)
+        dem_build_pairs(s, NULL);
+    const dem_pairs *p = &s->pairs;
+    for (size_t q = 0; q < p->n; q++) {
+        double n[3], dist;
+        double delta = pair_geometry(s, p->i[q], p->j[q], n, &dist);
+        if (delta <= 0)
+            continue;
+        e->elastic += dem_elastic_energy(&s->contact, p->k[q], delta);
+        if (p->hist[0]) {
+            double h[3] = {0, 0, 0};
+            for (int d = 0; d < D; d++)
+                h[d] = p->hist[d][q];
+            e->elastic += spring_energy(s, p->k[q], delta, h);
+        }
+    }
+    for (int w = 0; w < s->nwalls; w++) {
+        const dem_wall *wl = &s->walls[w];
+        if (!wl->active)
+            continue;
+        for (size_t i = 0; i < s->n; i++) {
+            double delta = wall_overlap(s, wl, i);
+            if (delta <= 0)
+                continue;
+            double k, gamma, mu;
+            dem_wall_parameters(s, wl, i, &k, &gamma, &mu);
+            e->elastic += dem_elastic_energy(&s->contact, k, delta);
+            if (wl->hist[0]) {
+                double h[3] = {0, 0, 0};
+                for (int d = 0; d < D; d++)
+                    h[d] = wl->hist[d][i];
+                e->elastic += spring_energy(s, k, delta, h);
+            }
+        }
+    }
+    e->total = e->kinetic + e->rotational + e->elastic + e->potential;
+}
+
+/* |slip| of particle i's contact point on wall wl. */
+static double wall_slip(const dem_scene *s, const dem_wall *wl, size_t i)
+{
+    const int D = s->dim;
+    const double *n = wl->normal;
+    double vr[3] = {0, 0, 0}, vn = 0;
+    for (int d = 0; d < D; d++) {
+        vr[d] = s->v[d][i] - wl->velocity[d];
+        vn += vr[d] * n[d];
+    }
+    if (D == 2)
+        return fabs(-vr[0] * n[1] + vr[1] * n[0] - (s->rot ? s->r[i] * s->w[2][i] : 0));
+    double om[3] = {0, 0, 0}, sl2 = 0;
+    for (int d = 0; s->rot && d < 3; d++)
+        om[d] = s->r[i] * s->w[d][i];
+    double oxn[3] = {om[1] * n[2] - om[2] * n[1], om[2] * n[0] - om[0] * n[2],
+                     om[0] * n[1] - om[1] * n[0]};
+    for (int d = 0; d < 3; d++) {
+        double sd = vr[d] - vn * n[d] - oxn[d];
+        sl2 += sd * sd;
+    }
+    return sqrt(sl2);
+}
+
+/* The tangential force a wall contact carries now, without advancing the spring history. */
+static double wall_tangential(const dem_scene *s, const dem_wall *wl, size_t i, double fn,
+                              double k, double mu, double delta)
+{
+    const dem_contact_def *c = &s->contact;
+    switch (c->tangential) {
+    case DEM_TANGENT_VISCOUS:
+        return c->gamma_t * wall_slip(s, wl, i);
+    case DEM_TANGENT_REGULARIZED: {
+        double x = wall_slip(s, wl, i) / c->v_r;
+        return x >= 1 ? mu * fn : mu * fn * pow(x, 1 / c->exponent);
+    }
+    case DEM_TANGENT_SPRING: {
+        if (!wl->hist[0])
+            return 0;
+        double h[3] = {0, 0, 0};
+        for (int d = 0; d < s->dim; d++)
+            h[d] = wl->hist[d][i];
+        double e = spring_energy(s, k, delta, h), h2 = h[0] * h[0] + h[1] * h[1] + h[2] * h[2];
+        return h2 > 0 ? fmin(2 * e / sqrt(h2), mu * fn) : 0; /* kt |xi| */
+    }
+    default:
+        return 0;
+    }
+}
+
+void dem_each_contact(dem_scene *s, void (*visit)(const dem_contact_info *c, void *ctx),
+                      void *ctx)
+{
+    const int D = s->dim;
+    if (s->need_rebuild || !s->pairs.start)
+        dem_build_pairs(s, NULL);
+    const dem_pairs *p = &s->pairs;
+    for (size_t q = 0; q < p->n; q++) {
+        dem_contact_info c;
+        double dist;
+        c.overlap = pair_geometry(s, p->i[q], p->j[q], c.normal, &dist);
+        if (c.overlap <= 0)
+            continue;
+        c.i = p->i[q];
+        c.j = p->j[q];
+        double fn = 0, f2 = 0;
+        for (int d = 0; d < D; d++) {
+            fn += p->f[d][q] * c.normal[d];
+            f2 += p->f[d][q] * p->f[d][q];
+        }
+        c.fn = fn;
+        c.ft = sqrt(fmax(0, f2 - fn * fn));
+        for (int d = 0; d < 3; d++)
+            c.point[d] = d < D ? s->x[d][c.i] - (s->r[c.i] - 0.5 * c.overlap) * c.normal[d] : 0;
+        visit(&c, ctx);
+    }
+    for (int w = 0; w < s->nwalls; w++) {
+        const dem_wall *wl = &s->walls[w];
+        if (!wl->active)
+            continue;
+        for (size_t i = 0; i < s->n; i++) {
+            double delta = wall_overlap(s, wl, i);
+            if (delta <= 0)
+                continue;
+            dem_contact_info c = {.i = (long)i, .j = -(long)w - 1, .overlap = delta};
+            double k, gamma, mu, vn = 0;
+            dem_wall_parameters(s, wl, i, &k, &gamma, &mu);
+            for (int d = 0; d < 3; d++) {
+                c.normal[d] = d < D ? wl->normal[d] : 0;
+                c.point[d] = d < D ? s->x[d][i] - s->r[i] * wl->normal[d] : 0;
+            }
+            for (int d = 0; d < D; d++)
+                vn += (s->v[d][i] - wl->velocity[d]) * wl->normal[d];
+            c.fn = dem_normal_force(&s->contact, k, gamma, delta, -vn);
+            c.ft = wall_tangential(s, wl, i, c.fn, k, mu, delta);
+            visit(&c, ctx);
+        }
+    }
+}
+
+long dem_measure_stress(dem_scene *s, double volume, double sigma[3][3])
+{
+    const int D = s->dim;
+    memset(sigma, 0, 9 * sizeof(double));
+    if (!(volume > 0)) {
+        volume = 1;
+        for (int d = 0; d < D; d++)
+            volume *= s->len[d];
+    }
+    if (s->need_rebuild || !s->pairs.start)
+        dem_build_pairs(s, NULL);
+    const dem_pairs *p = &s->pairs;
+    long count = 0;
+    for (size_t q = 0; q < p->n; q++) {
+        double n[3], dist;
+        if (pair_geometry(s, p->i[q], p->j[q], n, &dist) <= 0)
+            continue;
+        count++;
+        /* branch vector from j to i times the force on i */
+        for (int a = 0; a < D; a++)
+            for (int b = 0; b < D; b++)
+                sigma[a][b] += dist * n[a] * p->f[b][q];
+    }
+    for (int a = 0; a < D; a++)
+        for (int b = 0; b < D; b++)
+            sigma[a][b] /= volume;
+    return count;
+}
+
+void dem_measure_coordination(dem_scene *s, double *z_all, double *z_no_rattlers)
+{
+    if (s->need_rebuild || !s->pairs.start)
+        dem_build_pairs(s, NULL);
+    const dem_pairs *p = &s->pairs;
+    long total = 0, kept = 0, kept_particles = 0;
+    for (size_t i = 0; i < s->n; i++) {
+        long z = 0;
+        double n[3], dist;
+        for (size_t q = p->start[i]; q < p->start[i + 1]; q++)
+            z += pair_geometry(s, i, p->j[q], n, &dist) > 0;
+        for (size_t e = p->jstart[i]; e < p->jstart[i + 1]; e++)
+            z += pair_geometry(s, p->i[p->jpair[e]], i, n, &dist) > 0;
+        for (int w = 0; w < s->nwalls; w++)
+            z += s->walls[w].active && wall_overlap(s, &s->walls[w], i) > 0;
+        total += z;
+        if (z >= 2) {
+            kept += z;
+            kept_particles++;
+        }
+    }
+    *z_all = s->n ? (double)total / (double)s->n : 0;
+    *z_no_rattlers = kept_particles ? (double)kept / (double)kept_particles : 0;
+}
+
+double dem_measure_slip(dem_scene *s)
+{
+    const int D = s->dim;
+    if (s->need_rebuild || !s->pairs.start)
+        dem_build_pairs(s, NULL);
+    const dem_pairs *p = &s->pairs;
+    double sum = 0;
+    long count = 0;
+    for (size_t q = 0; q < p->n; q++) {
+        const size_t i = p->i[q], j = p->j[q];
+        double n[3], dist;
+        if (pair_geometry(s, i, j, n, &dist) <= 0)
+            continue;
+        double vr[3] = {0, 0, 0}, vn = 0;
+        for (int d = 0; d < D; d++) {
+            vr[d] = s->v[d][i] - s->v[d][j];
+            vn += vr[d] * n[d];
+        }
+        double slip;
+        if (D == 2) {
+            double w = s->rot ? s->r[i] * s->w[2][i] + s->r[j] * s->w[2][j] : 0;
+            slip = fabs(-vr[0] * n[1] + vr[1] * n[0] - w);
+        } else {
+            double om[3] = {0, 0, 0}, s2 = 0;
+            for (int d = 0; s->rot && d < 3; d++)
+                om[d] = s->r[i] * s->w[d][i] + s->r[j] * s->w[d][j];
+            double oxn[3] = {om[1] * n[2] - om[2] * n[1], om[2] * n[0] - om[0] * n[2],
+                             om[0] * n[1] - om[1] * n[0]};
+            for (int d = 0; d < 3; d++) {
+                double sd = vr[d] - vn * n[d] - oxn[d];
+                s2 += sd * sd;
+            }
+            slip = sqrt(s2);
+        }
+        sum += slip;
+        count++;
+    }
+    return count ? sum / (double)count : 0;
+}
+
+core_status dem_set_reference(dem_scene *s, core_error *err)
+{
+    for (int d = 0; d < s->dim; d++) {
+        if (!s->x_ref[d] && dem_alloc_array(&s->x_ref[d], s->cap ? s->cap : 1, err))
+            return err->status;
+        memcpy(s->x_ref[d], s->x[d], s->n * sizeof(double));
+    }
+    return CORE_OK;
+}
+
+core_status dem_measure_displacement(const dem_scene *s, const double grad_u[3][3],
+                                     const double center[3], double *out[3], core_error *err)
+{
+    const int D = s->dim;
+    if (!s->x_ref[0])
+        return core_fail(err, CORE_ERR_STATE, "no reference state: call set_reference first");
+    for (size_t i = 0; i < s->n; i++)
+        for (int a = 0; a < D; a++) {
+            double u = s->x[a][i] - s->x_ref[a][i];
+            if (grad_u)
+                for (int b = 0; b < D; b++)
+                    u -= grad_u[a][b] * (s->x_ref[b][i] - (center ? center[b] : 0));
+            out[a][i] = u;
+        }
+    return CORE_OK;
+}

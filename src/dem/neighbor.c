@@ -1,0 +1,387 @@
+/* Neighbour search: particles are binned into cells at least one cutoff (2 r_max + skin) wide;
+ * the Verlet list keeps every pair closer than r_i + r_j + skin, and is rebuilt when some particle
+ * has moved more than skin/2 since the last build. Pairs are sorted by (i, j), so the list, the
+ * carried-over contact history and the force sums are the same for any number of threads. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "dem/dem_internal.h"
+
+void dem_free_pairs(dem_pairs *p)
+{
+    free(p->i), free(p->j), free(p->k), free(p->gamma), free(p->mu);
+    for (int d = 0; d < 3; d++)
+        free(p->hist[d]), free(p->f[d]), free(p->c[d]);
+    free(p->start), free(p->jstart), free(p->jpair);
+    memset(p, 0, sizeof *p);
+}
+
+static double effective_modulus(const dem_material *a, const dem_material *b)
+{
+    return 1.0 / ((1 - a->poisson * a->poisson) / a->young +
+                  (1 - b->poisson * b->poisson) / b->young);
+}
+
+/* Damping coefficient that gives restitution e to a linear spring k between masses m_eff:
+ * b = -ln(e) w0 / sqrt(pi^2 + ln(e)^2), gamma = 2 m_eff b (the closed form of VALIDATION.md). */
+static double linear_gamma(double k, double m_eff, double e)
+{
+    if (e >= 1)
+        return 0;
+    double lne = log(e), w0 = sqrt(k / m_eff);
+    return 2 * m_eff * (-lne * w0 / sqrt(DEM_PI * DEM_PI + lne * lne));
+}
+
+static void law_parameters(const dem_scene *s, const dem_material *a, const dem_material *b,
+                           double r_eff, double m_eff, double mu, double *k, double *gamma,
+                           double *mu_out)
+{
+    const dem_contact_def *c = &s->contact;
+    *k = c->normal == DEM_NORMAL_HERTZ ? 4.0 / 3.0 * effective_modulus(a, b) * sqrt(r_eff)
+                                       : c->stiffness;
+    *gamma = 0;
+    if (c->damping == DEM_DAMPING_VISCOUS) {
+        if (c->gamma_n >= 0)
+            *gamma = c->gamma_n;
+        else /* the linear law's closed form; for other laws it sets the scale */
+            *gamma = linear_gamma(*k, m_eff, fmin(a->restitution, b->restitution));
+    }
+    *mu_out = mu;
+}
+
+void dem_pair_parameters(dem_scene *s, size_t i, size_t j, double *k, double *gamma, double *mu)
+{
+    const dem_material *a = &s->mats[s->mat[i]], *b = &s->mats[s->mat[j]];
+    double ri = s->r[i], rj = s->r[j];
+    /* A fixed or prescribed particle acts with infinite mass. */
+    double inv = s->inv_m[i] + s->inv_m[j];
+    double m_eff = inv > 0 ? 1 / inv : 0.5 * (s->m[i] + s->m[j]);
+    law_parameters(s, a, b, ri * rj / (ri + rj), m_eff, fmin(a->friction, b->friction), k, gamma,
+                   mu);
+}
+
+void dem_wall_parameters(const dem_scene *s, const dem_wall *w, size_t i, double *k,
+                         double *gamma, double *mu)
+{
+    const dem_material *a = &s->mats[s->mat[i]];
+    const dem_material *b = w->material >= 0 ? &s->mats[w->material] : a;
+    double m_eff = s->inv_m[i] > 0 ? 1 / s->inv_m[i] : s->m[i];
+    law_parameters(s, a, b, s->r[i], m_eff, w->friction >= 0 ? w->friction : a->friction, k,
+                   gamma, mu);
+}
+
+static core_status alloc_u32(uint32_t **a, size_t n, core_error *err)
+{
+    uint32_t *p = realloc(*a, (n ? n : 1) * sizeof *p);
+    if (!p)
+        return core_fail(err, CORE_ERR_NOMEM, "cannot allocate %zu list entries", n);
+    *a = p;
+    return CORE_OK;
+}
+
+static core_status alloc_size(size_t **a, size_t n, core_error *err)
+{
+    size_t *p = realloc(*a, (n ? n : 1) * sizeof *p);
+    if (!p)
+        return core_fail(err, CORE_ERR_NOMEM, "cannot allocate %zu list entries", n);
+    *a = p;
+    return CORE_OK;
+}
+
+static core_status reserve_pairs(dem_scene *s, size_t n, core_error *err)
+{
+    dem_pairs *p = &s->pairs;
+    if (n <= p->cap)
+        return CORE_OK;
+    size_t cap = p->cap ? p->cap : 1024;
+    while (cap < n)
+        cap *= 2;
+    core_status st = alloc_u32(&p->i, cap, err);
+    if (!st)
+        st = alloc_u32(&p->j, cap, err);
+    if (!st)
+        st = dem_alloc_array(&p->k, cap, err);
+    if (!st)
+        st = dem_alloc_array(&p->gamma, cap, err);
+    if (!st)
+        st = dem_alloc_array(&p->mu, cap, err);
+    for (int d = 0; d < 3 && !st; d++) {
+        if (d < s->dim)
+            st = dem_alloc_array(&p->f[d], cap, err);
+        if (!st && s->rot && (s->dim == 3 || d == 2))
+            st = dem_alloc_array(&p->c[d], cap, err);
+        if (!st && s->contact.tangential == DEM_TANGENT_SPRING && d < s->dim)
+            st = dem_alloc_array(&p->hist[d], cap, err);
+    }
+    if (!st)
+        p->cap = cap;
+    return st;
+}
+
+/* Cells at least one cutoff wide; not more cells than about 2 per particle, so a sparse scene
+ * in a large box does not pay for empty cells. Periodic axes need 3 cells or more. */
+static core_status setup_cells(dem_scene *s, double cutoff, core_error *err)
+{
+    const int D = s->dim;
+    size_t total = 1;
+    double size = cutoff;
+    for (int pass = 0; pass < 64; pass++) {
+        total = 1;
+        for (int d = 0; d < D; d++) {
+            int nc = (int)floor(s->len[d] / size);
+            if (nc < 1)
+                nc = 1;
+            if (nc > 1 << 20)
+                nc = 1 << 20;
+            s->ncell[d] = nc;
+            s->cell_size[d] = s->len[d] / nc;
+            total *= (size_t)nc;
+        }
+        if (total <= 2 * s->n + 64)
+            break;
+        size *= 1.25;
+    }
+    for (int d = D; d < 3; d++) {
+        s->ncell[d] = 1;
+        s->cell_size[d] = 1;
+    }
+    for (int d = 0; d < D; d++)
+        if (s->periodic[d] && s->ncell[d] < 3)
+            return core_fail(err, CORE_ERR_ARG,
+                             "periodic axis %d is %g long, less than 3 neighbour cutoffs "
+                             "(3 x %g): make the box longer or the particles smaller",
+                             d + 1, s->len[d], cutoff);
+    if (total + 1 > s->cell_cap) {
+        if (alloc_size(&s->cell_start, total + 1, err))
+            return err->status;
+        s->cell_cap = total + 1;
+    }
+    return CORE_OK;
+}
+
+static int cell_coord(const dem_scene *s, int d, double x)
+{
+    int c = (int)floor((x - s->lo[d]) / s->cell_size[d]);
+    if (s->periodic[d]) {
+        c %= s->ncell[d];
+        if (c < 0)
+            c += s->ncell[d];
+    } else if (c < 0) {
+        c = 0;
+    } else if (c >= s->ncell[d]) {
+        c = s->ncell[d] - 1;
+    }
+    return c;
+}
+
+static size_t cell_index(const dem_scene *s, const int c[3])
+{
+    return ((size_t)c[2] * (size_t)s->ncell[1] + (size_t)c[1]) * (size_t)s->ncell[0] + (size_t)c[0];
+}
+
+/* Squared distance of particles i and j with the minimum image on periodic axes. */
+static double dist2(const dem_scene *s, size_t i, size_t j)
+{
+    double r2 = 0;
+    for (int d = 0; d < s->dim; d++) {
+        double dx = s->x[d][i] - s->x[d][j];
+        if (s->periodic[d])
+            dx -= s->len[d] * nearbyint(dx / s->len[d]);
+        r2 += dx * dx;
+    }
+    return r2;
+}
+
+/* Visits the neighbours j > i of particle i (within r_i + r_j + skin): count or store them. */
+static size_t scan(const dem_scene *s, size_t i, uint32_t *out)
+{
+    const int D = s->dim;
+    int c[3] = {0, 0, 0}, lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+    for (int d = 0; d < D; d++) {
+        c[d] = cell_coord(s, d, s->x[d][i]);
+        lo[d] = c[d] - 1;
+        hi[d] = c[d] + 1;
+        if (!s->periodic[d]) {
+            if (lo[d] < 0)
+                lo[d] = 0;
+            if (hi[d] >= s->ncell[d])
+                hi[d] = s->ncell[d] - 1;
+        }
+    }
+    size_t count = 0;
+    int k[3];
+    for (k[2] = lo[2]; k[2] <= hi[2]; k[2]++)
+        for (k[1] = lo[1]; k[1] <= hi[1]; k[1]++)
+            for (k[0] = lo[0]; k[0] <= hi[0]; k[0]++) {
+                int cc[3];
+                for (int d = 0; d < 3; d++) {
+                    cc[d] = k[d];
+                    if (d < D && s->periodic[d])
+                        cc[d] = (k[d] + s->ncell[d]) % s->ncell[d];
+                }
+                size_t cell = cell_index(s, cc);
+                for (size_t e = s->cell_start[cell]; e < s->cell_start[cell + 1]; e++) {
+                    uint32_t j = s->cell_items[e];
+                    if (j <= i)
+                        continue;
+                    double cut = s->r[i] + s->r[j] + s->skin;
+                    if (dist2(s, i, j) < cut * cut) {
+                        if (out)
+                            out[count] = j;
+                        count++;
+                    }
+                }
+            }
+    return count;
+}
+
+static int cmp_u32(const void *a, const void *b)
+{
+    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    return (x > y) - (x < y);
+}
+
+core_status dem_build_pairs(dem_scene *s, core_error *err)
+{
+    const int D = s->dim;
+    const size_t n = s->n;
+    dem_pairs *p = &s->pairs;
+    s->skin = s->skin_def > 0 ? s->skin_def : 0.2 * s->r_max;
+
+    /* Wrap positions on periodic axes into the box (the list is built from wrapped positions). */
+    for (int d = 0; d < D; d++) {
+        if (!s->periodic[d])
+            continue;
+        for (size_t i = 0; i < n; i++) {
+            double x = s->x[d][i];
+            if (x < s->lo[d] || x >= s->hi[d]) {
+                double w = x - s->len[d] * floor((x - s->lo[d]) / s->len[d]);
+                if (s->x_prev[d])
+                    s->x_prev[d][i] += w - x;
+                if (s->gear[0][d])
+                    s->gear[0][d][i] += w - x;
+                if (s->x_ref[d])
+                    s->x_ref[d][i] += w - x; /* displacements stay continuous */
+                s->x[d][i] = w;
+            }
+        }
+    }
+
+    core_status st = setup_cells(s, 2 * s->r_max + s->skin, err);
+    if (st)
+        return st;
+    size_t ncells = (size_t)s->ncell[0] * (size_t)s->ncell[1] * (size_t)s->ncell[2];
+    if ((st = alloc_u32(&s->cell_items, n, err)))
+        return st;
+    memset(s->cell_start, 0, (ncells + 1) * sizeof(size_t));
+    uint32_t *cell_of = malloc((n ? n : 1) * sizeof *cell_of);
+    if (!cell_of)
+        return core_fail(err, CORE_ERR_NOMEM, "cannot allocate cell indices");
+    for (size_t i = 0; i < n; i++) {
+        int c[3] = {0, 0, 0};
+        for (int d = 0; d < D; d++)
+            c[d] = cell_coord(s, d, s->x[d][i]);
+        cell_of[i] = (uint32_t)cell_index(s, c);
+        s->cell_start[cell_of[i] + 1]++;
+    }
+    for (size_t c = 0; c < ncells; c++)
+        s->cell_start[c + 1] += s->cell_start[c];
+    {
+        size_t *fill = malloc((ncells ? ncells : 1) * sizeof *fill);
+        if (!fill) {
+            free(cell_of);
+            return core_fail(err, CORE_ERR_NOMEM, "cannot allocate cells");
+        }
+        memcpy(fill, s->cell_start, ncells * sizeof *fill);
+        for (size_t i = 0; i < n; i++)
+            s->cell_items[fill[cell_of[i]]++] = (uint32_t)i;
+        free(fill);
+    }
+    free(cell_of);
+
+    /* Count, then fill, the neighbours of each particle: two passes keep the list in (i, j)
+     * order whatever the thread count. */
+    size_t *start = malloc((n + 1) * sizeof *start);
+    if (!start)
+        return core_fail(err, CORE_ERR_NOMEM, "cannot allocate the pair list");
+    start[0] = 0;
+#pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < n; i++)
+        start[i + 1] = scan(s, i, NULL);
+    for (size_t i = 0; i < n; i++)
+        start[i + 1] += start[i];
+    size_t npairs = start[n];
+
+    /* Keep the old list to carry the contact history over. */
+    dem_pairs old = *p;
+    int carry = s->contact.tangential == DEM_TANGENT_SPRING && old.hist[0] && old.start;
+    memset(p, 0, sizeof *p);
+    if ((st = reserve_pairs(s, npairs, err))) {
+        free(start);
+        dem_free_pairs(&old);
+        return st;
+    }
+    p->n = npairs;
+    p->np = n;
+    p->start = start;
+#pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < n; i++) {
+        size_t b = start[i], e = start[i + 1];
+        scan(s, i, p->j + b);
+        qsort(p->j + b, e - b, sizeof(uint32_t), cmp_u32);
+        for (size_t q = b; q < e; q++) {
+            p->i[q] = (uint32_t)i;
+            dem_pair_parameters(s, i, p->j[q], &p->k[q], &p->gamma[q], &p->mu[q]);
+        }
+    }
+    if (p->hist[0]) {
+        size_t old_np = carry ? (old.np < n ? old.np : n) : 0;
+#pragma omp parallel for schedule(static)
+        for (size_t i = 0; i < n; i++) {
+            size_t q = start[i], e = start[i + 1];
+            size_t o = i < old_np ? old.start[i] : 0, oe = i < old_np ? old.start[i + 1] : 0;
+            for (; q < e; q++) { /* merge two lists sorted by j */
+                while (o < oe && old.j[o] < p->j[q])
+                    o++;
+                int same = o < oe && old.j[o] == p->j[q];
+                for (int d = 0; d < D; d++)
+                    p->hist[d][q] = same ? old.hist[d][o] : 0;
+            }
+        }
+    }
+    for (int d = 0; d < 3; d++) {
+        if (p->f[d])
+            memset(p->f[d], 0, (npairs ? npairs : 1) * sizeof(double));
+        if (p->c[d])
+            memset(p->c[d], 0, (npairs ? npairs : 1) * sizeof(double));
+    }
+
+    /* Incidence as j: pair indices in pair order, per particle. */
+    if ((st = alloc_size(&p->jstart, n + 1, err)) || (st = alloc_u32(&p->jpair, npairs, err))) {
+        dem_free_pairs(&old);
+        return st;
+    }
+    memset(p->jstart, 0, (n + 1) * sizeof(size_t));
+    for (size_t q = 0; q < npairs; q++)
+        p->jstart[p->j[q] + 1]++;
+    for (size_t i = 0; i < n; i++)
+        p->jstart[i + 1] += p->jstart[i];
+    {
+        size_t *fill = malloc((n ? n : 1) * sizeof *fill);
+        if (!fill) {
+            dem_free_pairs(&old);
+            return core_fail(err, CORE_ERR_NOMEM, "cannot allocate the incidence list");
+        }
+        memcpy(fill, p->jstart, n * sizeof *fill);
+        for (size_t q = 0; q < npairs; q++)
+            p->jpair[fill[p->j[q]]++] = (uint32_t)q;
+        free(fill);
+    }
+
+    for (int d = 0; d < D; d++)
+        memcpy(s->x_build[d], s->x[d], n * sizeof(double));
+    dem_free_pairs(&old);
+    s->need_rebuild = 0;
+    return CORE_OK;
+}

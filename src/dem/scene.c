@@ -1,0 +1,476 @@
+/* DEM scenes: creation, materials, particles, walls and contact laws, each checked on entry. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "dem/dem_internal.h"
+
+dem_scene_def dem_default_scene_def(void)
+{
+    dem_scene_def d;
+    memset(&d, 0, sizeof d);
+    d.dim = 2;
+    d.hi[0] = d.hi[1] = d.hi[2] = 1.0;
+    return d;
+}
+
+dem_material dem_default_material(void)
+{
+    return (dem_material){.density = 2650, .young = 30e9, .poisson = 0.3, .friction = 0.45,
+                          .restitution = 0.5};
+}
+
+dem_contact_def dem_default_contact_def(void)
+{
+    return (dem_contact_def){.normal = DEM_NORMAL_HERTZ, .stiffness = 0, .beta = 1.5,
+                             .damping = DEM_DAMPING_NONE, .gamma_n = -1, .damping_time = 0,
+                             .tangential = DEM_TANGENT_NONE, .gamma_t = 0, .kt = -1,
+                             .v_r = 1e-3, .exponent = 10, .clip = true, .rolling = false};
+}
+
+core_status dem_alloc_array(double **a, size_t n, core_error *err)
+{
+    double *p = realloc(*a, (n ? n : 1) * sizeof *p);
+    if (!p)
+        return core_fail(err, CORE_ERR_NOMEM, "cannot allocate %zu values", n);
+    *a = p;
+    return CORE_OK;
+}
+
+core_status dem_create(const dem_scene_def *def, dem_scene **out, core_error *err)
+{
+    *out = NULL;
+    if (def->dim != 2 && def->dim != 3)
+        return core_fail(err, CORE_ERR_ARG, "dim must be 2 or 3, got %d", def->dim);
+    for (int d = 0; d < def->dim; d++) {
+        if (!isfinite(def->lo[d]) || !isfinite(def->hi[d]) || !(def->hi[d] > def->lo[d]))
+            return core_fail(err, CORE_ERR_ARG, "box axis %d: upper %g must exceed lower %g", d + 1,
+                             def->hi[d], def->lo[d]);
+        if (!isfinite(def->gravity[d]))
+            return core_fail(err, CORE_ERR_ARG, "gravity component %d is not finite", d + 1);
+    }
+    if (!(def->thickness >= 0) || !isfinite(def->thickness))
+        return core_fail(err, CORE_ERR_ARG, "thickness must be >= 0, got %g", def->thickness);
+    if (!(def->skin >= 0) || !isfinite(def->skin))
+        return core_fail(err, CORE_ERR_ARG, "skin must be >= 0, got %g", def->skin);
+    dem_scene *s = calloc(1, sizeof *s);
+    if (!s)
+        return core_fail(err, CORE_ERR_NOMEM, "cannot allocate a scene");
+    s->dim = def->dim;
+    for (int d = 0; d < 3; d++) {
+        s->lo[d] = d < def->dim ? def->lo[d] : 0;
+        s->hi[d] = d < def->dim ? def->hi[d] : 0;
+        s->len[d] = s->hi[d] - s->lo[d];
+        s->periodic[d] = d < def->dim && def->periodic[d];
+        s->gravity[d] = d < def->dim ? def->gravity[d] : 0;
+    }
+    s->thickness = def->dim == 2 ? def->thickness : 0;
+    s->skin_def = def->skin;
+    s->contact = dem_default_contact_def();
+    s->need_rebuild = 1;
+    *out = s;
+    return CORE_OK;
+}
+
+void dem_destroy(dem_scene *s)
+{
+    if (!s)
+        return;
+    for (int d = 0; d < 3; d++) {
+        free(s->x[d]), free(s->v[d]), free(s->f[d]), free(s->w[d]), free(s->tq[d]);
+        free(s->x_build[d]), free(s->x_ref[d]), free(s->x_prev[d]);
+        for (int k = 0; k < 6; k++)
+            free(s->gear[k][d]), free(s->gear_w[k][d]);
+    }
+    free(s->r), free(s->m), free(s->inv_m), free(s->inv_inertia), free(s->mat), free(s->flags);
+    for (int w = 0; w < s->nwalls; w++)
+        for (int d = 0; d < 3; d++)
+            free(s->walls[w].hist[d]);
+    free(s->walls), free(s->mats);
+    dem_free_pairs(&s->pairs);
+    free(s->cell_start), free(s->cell_items);
+    free(s);
+}
+
+int dem_dim(const dem_scene *s) { return s->dim; }
+
+/* ---- materials ------------------------------------------------------------------------------ */
+int dem_add_material(dem_scene *s, const dem_material *m, core_error *err)
+{
+    if (!(m->density > 0) || !isfinite(m->density))
+        return core_fail(err, CORE_ERR_ARG, "density must be > 0, got %g", m->density), -1;
+    if (!(m->young > 0) || !isfinite(m->young))
+        return core_fail(err, CORE_ERR_ARG, "young must be > 0, got %g", m->young), -1;
+    if (!(m->poisson >= 0 && m->poisson < 0.5))
+        return core_fail(err, CORE_ERR_ARG, "poisson must be in [0, 0.5), got %g", m->poisson), -1;
+    if (!(m->friction >= 0) || !isfinite(m->friction))
+        return core_fail(err, CORE_ERR_ARG, "friction must be >= 0, got %g", m->friction), -1;
+    if (!(m->restitution > 0 && m->restitution <= 1))
+        return core_fail(err, CORE_ERR_ARG, "restitution must be in (0, 1], got %g",
+                         m->restitution), -1;
+    if (s->nmat == s->cap_mat) {
+        int cap = s->cap_mat ? 2 * s->cap_mat : 4;
+        dem_material *p = realloc(s->mats, (size_t)cap * sizeof *p);
+        if (!p)
+            return core_fail(err, CORE_ERR_NOMEM, "cannot allocate materials"), -1;
+        s->mats = p;
+        s->cap_mat = cap;
+    }
+    s->mats[s->nmat] = *m;
+    s->need_rebuild = 1; /* pair parameters depend on materials */
+    return s->nmat++;
+}
+
+/* ---- contact law ---------------------------------------------------------------------------- */
+core_status dem_set_contact(dem_scene *s, const dem_contact_def *c, core_error *err)
+{
+    if (c->normal == DEM_NORMAL_LINEAR || c->normal == DEM_NORMAL_POWER) {
+        if (!(c->stiffness > 0) || !isfinite(c->stiffness))
+            return core_fail(err, CORE_ERR_ARG, "stiffness must be > 0 for the %s law, got %g",
+                             c->normal == DEM_NORMAL_LINEAR ? "linear" : "power", c->stiffness);
+    }
+    if (c->normal == DEM_NORMAL_POWER && c->beta != 1 && c->beta != 1.5 && c->beta != 2)
+        return core_fail(err, CORE_ERR_ARG, "beta must be 1, 1.5 or 2, got %g", c->beta);
+    if (c->damping == DEM_DAMPING_BRILLIANTOV) {
+        if (c->normal != DEM_NORMAL_HERTZ)
+            return core_fail(err, CORE_ERR_ARG, "brilliantov damping needs the hertz normal law");
+        if (!(c->damping_time >= 0) || !isfinite(c->damping_time))
+            return core_fail(err, CORE_ERR_ARG, "damping_time must be >= 0, got %g",
+                             c->damping_time);
+    }
+    if (c->damping == DEM_DAMPING_VISCOUS && !(c->gamma_n < 0 || isfinite(c->gamma_n)))
+        return core_fail(err, CORE_ERR_ARG, "gamma_n must be finite, got %g", c->gamma_n);
+    if (c->tangential == DEM_TANGENT_VISCOUS && !(c->gamma_t >= 0 && isfinite(c->gamma_t)))
+        return core_fail(err, CORE_ERR_ARG, "gamma_t must be >= 0, got %g", c->gamma_t);
+    if (c->tangential == DEM_TANGENT_SPRING && !(c->kt < 0 || (c->kt > 0 && isfinite(c->kt))))
+        return core_fail(err, CORE_ERR_ARG, "kt must be > 0, got %g", c->kt);
+    if (c->tangential == DEM_TANGENT_REGULARIZED) {
+        if (!(c->v_r > 0) || !isfinite(c->v_r))
+            return core_fail(err, CORE_ERR_ARG, "v_r must be > 0, got %g", c->v_r);
+        if (!(c->exponent >= 1) || !isfinite(c->exponent))
+            return core_fail(err, CORE_ERR_ARG, "exponent must be >= 1, got %g", c->exponent);
+    }
+    int spring_before = s->contact.tangential == DEM_TANGENT_SPRING;
+    s->contact = *c;
+    if (c->tangential != DEM_TANGENT_NONE || c->rolling) {
+        core_status st = dem_ensure_rotation(s, err);
+        if (st != CORE_OK)
+            return st;
+    }
+    if (spring_before != (c->tangential == DEM_TANGENT_SPRING)) {
+        for (int d = 0; d < 3; d++) { /* history is meaningless under another law */
+            free(s->pairs.hist[d]);
+            s->pairs.hist[d] = NULL;
+            for (int w = 0; w < s->nwalls; w++) {
+                free(s->walls[w].hist[d]);
+                s->walls[w].hist[d] = NULL;
+            }
+        }
+    }
+    s->need_rebuild = 1;
+    s->gear_ready = s->prev_ready = 0;
+    return CORE_OK;
+}
+
+const dem_contact_def *dem_contact(const dem_scene *s) { return &s->contact; }
+
+/* ---- particles ------------------------------------------------------------------------------ */
+static core_status grow(dem_scene *s, size_t need, core_error *err)
+{
+    if (need <= s->cap)
+        return CORE_OK;
+    size_t cap = s->cap ? s->cap : 64;
+    while (cap < need)
+        cap *= 2;
+    core_status st = CORE_OK;
+    for (int d = 0; d < s->dim && st == CORE_OK; d++) {
+        st = dem_alloc_array(&s->x[d], cap, err);
+        if (st == CORE_OK)
+            st = dem_alloc_array(&s->v[d], cap, err);
+        if (st == CORE_OK)
+            st = dem_alloc_array(&s->f[d], cap, err);
+        if (st == CORE_OK)
+            st = dem_alloc_array(&s->x_build[d], cap, err);
+        if (st == CORE_OK && s->x_ref[d])
+            st = dem_alloc_array(&s->x_ref[d], cap, err);
+        if (st == CORE_OK && s->x_prev[d])
+            st = dem_alloc_array(&s->x_prev[d], cap, err);
+        for (int k = 0; k < 6 && st == CORE_OK; k++) {
+            if (st == CORE_OK && s->gear[k][d])
+                st = dem_alloc_array(&s->gear[k][d], cap, err);
+        }
+    }
+    for (int d = 0; d < 3 && st == CORE_OK; d++) {
+        if (s->w[d])
+            st = dem_alloc_array(&s->w[d], cap, err);
+        if (st == CORE_OK && s->tq[d])
+            st = dem_alloc_array(&s->tq[d], cap, err);
+        for (int k = 0; k < 6 && st == CORE_OK; k++)
+            if (s->gear_w[k][d])
+                st = dem_alloc_array(&s->gear_w[k][d], cap, err);
+        for (int w = 0; w < s->nwalls && st == CORE_OK; w++)
+            if (s->walls[w].hist[d]) {
+                st = dem_alloc_array(&s->walls[w].hist[d], cap, err);
+                if (st == CORE_OK)
+                    memset(s->walls[w].hist[d] + s->cap, 0, (cap - s->cap) * sizeof(double));
+            }
+    }
+    if (st == CORE_OK)
+        st = dem_alloc_array(&s->r, cap, err);
+    if (st == CORE_OK)
+        st = dem_alloc_array(&s->m, cap, err);
+    if (st == CORE_OK)
+        st = dem_alloc_array(&s->inv_m, cap, err);
+    if (st == CORE_OK)
+        st = dem_alloc_array(&s->inv_inertia, cap, err);
+    if (st != CORE_OK)
+        return st;
+    int *mat = realloc(s->mat, cap * sizeof *mat);
+    if (mat)
+        s->mat = mat;
+    unsigned char *fl = realloc(s->flags, cap);
+    if (fl)
+        s->flags = fl;
+    if (!mat || !fl)
+        return core_fail(err, CORE_ERR_NOMEM, "cannot allocate %zu particles", cap);
+    s->cap = cap;
+    return CORE_OK;
+}
+
+static double inertia_factor(const dem_scene *s)
+{
+    return (s->dim == 2 && s->thickness > 0) ? 0.5 : 0.4; /* cylinder : sphere */
+}
+
+core_status dem_ensure_rotation(dem_scene *s, core_error *err)
+{
+    if (s->rot)
+        return CORE_OK;
+    size_t cap = s->cap ? s->cap : 1;
+    int d0 = s->dim == 2 ? 2 : 0;
+    for (int d = d0; d < 3; d++) {
+        if (dem_alloc_array(&s->w[d], cap, err) || dem_alloc_array(&s->tq[d], cap, err))
+            return err ? err->status : CORE_ERR_NOMEM;
+        memset(s->w[d], 0, cap * sizeof(double));
+        memset(s->tq[d], 0, cap * sizeof(double));
+    }
+    s->rot = 1;
+    s->gear_ready = 0;
+    return CORE_OK;
+}
+
+long dem_add_particle(dem_scene *s, const dem_particle_def *p, core_error *err)
+{
+    const int D = s->dim;
+    if (!(p->radius > 0) || !isfinite(p->radius))
+        return core_fail(err, CORE_ERR_ARG, "radius must be > 0, got %g", p->radius), -1;
+    if (p->material < 0 || p->material >= s->nmat)
+        return core_fail(err, CORE_ERR_ARG, "unknown material %d", p->material), -1;
+    if (s->n >= UINT32_MAX - 1)
+        return core_fail(err, CORE_ERR_ARG, "too many particles"), -1;
+    for (int d = 0; d < D; d++) {
+        if (!isfinite(p->x[d]) || !isfinite(p->v[d]))
+            return core_fail(err, CORE_ERR_ARG, "position and velocity must be finite"), -1;
+        if (p->x[d] < s->lo[d] || p->x[d] > s->hi[d])
+            return core_fail(err, CORE_ERR_ARG,
+                             "position %g on axis %d is outside the box [%g, %g]", p->x[d], d + 1,
+                             s->lo[d], s->hi[d]), -1;
+    }
+    for (int d = 0; d < 3; d++)
+        if (!isfinite(p->omega[d]))
+            return core_fail(err, CORE_ERR_ARG, "angular velocity must be finite"), -1;
+    for (int w = 0; w < s->nwalls; w++) {
+        const dem_wall *wl = &s->walls[w];
+        if (!wl->active)
+            continue;
+        double dist = 0;
+        for (int d = 0; d < D; d++)
+            dist += (p->x[d] - wl->point[d]) * wl->normal[d];
+        if (dist < p->radius)
+            return core_fail(err, CORE_ERR_ARG,
+                             "particle at distance %g from wall %d overlaps it (radius %g)", dist,
+                             w + 1, p->radius), -1;
+    }
+    core_status st = grow(s, s->n + 1, err);
+    if (st != CORE_OK)
+        return -1;
+    size_t i = s->n;
+    const dem_material *mat = &s->mats[p->material];
+    double r = p->radius, vol;
+    if (D == 2 && s->thickness > 0)
+        vol = DEM_PI * r * r * s->thickness;
+    else
+        vol = 4.0 / 3.0 * DEM_PI * r * r * r;
+    double m = mat->density * vol;
+    for (int d = 0; d < D; d++) {
+        s->x[d][i] = p->x[d];
+        s->v[d][i] = (p->flags & DEM_FIXED) ? 0 : p->v[d];
+        s->f[d][i] = 0;
+        s->x_build[d][i] = p->x[d];
+        if (s->x_ref[d])
+            s->x_ref[d][i] = p->x[d];
+        if (s->x_prev[d])
+            s->x_prev[d][i] = p->x[d];
+    }
+    for (int d = 0; d < 3; d++) {
+        if (s->w[d])
+            s->w[d][i] = (p->flags & DEM_FIXED) ? 0 : p->omega[d];
+        if (s->tq[d])
+            s->tq[d][i] = 0;
+        for (int w = 0; w < s->nwalls; w++)
+            if (s->walls[w].hist[d])
+                s->walls[w].hist[d][i] = 0;
+    }
+    s->r[i] = r;
+    s->m[i] = m;
+    s->inv_m[i] = (p->flags & (DEM_FIXED | DEM_PRESCRIBED)) ? 0 : 1 / m;
+    s->inv_inertia[i] = (p->flags & (DEM_FIXED | DEM_PRESCRIBED))
+                            ? 0
+                            : 1 / (inertia_factor(s) * m * r * r);
+    s->mat[i] = p->material;
+    s->flags[i] = (unsigned char)p->flags;
+    if (r > s->r_max)
+        s->r_max = r;
+    s->n++;
+    s->need_rebuild = 1;
+    s->gear_ready = s->prev_ready = 0;
+    return (long)i;
+}
+
+size_t dem_count(const dem_scene *s) { return s->n; }
+const double *dem_positions(const dem_scene *s, int d) { return s->x[d]; }
+const double *dem_velocities(const dem_scene *s, int d) { return s->v[d]; }
+const double *dem_angular_velocities(const dem_scene *s, int d) { return s->w[d]; }
+const double *dem_radii(const dem_scene *s) { return s->r; }
+const double *dem_masses(const dem_scene *s) { return s->m; }
+double dem_time(const dem_scene *s) { return s->time; }
+long dem_steps_done(const dem_scene *s) { return s->steps; }
+long dem_force_evaluations(const dem_scene *s) { return s->force_evals; }
+
+core_status dem_set_velocity(dem_scene *s, size_t i, const double v[3], core_error *err)
+{
+    if (i >= s->n)
+        return core_fail(err, CORE_ERR_ARG, "no particle %zu (the scene has %zu)", i + 1, s->n);
+    for (int d = 0; d < s->dim; d++)
+        if (!isfinite(v[d]))
+            return core_fail(err, CORE_ERR_ARG, "velocity must be finite");
+    if (s->flags[i] & DEM_FIXED)
+        return core_fail(err, CORE_ERR_STATE, "particle %zu is fixed", i + 1);
+    for (int d = 0; d < s->dim; d++)
+        s->v[d][i] = v[d];
+    s->gear_ready = s->prev_ready = 0;
+    return CORE_OK;
+}
+
+core_status dem_scale_mass(dem_scene *s, double factor, core_error *err)
+{
+    if (!(factor > 0) || !isfinite(factor))
+        return core_fail(err, CORE_ERR_ARG, "mass scale factor must be > 0, got %g", factor);
+    for (size_t i = 0; i < s->n; i++) {
+        s->m[i] *= factor;
+        s->inv_m[i] /= factor;
+        s->inv_inertia[i] /= factor;
+    }
+    for (int k = 0; k < s->nmat; k++)
+        s->mats[k].density *= factor;
+    s->need_rebuild = 1; /* damping coefficients depend on masses */
+    return CORE_OK;
+}
+
+/* ---- walls ---------------------------------------------------------------------------------- */
+int dem_add_wall(dem_scene *s, const dem_wall_def *w, core_error *err)
+{
+    const int D = s->dim;
+    double nn = 0;
+    for (int d = 0; d < D; d++) {
+        if (!isfinite(w->point[d]) || !isfinite(w->normal[d]) || !isfinite(w->velocity[d]))
+            return core_fail(err, CORE_ERR_ARG, "point, normal and velocity must be finite"), -1;
+        nn += w->normal[d] * w->normal[d];
+    }
+    if (!(nn > 1e-24))
+        return core_fail(err, CORE_ERR_ARG, "normal must not be zero"), -1;
+    if (w->material >= s->nmat)
+        return core_fail(err, CORE_ERR_ARG, "unknown material %d", w->material), -1;
+    if (!isfinite(w->friction))
+        return core_fail(err, CORE_ERR_ARG, "friction must be finite"), -1;
+    dem_wall wl = {.active = 1, .friction = w->friction, .material = w->material};
+    for (int d = 0; d < D; d++) {
+        wl.point[d] = w->point[d];
+        wl.normal[d] = w->normal[d] / sqrt(nn);
+        wl.velocity[d] = w->velocity[d];
+    }
+    for (size_t i = 0; i < s->n; i++) {
+        double dist = 0;
+        for (int d = 0; d < D; d++)
+            dist += (s->x[d][i] - wl.point[d]) * wl.normal[d];
+        if (dist < s->r[i])
+            return core_fail(err, CORE_ERR_ARG,
+                             "wall would overlap particle %zu (distance %g, radius %g)", i + 1,
+                             dist, s->r[i]), -1;
+    }
+    for (int k = 0; k < s->nwalls; k++) {
+        const dem_wall *o = &s->walls[k];
+        if (!o->active)
+            continue;
+        double dot = 0, off = 0;
+        for (int d = 0; d < D; d++) {
+            dot += o->normal[d] * wl.normal[d];
+            off += (wl.point[d] - o->point[d]) * o->normal[d];
+        }
+        if (dot < -1 + 1e-12 && off <= 0) /* facing walls that leave no room between them */
+            return core_fail(err, CORE_ERR_ARG, "wall overlaps wall %d (they face each other "
+                             "with no space between)", k + 1), -1;
+    }
+    if (s->nwalls == s->cap_walls) {
+        int cap = s->cap_walls ? 2 * s->cap_walls : 8;
+        dem_wall *p = realloc(s->walls, (size_t)cap * sizeof *p);
+        if (!p)
+            return core_fail(err, CORE_ERR_NOMEM, "cannot allocate walls"), -1;
+        s->walls = p;
+        s->cap_walls = cap;
+    }
+    s->walls[s->nwalls] = wl;
+    s->gear_ready = s->prev_ready = 0;
+    return s->nwalls++;
+}
+
+static core_status check_wall(const dem_scene *s, int id, core_error *err)
+{
+    if (id < 0 || id >= s->nwalls || !s->walls[id].active)
+        return core_fail(err, CORE_ERR_ARG, "no wall %d", id + 1);
+    return CORE_OK;
+}
+
+core_status dem_remove_wall(dem_scene *s, int id, core_error *err)
+{
+    core_status st = check_wall(s, id, err);
+    if (st == CORE_OK) {
+        s->walls[id].active = 0;
+        for (int d = 0; d < 3; d++) {
+            free(s->walls[id].hist[d]);
+            s->walls[id].hist[d] = NULL;
+        }
+    }
+    return st;
+}
+
+core_status dem_set_wall_velocity(dem_scene *s, int id, const double v[3], core_error *err)
+{
+    core_status st = check_wall(s, id, err);
+    if (st != CORE_OK)
+        return st;
+    for (int d = 0; d < s->dim; d++) {
+        if (!isfinite(v[d]))
+            return core_fail(err, CORE_ERR_ARG, "wall velocity must be finite");
+        s->walls[id].velocity[d] = v[d];
+    }
+    return CORE_OK;
+}
+
+core_status dem_wall_point(const dem_scene *s, int id, double p[3], core_error *err)
+{
+    core_status st = check_wall(s, id, err);
+    for (int d = 0; st == CORE_OK && d < 3; d++)
+        p[d] = s->walls[id].point[d];
+    return st;
+}

@@ -1,0 +1,840 @@
+/* The Lua module `dem`: scenes of disks (2D) or spheres (3D) over src/dem. Translates and checks
+ * arguments, calls the kernels, raises their errors named after the call. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/progress.h"
+#include "dem/dem.h"
+#include "lua/bind.h"
+
+static const char *SCENE = "dem.scene";
+
+typedef struct lscene {
+    dem_scene *s;
+} lscene;
+
+static dem_scene *check_scene(lua_State *L, int idx)
+{
+    lscene *u = luaL_checkudata(L, idx, SCENE);
+    if (!u->s)
+        luaL_error(L, "the dem.scene was closed");
+    return u->s;
+}
+
+/* ---- dem.scene{...} ------------------------------------------------------------------------ */
+static void read_box(lua_State *L, int arg, int dim, dem_scene_def *def)
+{
+    char expected[96];
+    snprintf(expected, sizeof expected, "{{lower corner}, {upper corner}} with %d numbers each", dim);
+    if (lua_getfield(L, arg, "box") != LUA_TTABLE || luaL_len(L, -1) != 2)
+        bind_field_error(L, arg, "scene", "box", expected);
+    for (int c = 0; c < 2; c++) {
+        if (lua_rawgeti(L, -1, c + 1) != LUA_TTABLE || luaL_len(L, -1) != dim) {
+            lua_pop(L, 1);
+            bind_field_error(L, arg, "scene", "box", expected);
+        }
+        for (int d = 0; d < dim; d++) {
+            lua_rawgeti(L, -1, d + 1);
+            int isnum;
+            double v = lua_tonumberx(L, -1, &isnum);
+            lua_pop(L, 1);
+            if (!isnum || !isfinite(v)) {
+                lua_pop(L, 1);
+                bind_field_error(L, arg, "scene", "box", expected);
+            }
+            (c == 0 ? def->lo : def->hi)[d] = v;
+        }
+        lua_pop(L, 1);
+    }
+    lua_pop(L, 1);
+    for (int d = 0; d < dim; d++)
+        if (!(def->hi[d] > def->lo[d])) {
+            lua_getfield(L, arg, "box");
+            bind_field_error(L, arg, "scene", "box", "upper corner above the lower one on every axis");
+        }
+}
+
+static int l_scene(lua_State *L)
+{
+    static const char *const fields[] = {"dim", "box", "gravity", "periodic", "thickness", "skin",
+                                         NULL};
+    bind_check_table(L, 1, "scene");
+    bind_check_fields(L, 1, "scene", fields);
+    dem_scene_def def = dem_default_scene_def();
+    def.dim = (int)bind_field_integer(L, 1, "scene", "dim", 2, 2, 3, 0);
+    read_box(L, 1, def.dim, &def);
+    bind_field_vector(L, 1, "scene", "gravity", def.dim, def.gravity, 0);
+    if (lua_getfield(L, 1, "periodic") != LUA_TNIL) {
+        char expected[64];
+        snprintf(expected, sizeof expected, "array of %d booleans", def.dim);
+        if (lua_type(L, -1) != LUA_TTABLE || luaL_len(L, -1) != def.dim)
+            bind_field_error(L, 1, "scene", "periodic", expected);
+        for (int d = 0; d < def.dim; d++) {
+            int t = lua_rawgeti(L, -1, d + 1);
+            def.periodic[d] = lua_toboolean(L, -1);
+            lua_pop(L, 1);
+            if (t != LUA_TBOOLEAN)
+                bind_field_error(L, 1, "scene", "periodic", expected);
+        }
+    }
+    lua_pop(L, 1);
+    def.thickness = bind_field_number(L, 1, "scene", "thickness", 0, BIND_NONNEG);
+    if (def.dim == 3 && def.thickness > 0) {
+        lua_getfield(L, 1, "thickness");
+        bind_field_error(L, 1, "scene", "thickness", "nothing in 3D (thickness is for 2D disks)");
+    }
+    def.skin = bind_field_number(L, 1, "scene", "skin", 0, BIND_NONNEG);
+
+    lscene *u = lua_newuserdatauv(L, sizeof *u, 1);
+    u->s = NULL;
+    luaL_setmetatable(L, SCENE);
+    lua_newtable(L); /* grainlab.material -> material index */
+    lua_setiuservalue(L, -2, 1);
+    core_error err;
+    if (dem_create(&def, &u->s, &err) != CORE_OK)
+        return bind_raise(L, "scene", &err);
+    return 1;
+}
+
+/* Material index for the field `field` of the table at arg: a grainlab.material (registered on
+ * first use) or, when absent, grainlab's default quartz. */
+static int material_index(lua_State *L, int scene, int arg, const char *call, const char *field,
+                          int absent)
+{
+    dem_scene *s = check_scene(L, scene);
+    int t = lua_getfield(L, arg, field);
+    if (t == LUA_TNIL && absent != -2) {
+        lua_pop(L, 1);
+        if (absent == -1)
+            return -1;
+        lua_pushliteral(L, "default");
+    } else if (t != LUA_TTABLE || !luaL_getmetafield(L, -1, "__name") ||
+               strcmp(lua_tostring(L, -1), "grainlab.material") != 0) {
+        if (t == LUA_TTABLE)
+            lua_settop(L, lua_gettop(L)); /* leave the value on top for the message */
+        return bind_field_error(L, arg, call, field, "grainlab.material");
+    } else {
+        lua_pop(L, 1); /* __name */
+    }
+    lua_getiuservalue(L, scene, 1);
+    lua_pushvalue(L, -2);
+    if (lua_rawget(L, -2) == LUA_TNUMBER) {
+        int idx = (int)lua_tointeger(L, -1);
+        lua_pop(L, 3);
+        return idx;
+    }
+    lua_pop(L, 1);
+    dem_material m = dem_default_material();
+    if (lua_type(L, -2) == LUA_TTABLE) {
+        lua_getfield(L, -2, "density");
+        m.density = lua_tonumber(L, -1);
+        lua_getfield(L, -3, "young");
+        m.young = lua_tonumber(L, -1);
+        lua_getfield(L, -4, "poisson");
+        m.poisson = lua_tonumber(L, -1);
+        lua_getfield(L, -5, "friction");
+        m.friction = lua_tonumber(L, -1);
+        lua_getfield(L, -6, "restitution");
+        m.restitution = lua_tonumber(L, -1);
+        lua_pop(L, 5);
+    }
+    core_error err;
+    int idx = dem_add_material(s, &m, &err);
+    if (idx < 0)
+        return bind_raise(L, call, &err);
+    lua_pushvalue(L, -2);
+    lua_pushinteger(L, idx);
+    lua_rawset(L, -3);
+    lua_pop(L, 2);
+    return idx;
+}
+
+/* ---- s:contact{...} ------------------------------------------------------------------------ */
+static const char *const NORMAL_NAMES[] = {"linear", "power", "hertz", NULL};
+static const char *const DAMPING_NAMES[] = {"none", "viscous", "brilliantov", NULL};
+static const char *const TANGENT_NAMES[] = {"none", "viscous", "spring", "coulomb_regularized",
+                                            NULL};
+
+static int l_contact(lua_State *L)
+{
+    static const char *const fields[] = {
+        "normal", "stiffness", "beta", "damping", "gamma_n", "damping_time", "restitution",
+        "impact_velocity", "tangential", "gamma_t", "kt", "v_r", "exponent", "clip", "rolling",
+        NULL};
+    dem_scene *s = check_scene(L, 1);
+    bind_check_table(L, 2, "contact");
+    bind_check_fields(L, 2, "contact", fields);
+    dem_contact_def c = dem_default_contact_def();
+    c.normal = (dem_normal_law)bind_field_option(L, 2, "contact", "normal", NORMAL_NAMES,
+                                                 DEM_NORMAL_HERTZ, 0);
+    unsigned need_k = c.normal == DEM_NORMAL_HERTZ ? 0 : BIND_REQUIRED;
+    c.stiffness = bind_field_number(L, 2, "contact", "stiffness", 0, BIND_POSITIVE | need_k);
+    c.beta = bind_field_number(L, 2, "contact", "beta", c.normal == DEM_NORMAL_LINEAR ? 1 : 1.5,
+                               BIND_POSITIVE);
+    c.damping = (dem_damping_law)bind_field_option(L, 2, "contact", "damping", DAMPING_NAMES,
+                                                   DEM_DAMPING_NONE, 0);
+    c.gamma_n = bind_field_number(L, 2, "contact", "gamma_n", -1, 0);
+    c.damping_time = bind_field_number(L, 2, "contact", "damping_time", -1, 0);
+    double e = bind_field_number(L, 2, "contact", "restitution", -1, 0);
+    double v_imp = bind_field_number(L, 2, "contact", "impact_velocity", 1, BIND_POSITIVE);
+    c.tangential = (dem_tangential_law)bind_field_option(L, 2, "contact", "tangential",
+                                                         TANGENT_NAMES, DEM_TANGENT_NONE, 0);
+    c.gamma_t = bind_field_number(L, 2, "contact", "gamma_t", 0, BIND_NONNEG);
+    c.kt = bind_field_number(L, 2, "contact", "kt", -1, 0);
+    c.v_r = bind_field_number(L, 2, "contact", "v_r", c.v_r, BIND_POSITIVE);
+    c.exponent = bind_field_number(L, 2, "contact", "exponent", c.exponent, BIND_POSITIVE);
+    c.clip = bind_field_boolean(L, 2, "contact", "clip", 1);
+    c.rolling = bind_field_boolean(L, 2, "contact", "rolling", 0);
+    if (c.damping == DEM_DAMPING_BRILLIANTOV) {
+        if (c.damping_time < 0 && e < 0)
+            return luaL_error(L, "contact: brilliantov damping needs damping_time (s) or "
+                                 "restitution (with impact_velocity, default 1 m/s)");
+        if (e >= 0) {
+            if (!(e > 0 && e <= 1)) {
+                lua_getfield(L, 2, "restitution");
+                return bind_field_error(L, 2, "contact", "restitution", "number in (0, 1]");
+            }
+            core_error err;
+            double T;
+            if (dem_damping_time_for(s, e, v_imp, &T, &err) != CORE_OK)
+                return bind_raise(L, "contact", &err);
+            c.damping_time = T;
+        }
+    }
+    core_error err;
+    if (dem_set_contact(s, &c, &err) != CORE_OK)
+        return bind_raise(L, "contact", &err);
+    lua_pushnumber(L, c.damping_time);
+    return 1;
+}
+
+/* ---- particles ------------------------------------------------------------------------------ */
+static int add_particle(lua_State *L, const char *call, int want_dim)
+{
+    static const char *const fields[] = {"pos", "radius", "material", "vel", "omega", "fixed",
+                                         "prescribed", NULL};
+    dem_scene *s = check_scene(L, 1);
+    const int D = dem_dim(s);
+    if (D != want_dim)
+        return luaL_error(L, "%s: this is a %dD scene (use %s)", call, D,
+                          D == 2 ? "add_disk" : "add_sphere");
+    bind_check_table(L, 2, call);
+    bind_check_fields(L, 2, call, fields);
+    dem_particle_def p;
+    memset(&p, 0, sizeof p);
+    bind_field_vector(L, 2, call, "pos", D, p.x, BIND_REQUIRED);
+    p.radius = bind_field_number(L, 2, call, "radius", 0, BIND_REQUIRED | BIND_POSITIVE);
+    bind_field_vector(L, 2, call, "vel", D, p.v, 0);
+    if (D == 2)
+        p.omega[2] = bind_field_number(L, 2, call, "omega", 0, 0);
+    else
+        bind_field_vector(L, 2, call, "omega", 3, p.omega, 0);
+    if (bind_field_boolean(L, 2, call, "fixed", 0))
+        p.flags |= DEM_FIXED;
+    if (bind_field_boolean(L, 2, call, "prescribed", 0))
+        p.flags |= DEM_PRESCRIBED;
+    if ((p.flags & DEM_FIXED) && (p.flags & DEM_PRESCRIBED))
+        return luaL_error(L, "%s: a particle is either fixed or prescribed, not both", call);
+    p.material = material_index(L, 1, 2, call, "material", 0);
+    core_error err;
+    long i = dem_add_particle(s, &p, &err);
+    if (i < 0)
+        return bind_raise(L, call, &err);
+    lua_pushinteger(L, i + 1);
+    return 1;
+}
+
+static int l_add_disk(lua_State *L) { return add_particle(L, "add_disk", 2); }
+static int l_add_sphere(lua_State *L) { return add_particle(L, "add_sphere", 3); }
+
+static size_t particle_arg(lua_State *L, dem_scene *s, int arg)
+{
+    lua_Integer i = luaL_checkinteger(L, arg);
+    if (i < 1 || (size_t)i > dem_count(s))
+        luaL_error(L, "bad argument #%d (particle id in [1, %d] expected, got %d)", arg - 1,
+                   (int)dem_count(s), (int)i);
+    return (size_t)(i - 1);
+}
+
+static int l_set_velocity(lua_State *L)
+{
+    dem_scene *s = check_scene(L, 1);
+    size_t i = particle_arg(L, s, 2);
+    double v[3] = {0, 0, 0};
+    luaL_checktype(L, 3, LUA_TTABLE);
+    for (int d = 0; d < dem_dim(s); d++) {
+        lua_rawgeti(L, 3, d + 1);
+        v[d] = luaL_checknumber(L, -1);
+        lua_pop(L, 1);
+    }
+    core_error err;
+    if (dem_set_velocity(s, i, v, &err))
+        return bind_raise(L, "set_velocity", &err);
+    return 0;
+}
+
+/* ---- walls ---------------------------------------------------------------------------------- */
+static int l_add_wall(lua_State *L)
+{
+    static const char *const fields[] = {"point", "normal", "velocity", "friction", "material",
+                                         NULL};
+    dem_scene *s = check_scene(L, 1);
+    const int D = dem_dim(s);
+    bind_check_table(L, 2, "add_wall");
+    bind_check_fields(L, 2, "add_wall", fields);
+    dem_wall_def w;
+    memset(&w, 0, sizeof w);
+    bind_field_vector(L, 2, "add_wall", "point", D, w.point, BIND_REQUIRED);
+    bind_field_vector(L, 2, "add_wall", "normal", D, w.normal, BIND_REQUIRED);
+    bind_field_vector(L, 2, "add_wall", "velocity", D, w.velocity, 0);
+    w.friction = bind_field_number(L, 2, "add_wall", "friction", -1, 0);
+    if (w.friction < 0 && lua_getfield(L, 2, "friction") != LUA_TNIL)
+        return bind_field_error(L, 2, "add_wall", "friction", "non-negative number");
+    w.material = material_index(L, 1, 2, "add_wall", "material", -1);
+    core_error err;
+    int id = dem_add_wall(s, &w, &err);
+    if (id < 0)
+        return bind_raise(L, "add_wall", &err);
+    lua_pushinteger(L, id + 1);
+    return 1;
+}
+
+static int wall_arg(lua_State *L, int arg)
+{
+    lua_Integer id = luaL_checkinteger(L, arg);
+    return (int)(id - 1);
+}
+
+static int l_remove_wall(lua_State *L)
+{
+    dem_scene *s = check_scene(L, 1);
+    core_error err;
+    if (dem_remove_wall(s, wall_arg(L, 2), &err))
+        return bind_raise(L, "remove_wall", &err);
+    return 0;
+}
+
+static int l_wall_velocity(lua_State *L)
+{
+    dem_scene *s = check_scene(L, 1);
+    double v[3] = {0, 0, 0};
+    luaL_checktype(L, 3, LUA_TTABLE);
+    for (int d = 0; d < dem_dim(s); d++) {
+        lua_rawgeti(L, 3, d + 1);
+        v[d] = luaL_checknumber(L, -1);
+        lua_pop(L, 1);
+    }
+    core_error err;
+    if (dem_set_wall_velocity(s, wall_arg(L, 2), v, &err))
+        return bind_raise(L, "wall_velocity", &err);
+    return 0;
+}
+
+static void push_vector(lua_State *L, const double *v, int n)
+{
+    lua_createtable(L, n, 0);
+    for (int d = 0; d < n; d++) {
+        lua_pushnumber(L, v[d]);
+        lua_rawseti(L, -2, d + 1);
+    }
+}
+
+static int l_wall_point(lua_State *L)
+{
+    dem_scene *s = check_scene(L, 1);
+    double p[3];
+    core_error err;
+    if (dem_wall_point(s, wall_arg(L, 2), p, &err))
+        return bind_raise(L, "wall_point", &err);
+    push_vector(L, p, dem_dim(s));
+    return 1;
+}
+
+/* ---- time stepping -------------------------------------------------------------------------- */
+static void push_timestep(lua_State *L, const dem_timestep *t)
+{
+    lua_createtable(L, 0, 4);
+    lua_pushnumber(L, t->contact_time);
+    lua_setfield(L, -2, "contact_time");
+    lua_pushnumber(L, t->limit);
+    lua_setfield(L, -2, "limit");
+    lua_pushnumber(L, t->dt_auto);
+    lua_setfield(L, -2, "dt_auto");
+    lua_pushnumber(L, t->impact_velocity);
+    lua_setfield(L, -2, "impact_velocity");
+}
+
+static int l_timestep(lua_State *L)
+{
+    dem_scene *s = check_scene(L, 1);
+    double v = 0;
+    if (!lua_isnoneornil(L, 2)) {
+        static const char *const fields[] = {"impact_velocity", NULL};
+        bind_check_table(L, 2, "timestep");
+        bind_check_fields(L, 2, "timestep", fields);
+        v = bind_field_number(L, 2, "timestep", "impact_velocity", 0, BIND_POSITIVE);
+    }
+    dem_timestep t;
+    core_error err;
+    if (dem_timestep_info(s, v, &t, &err))
+        return bind_raise(L, "timestep", &err);
+    push_timestep(L, &t);
+    return 1;
+}
+
+static const char *const INTEGRATOR_NAMES[] = {"velocity_verlet", "position_verlet", "gear",
+                                               "two_timescales", NULL};
+
+static int l_run(lua_State *L)
+{
+    static const char *const fields[] = {"steps", "time", "dt", "force", "impact_velocity",
+                                         "integrator", "m", "n", "q", "every", "on_step",
+                                         "progress", NULL};
+    dem_scene *s = check_scene(L, 1);
+    bind_check_table(L, 2, "run");
+    bind_check_fields(L, 2, "run", fields);
+    dem_run_def run = dem_default_run_def();
+    run.integrator = (dem_integrator)bind_field_option(L, 2, "run", "integrator",
+                                                       INTEGRATOR_NAMES, DEM_VELOCITY_VERLET, 0);
+    run.tt_m = (int)bind_field_integer(L, 2, "run", "m", 5, 1, 100000, 0);
+    run.tt_n = (int)bind_field_integer(L, 2, "run", "n", 5, 1, 100000, 0);
+    run.tt_q = (int)bind_field_integer(L, 2, "run", "q", 5, 0, 100000, 0);
+    double v_imp = bind_field_number(L, 2, "run", "impact_velocity", 0, BIND_POSITIVE);
+    int force = bind_field_boolean(L, 2, "run", "force", 0);
+    dem_timestep ts;
+    core_error err;
+    if (dem_timestep_info(s, v_imp, &ts, &err))
+        return bind_raise(L, "run", &err);
+    lua_getfield(L, 2, "dt");
+    if (lua_isnil(L, -1) || (lua_type(L, -1) == LUA_TSTRING && strcmp(lua_tostring(L, -1), "auto") == 0)) {
+        run.dt = ts.dt_auto;
+    } else {
+        lua_pop(L, 1);
+        run.dt = bind_field_number(L, 2, "run", "dt", 0, BIND_POSITIVE);
+        lua_pushnil(L);
+        /* For two timescales the large step n dt is the one that must stay stable. */
+        double big = run.integrator == DEM_TWO_TIMESCALES ? run.tt_n * run.dt : run.dt;
+        if (big > ts.limit && !force)
+            return luaL_error(L,
+                              "run: dt = %g s exceeds the stability limit %g s (1/10 of the "
+                              "contact time %g s of the stiffest, lightest pair at impact "
+                              "velocity %g m/s%s); use dt = \"auto\" (%g s), a smaller dt, or "
+                              "force = true",
+                              big, ts.limit, ts.contact_time, ts.impact_velocity,
+                              ts.limit < ts.contact_time / 10 ? ", or of the damping rate" : "",
+                              ts.dt_auto);
+    }
+    lua_pop(L, 1);
+    long steps = (long)bind_field_integer(L, 2, "run", "steps", -1, 0, LUA_MAXINTEGER, 0);
+    double time = bind_field_number(L, 2, "run", "time", -1, BIND_NONNEG);
+    if ((steps >= 0) == (time >= 0))
+        return luaL_error(L, "run: give exactly one of steps and time");
+    if (time >= 0)
+        steps = (long)ceil(time / run.dt - 1e-9);
+    long every = (long)bind_field_integer(L, 2, "run", "every", 0, 1, LUA_MAXINTEGER, 0);
+    int has_cb = lua_getfield(L, 2, "on_step") != LUA_TNIL;
+    if (has_cb && lua_type(L, -1) != LUA_TFUNCTION)
+        return bind_field_error(L, 2, "run", "on_step", "function");
+    int cb = lua_gettop(L);
+    if (has_cb && every == 0)
+        every = steps > 100 ? steps / 100 : 1;
+    if (every == 0)
+        every = steps ? steps : 1;
+    int want_progress = bind_field_boolean(L, 2, "run", "progress", -1);
+    progress prog;
+    prog.active = 0;
+    if (want_progress == 1 || (want_progress == -1 && steps >= 1000 &&
+                               progress_default_style() != PROGRESS_QUIET)) {
+        progress_begin(&prog, "dem run", (double)steps, "steps");
+        if (want_progress == -1 && prog.style != PROGRESS_BAR)
+            prog.active = 0; /* unasked, lines would flood logs: only a bar on a terminal */
+    }
+    double t0 = dem_time(s);
+    long s0 = dem_steps_done(s), f0 = dem_force_evaluations(s), done = 0;
+    int stopped = 0;
+    while (done < steps && !stopped) {
+        long chunk = steps - done < every ? steps - done : every;
+        run.steps = chunk;
+        run.progress = NULL;
+        core_status st = dem_run(s, &run, &err);
+        done += chunk;
+        if (prog.active)
+            progress_update(&prog, (double)done);
+        if (st != CORE_OK) {
+            if (prog.active)
+                progress_end(&prog);
+            return bind_raise(L, "run", &err);
+        }
+        if (has_cb) {
+            lua_pushvalue(L, cb);
+            lua_pushvalue(L, 1);
+            if (lua_pcall(L, 1, 1, 0) != LUA_OK) {
+                if (prog.active)
+                    progress_end(&prog);
+                return lua_error(L);
+            }
+            stopped = lua_type(L, -1) == LUA_TBOOLEAN && !lua_toboolean(L, -1);
+            lua_pop(L, 1);
+        }
+    }
+    if (prog.active)
+        progress_end(&prog);
+    lua_createtable(L, 0, 5);
+    lua_pushinteger(L, dem_steps_done(s) - s0);
+    lua_setfield(L, -2, "steps");
+    lua_pushinteger(L, dem_force_evaluations(s) - f0);
+    lua_setfield(L, -2, "force_evaluations");
+    lua_pushnumber(L, dem_time(s) - t0);
+    lua_setfield(L, -2, "time");
+    lua_pushnumber(L, run.dt);
+    lua_setfield(L, -2, "dt");
+    lua_pushboolean(L, stopped);
+    lua_setfield(L, -2, "stopped");
+    return 1;
+}
+
+/* ---- measurements --------------------------------------------------------------------------- */
+typedef struct contact_lists {
+    lua_State *L;
+    int tables[8];
+    lua_Integer n;
+    int dim;
+} contact_lists;
+
+static void add_contact(const dem_contact_info *c, void *ctx)
+{
+    contact_lists *cl = ctx;
+    lua_State *L = cl->L;
+    cl->n++;
+    double vals[8] = {(double)(c->i + 1), 0, c->fn, c->ft, c->normal[0], c->normal[1],
+                      c->normal[2], c->overlap};
+    for (int k = 0; k < 8; k++) {
+        if (k == 6 && cl->dim == 2)
+            continue;
+        if (k == 0 || k == 1) {
+            lua_Integer v = k == 0 ? c->i + 1 : (c->j >= 0 ? c->j + 1 : c->j);
+            lua_pushinteger(L, v);
+        } else {
+            lua_pushnumber(L, vals[k]);
+        }
+        lua_rawseti(L, cl->tables[k], cl->n);
+    }
+}
+
+static int l_measure(lua_State *L)
+{
+    static const char *const what_names[] = {"energy", "stress", "coordination", "slip",
+                                             "contacts", "displacement", NULL};
+    dem_scene *s = check_scene(L, 1);
+    const int D = dem_dim(s);
+    int what = luaL_checkoption(L, 2, NULL, what_names);
+    switch (what) {
+    case 0: {
+        dem_energy e;
+        dem_measure_energy(s, &e);
+        lua_createtable(L, 0, 5);
+        const char *names[] = {"kinetic", "rotational", "elastic", "potential", "total"};
+        double vals[] = {e.kinetic, e.rotational, e.elastic, e.potential, e.total};
+        for (int k = 0; k < 5; k++) {
+            lua_pushnumber(L, vals[k]);
+            lua_setfield(L, -2, names[k]);
+        }
+        return 1;
+    }
+    case 1: {
+        double volume = 0;
+        if (!lua_isnoneornil(L, 3)) {
+            static const char *const fields[] = {"volume", NULL};
+            bind_check_table(L, 3, "measure");
+            bind_check_fields(L, 3, "measure", fields);
+            volume = bind_field_number(L, 3, "measure", "volume", 0, BIND_POSITIVE);
+        }
+        double sig[3][3];
+        long nc = dem_measure_stress(s, volume, sig);
+        static const char *const comp[3][3] = {
+            {"xx", "xy", "xz"}, {"yx", "yy", "yz"}, {"zx", "zy", "zz"}};
+        lua_createtable(L, 0, 11);
+        double tr = 0;
+        for (int a = 0; a < D; a++) {
+            tr += sig[a][a];
+            for (int b = 0; b < D; b++) {
+                lua_pushnumber(L, sig[a][b]);
+                lua_setfield(L, -2, comp[a][b]);
+            }
+        }
+        lua_pushnumber(L, tr / D);
+        lua_setfield(L, -2, "pressure");
+        lua_pushinteger(L, nc);
+        lua_setfield(L, -2, "contacts");
+        return 1;
+    }
+    case 2: {
+        double z, zr;
+        dem_measure_coordination(s, &z, &zr);
+        lua_createtable(L, 0, 2);
+        lua_pushnumber(L, z);
+        lua_setfield(L, -2, "z");
+        lua_pushnumber(L, zr);
+        lua_setfield(L, -2, "z_no_rattlers");
+        return 1;
+    }
+    case 3:
+        lua_pushnumber(L, dem_measure_slip(s));
+        return 1;
+    case 4: {
+        static const char *const names[8] = {"i", "j", "fn", "ft", "nx", "ny", "nz", "overlap"};
+        contact_lists cl = {.L = L, .n = 0, .dim = D};
+        lua_createtable(L, 0, 8);
+        int result = lua_gettop(L);
+        for (int k = 0; k < 8; k++) {
+            if (k == 6 && D == 2) {
+                cl.tables[k] = 0;
+                continue;
+            }
+            lua_newtable(L);
+            cl.tables[k] = lua_gettop(L);
+        }
+        dem_each_contact(s, add_contact, &cl);
+        for (int k = 7; k >= 0; k--) {
+            if (k == 6 && D == 2)
+                continue;
+            lua_setfield(L, result, names[k]);
+        }
+        lua_pushinteger(L, cl.n);
+        lua_setfield(L, result, "count");
+        return 1;
+    }
+    default: { /* displacement, optionally relative to an affine field */
+        double grad[3][3] = {{0}}, center[3] = {0, 0, 0};
+        int affine = 0;
+        if (!lua_isnoneornil(L, 3)) {
+            static const char *const fields[] = {"affine", "center", NULL};
+            bind_check_table(L, 3, "measure");
+            bind_check_fields(L, 3, "measure", fields);
+            if (lua_getfield(L, 3, "affine") == LUA_TTABLE) {
+                affine = 1;
+                for (int a = 0; a < D; a++) {
+                    lua_rawgeti(L, -1, a + 1);
+                    for (int b = 0; b < D; b++) {
+                        lua_rawgeti(L, -1, b + 1);
+                        int isnum;
+                        grad[a][b] = lua_tonumberx(L, -1, &isnum);
+                        lua_pop(L, 1);
+                        if (!isnum)
+                            return luaL_error(L, "measure: affine must be a %dx%d matrix of "
+                                                 "numbers (displacement gradient)", D, D);
+                    }
+                    lua_pop(L, 1);
+                }
+            }
+            lua_pop(L, 1);
+            bind_field_vector(L, 3, "measure", "center", D, center, 0);
+        }
+        size_t n = dem_count(s);
+        double *out[3] = {NULL, NULL, NULL};
+        for (int d = 0; d < D; d++) {
+            out[d] = malloc((n ? n : 1) * sizeof(double));
+            if (!out[d]) {
+                for (int k = 0; k < d; k++)
+                    free(out[k]);
+                return luaL_error(L, "measure: out of memory");
+            }
+        }
+        core_error err;
+        core_status st = dem_measure_displacement(s, affine ? (const double(*)[3])grad : NULL,
+                                                  center, out, &err);
+        if (st == CORE_OK) {
+            static const char *const names[3] = {"x", "y", "z"};
+            lua_createtable(L, 0, D);
+            for (int d = 0; d < D; d++) {
+                lua_createtable(L, (int)n, 0);
+                for (size_t i = 0; i < n; i++) {
+                    lua_pushnumber(L, out[d][i]);
+                    lua_rawseti(L, -2, (lua_Integer)i + 1);
+                }
+                lua_setfield(L, -2, names[d]);
+            }
+        }
+        for (int d = 0; d < D; d++)
+            free(out[d]);
+        if (st != CORE_OK)
+            return bind_raise(L, "measure", &err);
+        return 1;
+    }
+    }
+}
+
+static void push_array(lua_State *L, const double *a, size_t n, const char *name)
+{
+    lua_createtable(L, (int)n, 0);
+    for (size_t i = 0; i < n; i++) {
+        lua_pushnumber(L, a[i]);
+        lua_rawseti(L, -2, (lua_Integer)i + 1);
+    }
+    lua_setfield(L, -2, name);
+}
+
+static int l_particles(lua_State *L)
+{
+    dem_scene *s = check_scene(L, 1);
+    const int D = dem_dim(s);
+    size_t n = dem_count(s);
+    static const char *const xs[3] = {"x", "y", "z"}, *const vs[3] = {"vx", "vy", "vz"};
+    static const char *const ws[3] = {"wx", "wy", "wz"};
+    lua_createtable(L, 0, 10);
+    for (int d = 0; d < D; d++) {
+        push_array(L, dem_positions(s, d), n, xs[d]);
+        push_array(L, dem_velocities(s, d), n, vs[d]);
+    }
+    if (D == 2 && dem_angular_velocities(s, 2))
+        push_array(L, dem_angular_velocities(s, 2), n, "omega");
+    for (int d = 0; D == 3 && d < 3; d++)
+        if (dem_angular_velocities(s, d))
+            push_array(L, dem_angular_velocities(s, d), n, ws[d]);
+    push_array(L, dem_radii(s), n, "radius");
+    push_array(L, dem_masses(s), n, "mass");
+    lua_pushinteger(L, (lua_Integer)n);
+    lua_setfield(L, -2, "count");
+    return 1;
+}
+
+static int l_set_reference(lua_State *L)
+{
+    dem_scene *s = check_scene(L, 1);
+    core_error err;
+    if (dem_set_reference(s, &err))
+        return bind_raise(L, "set_reference", &err);
+    return 0;
+}
+
+static int l_scale_mass(lua_State *L)
+{
+    dem_scene *s = check_scene(L, 1);
+    core_error err;
+    if (dem_scale_mass(s, luaL_checknumber(L, 2), &err))
+        return bind_raise(L, "scale_mass", &err);
+    return 0;
+}
+
+static int l_info(lua_State *L)
+{
+    dem_scene *s = check_scene(L, 1);
+    lua_createtable(L, 0, 6);
+    lua_pushinteger(L, dem_dim(s));
+    lua_setfield(L, -2, "dim");
+    lua_pushinteger(L, (lua_Integer)dem_count(s));
+    lua_setfield(L, -2, "count");
+    lua_pushnumber(L, dem_time(s));
+    lua_setfield(L, -2, "time");
+    lua_pushinteger(L, dem_steps_done(s));
+    lua_setfield(L, -2, "steps");
+    lua_pushinteger(L, dem_force_evaluations(s));
+    lua_setfield(L, -2, "force_evaluations");
+    const dem_contact_def *c = dem_contact(s);
+    lua_pushstring(L, NORMAL_NAMES[c->normal]);
+    lua_setfield(L, -2, "normal");
+    lua_pushstring(L, DAMPING_NAMES[c->damping]);
+    lua_setfield(L, -2, "damping");
+    lua_pushstring(L, TANGENT_NAMES[c->tangential]);
+    lua_setfield(L, -2, "tangential");
+    lua_pushnumber(L, c->damping_time);
+    lua_setfield(L, -2, "damping_time");
+    return 1;
+}
+
+static int l_gc(lua_State *L)
+{
+    lscene *u = luaL_checkudata(L, 1, SCENE);
+    dem_destroy(u->s);
+    u->s = NULL;
+    return 0;
+}
+
+static int l_tostring(lua_State *L)
+{
+    lscene *u = luaL_checkudata(L, 1, SCENE);
+    if (!u->s)
+        lua_pushliteral(L, "dem.scene (closed)");
+    else
+        lua_pushfstring(L, "dem.scene (%dD, %d particles, t = %f s)", dem_dim(u->s),
+                        (int)dem_count(u->s), dem_time(u->s));
+    return 1;
+}
+
+void bind_open_dem(lua_State *L)
+{
+    static const bind_fn methods[] = {
+        {"contact", l_contact,
+         "s:contact{ normal = 'hertz'|'linear'|'power', stiffness =, beta =, damping = "
+         "'none'|'viscous'|'brilliantov', gamma_n =, damping_time =, restitution =, "
+         "impact_velocity =, tangential = 'none'|'viscous'|'spring'|'coulomb_regularized', "
+         "gamma_t =, kt =, v_r =, exponent =, clip = true, rolling = false }",
+         "Sets the contact law of the scene. Normal: linear f = k d (Herrmann Eq. 1a, beta = 1), "
+         "power f = k d^beta (beta 1, 1.5 or 2), hertz f = 4/3 E* sqrt(R) d^1.5 (Padbidri Eq. "
+         "1.1). Damping: viscous gamma_n d' (Eq. 1b; gamma_n per pair from the materials' "
+         "restitution unless given), brilliantov T K d^0.5 d' (Eq. 2.16; T = damping_time, or "
+         "solved from restitution at impact_velocity for the scene's mean pair). Tangential: "
+         "viscous -gamma_t s (Eq. 2a), spring (Cundall-Strack, Eq. 2b; kt defaults to 2/7 of "
+         "the normal tangent stiffness), coulomb_regularized mu f_n min(1, (s/v_r)^(1/exponent)) "
+         "(Eq. 2.18). clip = true forbids attractive normal forces. Returns the damping time."},
+        {"add_disk", l_add_disk,
+         "s:add_disk{ pos = {x, y}, radius = r, material = m, vel = {vx, vy}, omega = w, "
+         "fixed = false, prescribed = false }",
+         "Adds a disk to a 2D scene; returns its id. fixed: never moves; prescribed: moves at "
+         "vel whatever the forces. material: a grainlab.material (default quartz)."},
+        {"add_sphere", l_add_sphere,
+         "s:add_sphere{ pos = {x, y, z}, radius = r, material = m, vel = {...}, omega = {...} }",
+         "Adds a sphere to a 3D scene; returns its id."},
+        {"add_wall", l_add_wall,
+         "s:add_wall{ point = {...}, normal = {...}, velocity = {...}, friction = mu, material = m }",
+         "Adds a planar wall (normal into the domain), optionally moving and with its own "
+         "friction; returns the wall id."},
+        {"remove_wall", l_remove_wall, "s:remove_wall(id)", "Removes a wall during a run."},
+        {"wall_velocity", l_wall_velocity, "s:wall_velocity(id, {vx, vy})", "Sets a wall's velocity."},
+        {"wall_point", l_wall_point, "s:wall_point(id)", "The wall's reference point now."},
+        {"set_velocity", l_set_velocity, "s:set_velocity(id, {vx, vy})", "Sets a particle's velocity."},
+        {"timestep", l_timestep, "s:timestep{ impact_velocity = v }",
+         "The contact time of the stiffest, lightest pair at the impact velocity (default: the "
+         "fastest particle or sqrt(2 g H), at least 0.1 m/s), the stability limit (1/10 of it, "
+         "or less with stiff damping) and the automatic dt (1/5 of the limit)."},
+        {"run", l_run,
+         "s:run{ steps = N | time = T, dt = 'auto', force = false, integrator = "
+         "'velocity_verlet'|'position_verlet'|'gear'|'two_timescales', m =, n =, q =, every =, "
+         "on_step = function(s) end, progress = nil }",
+         "Advances the scene. dt above the stability limit is refused unless force = true. "
+         "two_timescales (Padbidri Sec. 2.4) takes cycles of one step n dt and q steps dt; steps "
+         "count small-step equivalents. on_step runs every `every` steps; returning false stops "
+         "the run. Ctrl-C stops between steps with the scene intact. Returns {steps, time, dt, "
+         "force_evaluations, stopped}."},
+        {"measure", l_measure, "s:measure('energy'|'stress'|'coordination'|'slip'|'contacts'|'displacement', opts)",
+         "energy: kinetic, rotational, elastic, potential, total (J). stress: assembly stress "
+         "sum(branch x force)/V (opts.volume; compression positive) with pressure. "
+         "coordination: z, z_no_rattlers. slip: mean |slip velocity| at contacts. contacts: "
+         "arrays i, j (negative j: wall), fn, ft, nx, ny, (nz), overlap. displacement: since "
+         "set_reference, minus opts.affine (displacement gradient) about opts.center."},
+        {"particles", l_particles, "s:particles()",
+         "Arrays of positions, velocities, angular velocities, radii and masses."},
+        {"set_reference", l_set_reference, "s:set_reference()",
+         "Remembers the current positions for displacement measurements."},
+        {"scale_mass", l_scale_mass, "s:scale_mass(factor)",
+         "Multiplies all masses (mass scaling, Padbidri Sec. 2.2)."},
+        {"info", l_info, "s:info()", "dim, count, time, steps, force_evaluations, the laws."},
+        {NULL, NULL, NULL, NULL}};
+    static const luaL_Reg meta[] = {
+        {"__gc", l_gc}, {"__close", l_gc}, {"__tostring", l_tostring}, {NULL, NULL}};
+    bind_new_type(L, SCENE, methods, meta, "A DEM scene from dem.scene{...}.");
+    static const bind_fn fns[] = {
+        {"scene", l_scene,
+         "dem.scene{ dim = 2, box = {{x0, y0}, {x1, y1}}, gravity = {0, -9.81}, periodic = "
+         "{false, false}, thickness = 0, skin = 0 }",
+         "A new DEM scene. 2D particles are spheres moving in the plane unless thickness > 0 "
+         "makes them cylinders (m = rho pi r^2 t, I = m r^2/2). skin: Verlet-list skin (0: 0.2 "
+         "of the largest radius)."},
+        {NULL, NULL, NULL, NULL}};
+    lua_newtable(L);
+    bind_register(L, -1, fns);
+    bind_doc(L, -1, "dem", "dem",
+             "Discrete elements: soft disks and spheres with contact laws, walls, integrators.");
+    lua_setglobal(L, "dem");
+}
