@@ -4,10 +4,11 @@ local grainlab = grainlab
 grainlab.report = require("grainlab.report").report
 grainlab.check = require("grainlab.check")
 grainlab.material = require("grainlab.material")
+grainlab.pack = require("grainlab.pack")
 help = require("grainlab.help")
 
 grainlab.doc(grainlab, { name = "grainlab",
-  doc = [[Core: report, check, material, rng, progress, clock, elapsed, threads, write_file, doc, version.]] })
+  doc = [[Core: report, check, material, pack, rng, progress, clock, elapsed, threads, write_file, doc, version.]] })
 grainlab.doc(params, { name = "params",
   doc = [[Command-line pairs: `grainlab FILE.lua n=100 name=run1` gives params.n == 100 and
 params.name == "run1" (numbers converted, true/false as booleans, other text kept as strings).]] })

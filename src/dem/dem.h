@@ -115,7 +115,7 @@ core_status dem_set_velocity(dem_scene *s, size_t i, const double v[3], core_err
 typedef struct dem_wall_def {
     double point[3], normal[3]; /* normal points into the domain */
     double velocity[3];         /* the wall translates at this velocity */
-    double friction;            /* < 0: the particle's material friction */
+    double friction;            /* < 0: the smaller of the particle's and the wall material's */
     int material;               /* < 0: the particle's material */
 } dem_wall_def;
 
@@ -165,6 +165,15 @@ long dem_steps_done(const dem_scene *s);
 long dem_force_evaluations(const dem_scene *s);
 /* Mass scaling: multiplies every mass and moment of inertia (Padbidri Sec. 2.2). */
 core_status dem_scale_mass(dem_scene *s, double factor, core_error *err);
+
+/* Multiplies every material's Young's modulus and the linear/power stiffness (a stiffness ramp
+ * for preparing samples). */
+core_status dem_scale_stiffness(dem_scene *s, double factor, core_error *err);
+/* Background drag: every free particle feels -rate m v and -rate I omega (rate in 1/s; 0 = off,
+ * the default). For settling samples only: it is not a contact law. */
+core_status dem_set_drag(dem_scene *s, double rate, core_error *err);
+double dem_drag(const dem_scene *s);
+void dem_box(const dem_scene *s, double lo[3], double hi[3], double gravity[3]);
 
 /* ---- measurements -------------------------------------------------------------------------- */
 typedef struct dem_energy {

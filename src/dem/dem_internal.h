@@ -41,6 +41,7 @@ struct dem_scene {
     bool periodic[3];
     double gravity[3];
     double thickness;
+    double drag;           /* background drag rate, 1/s */
     double skin_def;       /* as given (0 = automatic) */
     double skin;           /* in use */
 
@@ -100,6 +101,9 @@ double dem_normal_force(const dem_contact_def *c, double k, double gamma, double
 double dem_elastic_energy(const dem_contact_def *c, double k, double delta);
 
 /* scene.c */
+/* The scene changed outside a step: forces, integrator state and (if `list`) the pair list
+ * must be recomputed before the next step. */
+void dem_invalidate(dem_scene *s, int list);
 core_status dem_ensure_rotation(dem_scene *s, core_error *err);
 core_status dem_alloc_array(double **a, size_t n, core_error *err);
 

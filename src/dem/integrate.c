@@ -100,7 +100,7 @@ static size_t check_finite(const dem_scene *s)
     size_t bad = (size_t)-1;
     const long n = (long)s->n;
     const int D = s->dim;
-#pragma omp parallel for schedule(static) reduction(min : bad)
+#pragma omp parallel for schedule(static) reduction(min : bad) if (n > 4096)
     for (long i = 0; i < n; i++)
         for (int d = 0; d < D; d++)
             if (!isfinite(s->x[d][i]) || !isfinite(s->v[d][i]))
@@ -114,7 +114,7 @@ static void half_kick(dem_scene *s, double h)
 {
     const int D = s->dim, rot = s->rot;
     const long n = (long)s->n;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n > 4096)
     for (long i = 0; i < n; i++) {
         const double im = s->inv_m[i];
         for (int d = 0; d < D; d++)
@@ -131,7 +131,7 @@ static void drift(dem_scene *s, double dt)
 {
     const int D = s->dim;
     const long n = (long)s->n;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n > 4096)
     for (long i = 0; i < n; i++)
         for (int d = 0; d < D; d++)
             s->x[d][i] += dt * s->v[d][i];
@@ -172,7 +172,7 @@ static core_status step_position_verlet(dem_scene *s, double dt, core_error *err
     if ((st = forces(s, dt, err)))
         return st;
     const int rot = s->rot;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n > 4096)
     for (long i = 0; i < n; i++) {
         const double im = s->inv_m[i];
         for (int d = 0; d < D; d++) {
@@ -200,7 +200,7 @@ static const double GEAR_C[6] = {3.0 / 16, 251.0 / 360, 1, 11.0 / 18, 1.0 / 6, 1
 
 static void gear_predict(double *g[6], long n)
 {
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n > 4096)
     for (long i = 0; i < n; i++) {
         g[0][i] += g[1][i] + g[2][i] + g[3][i] + g[4][i] + g[5][i];
         g[1][i] += 2 * g[2][i] + 3 * g[3][i] + 4 * g[4][i] + 5 * g[5][i];
@@ -262,7 +262,7 @@ static core_status step_gear(dem_scene *s, double dt, core_error *err)
     }
     /* The forces see the predicted positions and velocities. Fixed and prescribed particles just
      * move at their velocity. */
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n > 4096)
     for (long i = 0; i < n; i++) {
         const int free_ = s->inv_m[i] > 0;
         for (int d = 0; d < D; d++) {
@@ -284,7 +284,7 @@ static core_status step_gear(dem_scene *s, double dt, core_error *err)
     s->time += dt;
     if ((st = forces(s, dt, err)))
         return st;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n > 4096)
     for (long i = 0; i < n; i++) {
         if (!(s->inv_m[i] > 0))
             continue;

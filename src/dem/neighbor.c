@@ -67,8 +67,9 @@ void dem_wall_parameters(const dem_scene *s, const dem_wall *w, size_t i, double
     const dem_material *a = &s->mats[s->mat[i]];
     const dem_material *b = w->material >= 0 ? &s->mats[w->material] : a;
     double m_eff = s->inv_m[i] > 0 ? 1 / s->inv_m[i] : s->m[i];
-    law_parameters(s, a, b, s->r[i], m_eff, w->friction >= 0 ? w->friction : a->friction, k,
-                   gamma, mu);
+    /* The wall's own friction if given; else the pair rule with the wall's material. */
+    double mu_w = w->friction >= 0 ? w->friction : fmin(a->friction, b->friction);
+    law_parameters(s, a, b, s->r[i], m_eff, mu_w, k, gamma, mu);
 }
 
 static core_status alloc_u32(uint32_t **a, size_t n, core_error *err)
@@ -306,7 +307,7 @@ core_status dem_build_pairs(dem_scene *s, core_error *err)
     if (!start)
         return core_fail(err, CORE_ERR_NOMEM, "cannot allocate the pair list");
     start[0] = 0;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n > 4096)
     for (size_t i = 0; i < n; i++)
         start[i + 1] = scan(s, i, NULL);
     for (size_t i = 0; i < n; i++)
@@ -325,9 +326,11 @@ core_status dem_build_pairs(dem_scene *s, core_error *err)
     p->n = npairs;
     p->np = n;
     p->start = start;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n > 4096)
     for (size_t i = 0; i < n; i++) {
         size_t b = start[i], e = start[i + 1];
+        if (e == b)
+            continue; /* no neighbours (and p->j may be unallocated when there are no pairs) */
         scan(s, i, p->j + b);
         qsort(p->j + b, e - b, sizeof(uint32_t), cmp_u32);
         for (size_t q = b; q < e; q++) {
@@ -337,7 +340,7 @@ core_status dem_build_pairs(dem_scene *s, core_error *err)
     }
     if (p->hist[0]) {
         size_t old_np = carry ? (old.np < n ? old.np : n) : 0;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n > 4096)
         for (size_t i = 0; i < n; i++) {
             size_t q = start[i], e = start[i + 1];
             size_t o = i < old_np ? old.start[i] : 0, oe = i < old_np ? old.start[i + 1] : 0;

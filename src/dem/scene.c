@@ -28,6 +28,15 @@ dem_contact_def dem_default_contact_def(void)
                              .v_r = 1e-3, .exponent = 10, .clip = true, .rolling = false};
 }
 
+void dem_invalidate(dem_scene *s, int list)
+{
+    s->forces_ready = 0;
+    s->gear_ready = 0;
+    s->prev_ready = 0;
+    if (list)
+        s->need_rebuild = 1;
+}
+
 core_status dem_alloc_array(double **a, size_t n, core_error *err)
 {
     double *p = realloc(*a, (n ? n : 1) * sizeof *p);
@@ -117,7 +126,7 @@ int dem_add_material(dem_scene *s, const dem_material *m, core_error *err)
         s->cap_mat = cap;
     }
     s->mats[s->nmat] = *m;
-    s->need_rebuild = 1; /* pair parameters depend on materials */
+    dem_invalidate(s, 1); /* pair parameters depend on materials */
     return s->nmat++;
 }
 
@@ -167,8 +176,7 @@ core_status dem_set_contact(dem_scene *s, const dem_contact_def *c, core_error *
             }
         }
     }
-    s->need_rebuild = 1;
-    s->gear_ready = s->prev_ready = 0;
+    dem_invalidate(s, 1);
     return CORE_OK;
 }
 
@@ -255,7 +263,7 @@ core_status dem_ensure_rotation(dem_scene *s, core_error *err)
         memset(s->tq[d], 0, cap * sizeof(double));
     }
     s->rot = 1;
-    s->gear_ready = 0;
+    dem_invalidate(s, 1);
     return CORE_OK;
 }
 
@@ -286,7 +294,7 @@ long dem_add_particle(dem_scene *s, const dem_particle_def *p, core_error *err)
         double dist = 0;
         for (int d = 0; d < D; d++)
             dist += (p->x[d] - wl->point[d]) * wl->normal[d];
-        if (dist < p->radius)
+        if (dist < p->radius * (1 - 1e-9)) /* touching is fine, up to rounding */
             return core_fail(err, CORE_ERR_ARG,
                              "particle at distance %g from wall %d overlaps it (radius %g)", dist,
                              w + 1, p->radius), -1;
@@ -332,8 +340,7 @@ long dem_add_particle(dem_scene *s, const dem_particle_def *p, core_error *err)
     if (r > s->r_max)
         s->r_max = r;
     s->n++;
-    s->need_rebuild = 1;
-    s->gear_ready = s->prev_ready = 0;
+    dem_invalidate(s, 1);
     return (long)i;
 }
 
@@ -358,7 +365,7 @@ core_status dem_set_velocity(dem_scene *s, size_t i, const double v[3], core_err
         return core_fail(err, CORE_ERR_STATE, "particle %zu is fixed", i + 1);
     for (int d = 0; d < s->dim; d++)
         s->v[d][i] = v[d];
-    s->gear_ready = s->prev_ready = 0;
+    dem_invalidate(s, 0);
     return CORE_OK;
 }
 
@@ -373,7 +380,7 @@ core_status dem_scale_mass(dem_scene *s, double factor, core_error *err)
     }
     for (int k = 0; k < s->nmat; k++)
         s->mats[k].density *= factor;
-    s->need_rebuild = 1; /* damping coefficients depend on masses */
+    dem_invalidate(s, 1); /* damping coefficients depend on masses */
     return CORE_OK;
 }
 
@@ -403,7 +410,7 @@ int dem_add_wall(dem_scene *s, const dem_wall_def *w, core_error *err)
         double dist = 0;
         for (int d = 0; d < D; d++)
             dist += (s->x[d][i] - wl.point[d]) * wl.normal[d];
-        if (dist < s->r[i])
+        if (dist < s->r[i] * (1 - 1e-9))
             return core_fail(err, CORE_ERR_ARG,
                              "wall would overlap particle %zu (distance %g, radius %g)", i + 1,
                              dist, s->r[i]), -1;
@@ -430,7 +437,7 @@ int dem_add_wall(dem_scene *s, const dem_wall_def *w, core_error *err)
         s->cap_walls = cap;
     }
     s->walls[s->nwalls] = wl;
-    s->gear_ready = s->prev_ready = 0;
+    dem_invalidate(s, 0);
     return s->nwalls++;
 }
 
@@ -450,6 +457,7 @@ core_status dem_remove_wall(dem_scene *s, int id, core_error *err)
             free(s->walls[id].hist[d]);
             s->walls[id].hist[d] = NULL;
         }
+        dem_invalidate(s, 0);
     }
     return st;
 }
@@ -464,6 +472,7 @@ core_status dem_set_wall_velocity(dem_scene *s, int id, const double v[3], core_
             return core_fail(err, CORE_ERR_ARG, "wall velocity must be finite");
         s->walls[id].velocity[d] = v[d];
     }
+    dem_invalidate(s, 0); /* damping and friction see the wall's velocity */
     return CORE_OK;
 }
 
@@ -473,4 +482,37 @@ core_status dem_wall_point(const dem_scene *s, int id, double p[3], core_error *
     for (int d = 0; st == CORE_OK && d < 3; d++)
         p[d] = s->walls[id].point[d];
     return st;
+}
+
+core_status dem_scale_stiffness(dem_scene *s, double factor, core_error *err)
+{
+    if (!(factor > 0) || !isfinite(factor))
+        return core_fail(err, CORE_ERR_ARG, "stiffness scale factor must be > 0, got %g", factor);
+    for (int k = 0; k < s->nmat; k++)
+        s->mats[k].young *= factor;
+    s->contact.stiffness *= factor;
+    if (s->contact.kt > 0)
+        s->contact.kt *= factor;
+    dem_invalidate(s, 1); /* pair stiffness and damping are cached in the list */
+    return CORE_OK;
+}
+
+core_status dem_set_drag(dem_scene *s, double rate, core_error *err)
+{
+    if (!(rate >= 0) || !isfinite(rate))
+        return core_fail(err, CORE_ERR_ARG, "drag rate must be >= 0, got %g", rate);
+    s->drag = rate;
+    dem_invalidate(s, 0);
+    return CORE_OK;
+}
+
+double dem_drag(const dem_scene *s) { return s->drag; }
+
+void dem_box(const dem_scene *s, double lo[3], double hi[3], double gravity[3])
+{
+    for (int d = 0; d < 3; d++) {
+        lo[d] = s->lo[d];
+        hi[d] = s->hi[d];
+        gravity[d] = s->gravity[d];
+    }
 }

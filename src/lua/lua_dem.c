@@ -415,15 +415,17 @@ static int l_run(lua_State *L)
         lua_pushnil(L);
         /* For two timescales the large step n dt is the one that must stay stable. */
         double big = run.integrator == DEM_TWO_TIMESCALES ? run.tt_n * run.dt : run.dt;
-        if (big > ts.limit && !force)
-            return luaL_error(L,
-                              "run: dt = %g s exceeds the stability limit %g s (1/10 of the "
-                              "contact time %g s of the stiffest, lightest pair at impact "
-                              "velocity %g m/s%s); use dt = \"auto\" (%g s), a smaller dt, or "
-                              "force = true",
-                              big, ts.limit, ts.contact_time, ts.impact_velocity,
-                              ts.limit < ts.contact_time / 10 ? ", or of the damping rate" : "",
-                              ts.dt_auto);
+        if (big > ts.limit && !force) {
+            char msg[512]; /* lua_pushfstring knows no %g */
+            snprintf(msg, sizeof msg,
+                     "run: dt = %g s exceeds the stability limit %g s (1/10 of the contact time "
+                     "%g s of the stiffest, lightest pair at impact velocity %g m/s%s); use dt = "
+                     "\"auto\" (%g s), a smaller dt, or force = true",
+                     big, ts.limit, ts.contact_time, ts.impact_velocity,
+                     ts.limit < ts.contact_time / 10 ? ", or of the damping rate" : "",
+                     ts.dt_auto);
+            return luaL_error(L, "%s", msg);
+        }
     }
     lua_pop(L, 1);
     long steps = (long)bind_field_integer(L, 2, "run", "steps", -1, 0, LUA_MAXINTEGER, 0);
@@ -717,10 +719,41 @@ static int l_scale_mass(lua_State *L)
     return 0;
 }
 
+static int l_scale_stiffness(lua_State *L)
+{
+    dem_scene *s = check_scene(L, 1);
+    core_error err;
+    if (dem_scale_stiffness(s, luaL_checknumber(L, 2), &err))
+        return bind_raise(L, "scale_stiffness", &err);
+    return 0;
+}
+
+static int l_drag(lua_State *L)
+{
+    dem_scene *s = check_scene(L, 1);
+    if (!lua_isnoneornil(L, 2)) {
+        core_error err;
+        if (dem_set_drag(s, luaL_checknumber(L, 2), &err))
+            return bind_raise(L, "drag", &err);
+    }
+    lua_pushnumber(L, dem_drag(s));
+    return 1;
+}
+
 static int l_info(lua_State *L)
 {
     dem_scene *s = check_scene(L, 1);
     lua_createtable(L, 0, 6);
+    double lo[3], hi[3], g[3];
+    dem_box(s, lo, hi, g);
+    lua_createtable(L, 2, 0);
+    push_vector(L, lo, dem_dim(s));
+    lua_rawseti(L, -2, 1);
+    push_vector(L, hi, dem_dim(s));
+    lua_rawseti(L, -2, 2);
+    lua_setfield(L, -2, "box");
+    push_vector(L, g, dem_dim(s));
+    lua_setfield(L, -2, "gravity");
     lua_pushinteger(L, dem_dim(s));
     lua_setfield(L, -2, "dim");
     lua_pushinteger(L, (lua_Integer)dem_count(s));
@@ -819,7 +852,14 @@ void bind_open_dem(lua_State *L)
          "Remembers the current positions for displacement measurements."},
         {"scale_mass", l_scale_mass, "s:scale_mass(factor)",
          "Multiplies all masses (mass scaling, Padbidri Sec. 2.2)."},
-        {"info", l_info, "s:info()", "dim, count, time, steps, force_evaluations, the laws."},
+        {"scale_stiffness", l_scale_stiffness, "s:scale_stiffness(factor)",
+         "Multiplies every Young's modulus and linear stiffness (a stiffness ramp for sample "
+         "preparation)."},
+        {"drag", l_drag, "s:drag([rate])",
+         "Background drag -rate m v (and -rate I omega) on every particle, for settling samples; "
+         "0 switches it off. Returns the rate."},
+        {"info", l_info, "s:info()",
+         "dim, box, gravity, count, time, steps, force_evaluations, the laws."},
         {NULL, NULL, NULL, NULL}};
     static const luaL_Reg meta[] = {
         {"__gc", l_gc}, {"__close", l_gc}, {"__tostring", l_tostring}, {NULL, NULL}};
