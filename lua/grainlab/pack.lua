@@ -297,10 +297,65 @@ function pack.deposit(s, opts)
   return ids, { placed = #ids }
 end
 
+-- Settles a scene into a quiescent state cheaply: contacts softened by `soften` (time steps grow
+-- like soften^(-2/5) for Hertz), a background drag, at least min_steps until the rms speed is below
+-- `quiet`; then the stiffness is restored gently (ramp_stages factors, each followed by ramp_steps
+-- steps with the drag on: a sudden stiffening releases the stored elastic energy at once and
+-- blows the pile apart); then drag off and `final_steps` steps at dt_final.
+function pack.settle(s, opts)
+  local call = "pack.settle"
+  opts = opts or {}
+  check_opts(call, opts, { soften = true, drag = true, quiet = true, min_steps = true,
+                           max_steps = true, ramp_stages = true, ramp_steps = true,
+                           final_steps = true, dt_final = true, verbose = true })
+  local soften = opts.soften or 1e-3
+  if type(soften) ~= "number" or not (soften > 0 and soften <= 1) then fail(call, "soften", "number in (0, 1]", soften) end
+  local quiet = opts.quiet or 1e-3
+  local drag = opts.drag or 20
+  local stages = positive_int(call, opts, "ramp_stages", 30)
+  local ramp_steps = positive_int(call, opts, "ramp_steps", 1000)
+  local min_steps = positive_int(call, opts, "min_steps", 20000)
+  local max_steps = positive_int(call, opts, "max_steps", 200000)
+  local final_steps = opts.final_steps or 2000
+  local function rms()
+    local P, s2 = s:particles(), 0
+    for i = 1, P.count do
+      s2 = s2 + P.vx[i] ^ 2 + P.vy[i] ^ 2 + (P.vz and P.vz[i] ^ 2 or 0)
+    end
+    return math.sqrt(s2 / math.max(1, P.count))
+  end
+  local old_drag = s:drag()
+  local steps = 0
+  s:scale_stiffness(soften)
+  s:drag(drag)
+  local v = math.huge
+  while (steps < min_steps or v > quiet) and steps < max_steps do
+    local r = s:run{ steps = 2000, impact_velocity = 0.1, progress = false }
+    steps = steps + r.steps
+    v = rms()
+    if opts.verbose then io.stderr:write(string.format("settle: %d soft steps, v_rms %.3g m/s\n", steps, v)) end
+  end
+  local factor = (1 / soften) ^ (1 / stages)
+  for k = 1, stages do
+    s:scale_stiffness(k < stages and factor or (1 / soften) / factor ^ (stages - 1))
+    steps = steps + s:run{ steps = ramp_steps, impact_velocity = 0.1, progress = false }.steps
+  end
+  s:drag(old_drag)
+  if final_steps > 0 then
+    steps = steps + s:run{ steps = final_steps, dt = opts.dt_final, progress = false }.steps
+  end
+  local z = s:measure("coordination")
+  return { steps = steps, v_rms = rms(), z = z.z, z_no_rattlers = z.z_no_rattlers }
+end
+
 grainlab.doc(pack, { name = "grainlab.pack", doc = [[Packing generators (reproducible from seed):
   pack.random(s, { n =, radius = r | {min, max}, region = {{lo},{hi}}, seed =, material =, speed = })
     random sequential addition without overlaps; returns ids, {placed, tries, fraction}
   pack.deposit(s, { n =, radius = {0.5e-3, 1e-3}, region =, seed =, material =, relax_steps = 3000, drag = 200 })
     gravity deposition: 2D drop-and-roll (Jodrey-Tory style) onto the floor of the region, then a
-    damped relaxation at the scene's stiffness; 3D: random addition and dynamic settling.]] })
+    damped relaxation at the scene's stiffness; 3D: random addition and dynamic settling.
+  pack.settle(s, { soften = 1e-3, drag = 20, quiet = 1e-3, min_steps = 20000, max_steps = 200000,
+                   ramp_stages = 30, ramp_steps = 1000, final_steps = 2000, dt_final = nil })
+    settles a scene with softened contacts and drag, then restores the stiffness gently;
+    returns {steps, v_rms, z, z_no_rattlers}.]] })
 return pack

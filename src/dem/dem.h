@@ -20,7 +20,8 @@ typedef struct dem_scene dem_scene;
 /* ---- scene ------------------------------------------------------------------------------- */
 typedef struct dem_scene_def {
     int dim;              /* 2 (disks) or 3 (spheres) */
-    double lo[3], hi[3];  /* the domain; particles may leave it only through periodic axes */
+    double lo[3], hi[3];  /* the domain: a particle leaving it on an axis that is not periodic
+                           * stops the run with an error */
     bool periodic[3];
     double gravity[3];    /* m/s^2 */
     /* 2D only: > 0 makes disks cylinders of this thickness (m = rho pi r^2 t, I = m r^2 / 2);

@@ -61,7 +61,7 @@ struct dem_scene {
     double *gear[6][3];    /* Gear: scaled derivatives of positions */
     double *gear_w[6][3];  /* Gear: scaled derivatives of rotation angles */
     int gear_ready, prev_ready, forces_ready;
-    double gear_dt;
+    double gear_dt, prev_dt;
 
     dem_material *mats;
     int nmat, cap_mat;

@@ -2,6 +2,7 @@
  * predictor-corrector (Herrmann Sec. 2) and Padbidri's two-timescales schedule (Sec. 2.4); the
  * run loop with Ctrl-C and instability checks; the contact-time step rule (Padbidri Sec. 2.3). */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -19,7 +20,7 @@ static core_status prepare(dem_scene *s, const dem_run_def *run, core_error *err
 {
     const int D = s->dim;
     if (s->nmat == 0 || s->n == 0)
-        return core_fail(err, CORE_ERR_STATE, "the scene has no particles");
+        return core_fail(err, CORE_ERR_STATE, "the scene has no particles: add some first");
     if (s->contact.tangential == DEM_TANGENT_SPRING) {
         for (int w = 0; w < s->nwalls; w++) {
             if (!s->walls[w].active || s->walls[w].hist[0])
@@ -49,13 +50,33 @@ static core_status prepare(dem_scene *s, const dem_run_def *run, core_error *err
     return CORE_OK;
 }
 
+/* The step being taken when a check fails is s->steps + 1 (steps counts completed ones). */
 static core_status unstable(dem_scene *s, size_t i, const char *what, core_error *err)
 {
+    dem_invalidate(s, 1); /* a later run must not reuse this step's forces */
     return core_fail(err, CORE_ERR_UNSTABLE,
                      "particle %zu %s at step %ld (t = %.6g s); likely cause: the time step is "
                      "too large for the contact stiffness or the impact speed (use dt = \"auto\" "
                      "or a smaller dt)",
                      i + 1, what, s->steps + 1, s->time);
+}
+
+/* A particle outside the domain on an axis that is not periodic (index, or (size_t)-1). */
+static size_t check_domain(const dem_scene *s)
+{
+    size_t bad = (size_t)-1;
+    const long n = (long)s->n;
+    const int D = s->dim;
+    for (int d = 0; d < D; d++) {
+        if (s->periodic[d])
+            continue;
+        const double lo = s->lo[d], hi = s->hi[d];
+#pragma omp parallel for schedule(static) reduction(min : bad) if (n > 4096)
+        for (long i = 0; i < n; i++)
+            if ((s->x[d][i] < lo || s->x[d][i] > hi) && (size_t)i < bad)
+                bad = (size_t)i;
+    }
+    return bad;
 }
 
 /* Forces at the current state; list rebuilt first when needed. */
@@ -78,8 +99,14 @@ static core_status forces(dem_scene *s, double dt, core_error *err)
     }
     if (s->need_rebuild) {
         core_status st = dem_build_pairs(s, err);
-        if (st)
+        if (st) {
+            if (err) { /* say when it happened */
+                char msg[sizeof err->msg];
+                snprintf(msg, sizeof msg, "%s", err->msg);
+                core_fail(err, st, "%s (at step %ld, t = %.6g s)", msg, s->steps + 1, s->time);
+            }
             return st;
+        }
     }
     size_t t = dem_compute_forces(s, dt);
     if (t != (size_t)-1)
@@ -168,6 +195,13 @@ static core_status step_position_verlet(dem_scene *s, double dt, core_error *err
                 s->x_prev[d][i] = s->x[d][i] - dt * s->v[d][i] +
                                   0.5 * dt * dt * s->f[d][i] * s->inv_m[i];
         s->prev_ready = 1;
+        s->prev_dt = dt;
+    }
+    if (dt != s->prev_dt) { /* x_prev encodes the velocity with the old step: rescale it */
+        for (long i = 0; i < n; i++)
+            for (int d = 0; d < D; d++)
+                s->x_prev[d][i] = s->x[d][i] - (s->x[d][i] - s->x_prev[d][i]) * dt / s->prev_dt;
+        s->prev_dt = dt;
     }
     if ((st = forces(s, dt, err)))
         return st;
@@ -353,15 +387,18 @@ core_status dem_run(dem_scene *s, const dem_run_def *run, core_error *err)
         default:
             st = step_velocity_verlet(s, h, err);
         }
-        if (st)
+        if (st) {
+            dem_invalidate(s, 1);
             return st;
+        }
+        size_t bad = check_finite(s);
+        if (bad != (size_t)-1)
+            return unstable(s, bad, "has a non-finite position or velocity", err);
+        if ((bad = check_domain(s)) != (size_t)-1)
+            return unstable(s, bad, "left the domain (a box side without a wall and not periodic)",
+                            err);
         s->steps++;
         done += advance;
-        if ((s->steps & 15) == 0 || done >= run->steps) {
-            size_t bad = check_finite(s);
-            if (bad != (size_t)-1)
-                return unstable(s, bad, "has a non-finite position or velocity", err);
-        }
         if (run->progress)
             progress_update(run->progress, (double)done);
     }
@@ -381,8 +418,7 @@ core_status dem_timestep_info(const dem_scene *s, double v_imp, dem_timestep *ou
 {
     const int D = s->dim;
     if (s->n == 0 || s->nmat == 0)
-        return core_fail(err, CORE_ERR_STATE, "the scene has no particles: add some before "
-                         "asking for the time step");
+        return core_fail(err, CORE_ERR_STATE, "the scene has no particles: add some first");
     if (!(v_imp > 0)) {
         double vmax2 = 0, h = 0, g = 0;
         for (size_t i = 0; i < s->n; i++) {

@@ -338,6 +338,15 @@ core_status dem_build_pairs(dem_scene *s, core_error *err)
             dem_pair_parameters(s, i, p->j[q], &p->k[q], &p->gamma[q], &p->mu[q]);
         }
     }
+    for (size_t q = 0; q < npairs; q++) /* the contact normal of two coincident centres is undefined */
+        if (dist2(s, p->i[q], p->j[q]) == 0) {
+            core_status bad = core_fail(err, CORE_ERR_ARG, "particles %u and %u are at the same "
+                                        "position: the contact normal is undefined",
+                                        p->i[q] + 1, p->j[q] + 1);
+            dem_free_pairs(&old);
+            s->need_rebuild = 1;
+            return bad;
+        }
     if (p->hist[0]) {
         size_t old_np = carry ? (old.np < n ? old.np : n) : 0;
 #pragma omp parallel for schedule(static) if (n > 4096)

@@ -296,8 +296,9 @@ long dem_add_particle(dem_scene *s, const dem_particle_def *p, core_error *err)
             dist += (p->x[d] - wl->point[d]) * wl->normal[d];
         if (dist < p->radius * (1 - 1e-9)) /* touching is fine, up to rounding */
             return core_fail(err, CORE_ERR_ARG,
-                             "particle at distance %g from wall %d overlaps it (radius %g)", dist,
-                             w + 1, p->radius), -1;
+                             "particle at pos (%g, %g%s) overlaps wall %d: its centre is %g from "
+                             "the wall, less than its radius %g",
+                             p->x[0], p->x[1], D == 3 ? ", ..." : "", w + 1, dist, p->radius), -1;
     }
     core_status st = grow(s, s->n + 1, err);
     if (st != CORE_OK)

@@ -185,9 +185,12 @@ int bind_field_vector(lua_State *L, int arg, const char *call, const char *field
         double v = lua_tonumberx(L, -1, &isnum);
         lua_pop(L, 1);
         if (!isnum || !isfinite(v)) {
-            snprintf(expected, sizeof expected, "array of %d finite numbers (entry %d is not)", n,
-                     k + 1);
-            bind_field_error(L, arg, call, field, expected);
+            char got[64];
+            lua_rawgeti(L, -1, k + 1);
+            bind_describe(L, -1, got, sizeof got);
+            return luaL_error(L, "bad field '%s' in argument #%d to '%s' (array of %d finite "
+                              "numbers expected, got %s at entry %d)",
+                              field, user_arg(L, arg), call, n, got, k + 1);
         }
         out[k] = v;
     }

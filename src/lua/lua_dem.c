@@ -174,14 +174,31 @@ static int l_contact(lua_State *L)
                                BIND_POSITIVE);
     c.damping = (dem_damping_law)bind_field_option(L, 2, "contact", "damping", DAMPING_NAMES,
                                                    DEM_DAMPING_NONE, 0);
+    /* Absent optional values are -1 ("not given"); given ones must be in range. */
     c.gamma_n = bind_field_number(L, 2, "contact", "gamma_n", -1, 0);
+    if (c.gamma_n < 0 && lua_getfield(L, 2, "gamma_n") != LUA_TNIL)
+        return bind_field_error(L, 2, "contact", "gamma_n", "non-negative number");
     c.damping_time = bind_field_number(L, 2, "contact", "damping_time", -1, 0);
+    if (c.damping_time < 0 && lua_getfield(L, 2, "damping_time") != LUA_TNIL)
+        return bind_field_error(L, 2, "contact", "damping_time", "non-negative number");
     double e = bind_field_number(L, 2, "contact", "restitution", -1, 0);
+    if (e >= 0 || lua_getfield(L, 2, "restitution") != LUA_TNIL) {
+        lua_getfield(L, 2, "restitution");
+        if (c.damping != DEM_DAMPING_BRILLIANTOV)
+            return bind_field_error(L, 2, "contact", "restitution",
+                                    "nothing unless damping = 'brilliantov' (viscous damping takes "
+                                    "the materials' restitution)");
+        if (!(e > 0 && e <= 1))
+            return bind_field_error(L, 2, "contact", "restitution", "number in (0, 1]");
+        lua_pop(L, 1);
+    }
     double v_imp = bind_field_number(L, 2, "contact", "impact_velocity", 1, BIND_POSITIVE);
     c.tangential = (dem_tangential_law)bind_field_option(L, 2, "contact", "tangential",
                                                          TANGENT_NAMES, DEM_TANGENT_NONE, 0);
     c.gamma_t = bind_field_number(L, 2, "contact", "gamma_t", 0, BIND_NONNEG);
     c.kt = bind_field_number(L, 2, "contact", "kt", -1, 0);
+    if (c.kt <= 0 && lua_getfield(L, 2, "kt") != LUA_TNIL)
+        return bind_field_error(L, 2, "contact", "kt", "positive number");
     c.v_r = bind_field_number(L, 2, "contact", "v_r", c.v_r, BIND_POSITIVE);
     c.exponent = bind_field_number(L, 2, "contact", "exponent", c.exponent, BIND_POSITIVE);
     c.clip = bind_field_boolean(L, 2, "contact", "clip", 1);
@@ -191,10 +208,6 @@ static int l_contact(lua_State *L)
             return luaL_error(L, "contact: brilliantov damping needs damping_time (s) or "
                                  "restitution (with impact_velocity, default 1 m/s)");
         if (e >= 0) {
-            if (!(e > 0 && e <= 1)) {
-                lua_getfield(L, 2, "restitution");
-                return bind_field_error(L, 2, "contact", "restitution", "number in (0, 1]");
-            }
             core_error err;
             double T;
             if (dem_damping_time_for(s, e, v_imp, &T, &err) != CORE_OK)
@@ -248,19 +261,19 @@ static int add_particle(lua_State *L, const char *call, int want_dim)
 static int l_add_disk(lua_State *L) { return add_particle(L, "add_disk", 2); }
 static int l_add_sphere(lua_State *L) { return add_particle(L, "add_sphere", 3); }
 
-static size_t particle_arg(lua_State *L, dem_scene *s, int arg)
+static size_t particle_arg(lua_State *L, dem_scene *s, int arg, const char *call)
 {
     lua_Integer i = luaL_checkinteger(L, arg);
     if (i < 1 || (size_t)i > dem_count(s))
-        luaL_error(L, "bad argument #%d (particle id in [1, %d] expected, got %d)", arg - 1,
-                   (int)dem_count(s), (int)i);
+        luaL_error(L, "bad argument #%d to '%s' (particle id in [1, %d] expected, got %d)",
+                   arg - 1, call, (int)dem_count(s), (int)i);
     return (size_t)(i - 1);
 }
 
 static int l_set_velocity(lua_State *L)
 {
     dem_scene *s = check_scene(L, 1);
-    size_t i = particle_arg(L, s, 2);
+    size_t i = particle_arg(L, s, 2, "set_velocity");
     double v[3] = {0, 0, 0};
     luaL_checktype(L, 3, LUA_TTABLE);
     for (int d = 0; d < dem_dim(s); d++) {
@@ -408,7 +421,8 @@ static int l_run(lua_State *L)
         return bind_raise(L, "run", &err);
     lua_getfield(L, 2, "dt");
     if (lua_isnil(L, -1) || (lua_type(L, -1) == LUA_TSTRING && strcmp(lua_tostring(L, -1), "auto") == 0)) {
-        run.dt = ts.dt_auto;
+        /* Two timescales: the large step n dt is the one that must be the automatic step. */
+        run.dt = run.integrator == DEM_TWO_TIMESCALES ? ts.dt_auto / run.tt_n : ts.dt_auto;
     } else {
         lua_pop(L, 1);
         run.dt = bind_field_number(L, 2, "run", "dt", 0, BIND_POSITIVE);
