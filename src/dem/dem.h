@@ -176,6 +176,18 @@ core_status dem_set_drag(dem_scene *s, double rate, core_error *err);
 double dem_drag(const dem_scene *s);
 void dem_box(const dem_scene *s, double lo[3], double hi[3], double gravity[3]);
 
+/* External forces on particles (N), added every step until changed or cleared; arrays are
+ * allocated on first use. Used for pressure boundary conditions applied as particle forces. */
+core_status dem_set_external_force(dem_scene *s, size_t i, const double f[3], core_error *err);
+void dem_clear_external_forces(dem_scene *s);
+
+/* Padbidri's quasistatic coefficient (Eq. 2.13; 2D form from 2.B1 with the force per boundary
+ * particle f0 = p 2R L / sqrt(2N)): phi = m eps^2 N^{2/3} / (4 p R) in 3D and
+ * phi = m eps^2 N / (2 p R) in 2D, with m and R the mean particle mass and radius, p the pressure
+ * (Pa) and eps the strain rate (1/s). psi = N^{-1/3} (3D) or (2N)^{-1/2} (2D) (Eq. 2.14). */
+core_status dem_quasistatic(const dem_scene *s, double pressure, double strain_rate, double *phi,
+                            double *psi, core_error *err);
+
 /* ---- measurements -------------------------------------------------------------------------- */
 typedef struct dem_energy {
     double kinetic, rotational, elastic, potential, total; /* J; potential from gravity */

@@ -56,6 +56,7 @@ struct dem_scene {
     double *w[3], *tq[3];  /* 2D: w[2], tq[2] only */
 
     double *x_build[3];    /* positions at the last list build (skin test) */
+    double *fext[3];       /* external forces (NULL until set) */
     double *x_ref[3];      /* reference for displacements (NULL until set) */
     double *x_prev[3];     /* position Verlet: previous positions */
     double *gear[6][3];    /* Gear: scaled derivatives of positions */

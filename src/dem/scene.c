@@ -87,7 +87,7 @@ void dem_destroy(dem_scene *s)
         return;
     for (int d = 0; d < 3; d++) {
         free(s->x[d]), free(s->v[d]), free(s->f[d]), free(s->w[d]), free(s->tq[d]);
-        free(s->x_build[d]), free(s->x_ref[d]), free(s->x_prev[d]);
+        free(s->x_build[d]), free(s->x_ref[d]), free(s->x_prev[d]), free(s->fext[d]);
         for (int k = 0; k < 6; k++)
             free(s->gear[k][d]), free(s->gear_w[k][d]);
     }
@@ -203,6 +203,11 @@ static core_status grow(dem_scene *s, size_t need, core_error *err)
             st = dem_alloc_array(&s->x_ref[d], cap, err);
         if (st == CORE_OK && s->x_prev[d])
             st = dem_alloc_array(&s->x_prev[d], cap, err);
+        if (st == CORE_OK && s->fext[d]) {
+            st = dem_alloc_array(&s->fext[d], cap, err);
+            if (st == CORE_OK)
+                memset(s->fext[d] + s->cap, 0, (cap - s->cap) * sizeof(double));
+        }
         for (int k = 0; k < 6 && st == CORE_OK; k++) {
             if (st == CORE_OK && s->gear[k][d])
                 st = dem_alloc_array(&s->gear[k][d], cap, err);
@@ -516,4 +521,58 @@ void dem_box(const dem_scene *s, double lo[3], double hi[3], double gravity[3])
         hi[d] = s->hi[d];
         gravity[d] = s->gravity[d];
     }
+}
+
+core_status dem_set_external_force(dem_scene *s, size_t i, const double f[3], core_error *err)
+{
+    if (i >= s->n)
+        return core_fail(err, CORE_ERR_ARG, "no particle %zu (the scene has %zu)", i + 1, s->n);
+    for (int d = 0; d < s->dim; d++)
+        if (!isfinite(f[d]))
+            return core_fail(err, CORE_ERR_ARG, "force on particle %zu is not finite", i + 1);
+    if (!s->fext[0])
+        for (int d = 0; d < s->dim; d++) {
+            if (dem_alloc_array(&s->fext[d], s->cap, err))
+                return err->status;
+            memset(s->fext[d], 0, s->cap * sizeof(double));
+        }
+    for (int d = 0; d < s->dim; d++)
+        s->fext[d][i] = f[d];
+    dem_invalidate(s, 0);
+    return CORE_OK;
+}
+
+void dem_clear_external_forces(dem_scene *s)
+{
+    for (int d = 0; d < 3; d++) {
+        free(s->fext[d]);
+        s->fext[d] = NULL;
+    }
+    dem_invalidate(s, 0);
+}
+
+core_status dem_quasistatic(const dem_scene *s, double pressure, double strain_rate, double *phi,
+                            double *psi, core_error *err)
+{
+    if (s->n == 0)
+        return core_fail(err, CORE_ERR_STATE, "the scene has no particles: add some first");
+    if (!(pressure > 0) || !isfinite(pressure))
+        return core_fail(err, CORE_ERR_ARG, "pressure must be > 0, got %g", pressure);
+    if (!(strain_rate > 0) || !isfinite(strain_rate))
+        return core_fail(err, CORE_ERR_ARG, "strain_rate must be > 0, got %g", strain_rate);
+    double m = 0, r = 0, N = (double)s->n;
+    for (size_t i = 0; i < s->n; i++) {
+        m += s->m[i];
+        r += s->r[i];
+    }
+    m /= N;
+    r /= N;
+    if (s->dim == 3) { /* Eq. 2.13, 2.14 */
+        *phi = m * strain_rate * strain_rate * pow(N, 2.0 / 3.0) / (4 * pressure * r);
+        *psi = pow(N, -1.0 / 3.0);
+    } else { /* Eq. 2.B1 */
+        *phi = m * strain_rate * strain_rate * N / (2 * pressure * r);
+        *psi = 1 / sqrt(2 * N);
+    }
+    return CORE_OK;
 }

@@ -1,6 +1,7 @@
 /* The Lua module `dem`: scenes of disks (2D) or spheres (3D) over src/dem. Translates and checks
  * arguments, calls the kernels, raises their errors named after the call. */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -754,6 +755,71 @@ static int l_drag(lua_State *L)
     return 1;
 }
 
+/* s:set_forces{ ids = {...}, fx = {...}, fy = {...}[, fz = {...}] } */
+static int l_set_forces(lua_State *L)
+{
+    static const char *const fields[] = {"ids", "fx", "fy", "fz", NULL};
+    static const char *const comp[3] = {"fx", "fy", "fz"};
+    dem_scene *s = check_scene(L, 1);
+    const int D = dem_dim(s);
+    bind_check_table(L, 2, "set_forces");
+    bind_check_fields(L, 2, "set_forces", fields);
+    if (lua_getfield(L, 2, "ids") != LUA_TTABLE)
+        return bind_field_error(L, 2, "set_forces", "ids", "array of particle ids");
+    lua_Integer n = luaL_len(L, -1);
+    for (int d = 0; d < D; d++)
+        if (lua_getfield(L, 2, comp[d]) != LUA_TTABLE || luaL_len(L, -1) != n)
+            return bind_field_error(L, 2, "set_forces", comp[d], "array as long as ids");
+    int base = lua_gettop(L) - D; /* ids at base, components after */
+    for (lua_Integer k = 1; k <= n; k++) {
+        lua_rawgeti(L, base, k);
+        lua_Integer id = lua_tointeger(L, -1);
+        lua_pop(L, 1);
+        double f[3] = {0, 0, 0};
+        for (int d = 0; d < D; d++) {
+            lua_rawgeti(L, base + 1 + d, k);
+            f[d] = lua_tonumber(L, -1);
+            lua_pop(L, 1);
+        }
+        core_error err;
+        if (id < 1 || dem_set_external_force(s, (size_t)(id - 1), f, &err))
+            return luaL_error(L, "set_forces: entry %d: %s", (int)k,
+                              id < 1 ? "particle ids start at 1" : err.msg);
+    }
+    return 0;
+}
+
+static int l_clear_forces(lua_State *L)
+{
+    dem_clear_external_forces(check_scene(L, 1));
+    return 0;
+}
+
+static int l_quasistatic(lua_State *L)
+{
+    static const char *const fields[] = {"pressure", "strain_rate", NULL};
+    dem_scene *s = check_scene(L, 1);
+    bind_check_table(L, 2, "quasistatic");
+    bind_check_fields(L, 2, "quasistatic", fields);
+    double p = bind_field_number(L, 2, "quasistatic", "pressure", 0, BIND_REQUIRED | BIND_POSITIVE);
+    double rate = bind_field_number(L, 2, "quasistatic", "strain_rate", 0,
+                                    BIND_REQUIRED | BIND_POSITIVE);
+    double phi, psi;
+    core_error err;
+    if (dem_quasistatic(s, p, rate, &phi, &psi, &err))
+        return bind_raise(L, "quasistatic", &err);
+    if (phi > 0.01 && progress_default_style() != PROGRESS_QUIET)
+        fprintf(stderr, "grainlab: warning: quasistatic coefficient phi = %.3g is not << 1: the "
+                        "process is not macroscopically quasistatic (Padbidri Eq. 2.13); lower "
+                        "the mass scaling or the strain rate\n", phi);
+    lua_createtable(L, 0, 2);
+    lua_pushnumber(L, phi);
+    lua_setfield(L, -2, "phi");
+    lua_pushnumber(L, psi);
+    lua_setfield(L, -2, "psi");
+    return 1;
+}
+
 static int l_info(lua_State *L)
 {
     dem_scene *s = check_scene(L, 1);
@@ -872,6 +938,14 @@ void bind_open_dem(lua_State *L)
         {"drag", l_drag, "s:drag([rate])",
          "Background drag -rate m v (and -rate I omega) on every particle, for settling samples; "
          "0 switches it off. Returns the rate."},
+        {"set_forces", l_set_forces, "s:set_forces{ ids = {...}, fx = {...}, fy = {...} }",
+         "External forces (N) on the listed particles, applied every step until changed or "
+         "cleared (pressure boundary conditions applied as particle forces)."},
+        {"clear_forces", l_clear_forces, "s:clear_forces()", "Removes all external forces."},
+        {"quasistatic", l_quasistatic, "s:quasistatic{ pressure = p, strain_rate = eps }",
+         "Padbidri's quasistatic coefficient phi (Eq. 2.13; 2D: m eps^2 N / (2 p R) from "
+         "2.B1) and size coefficient psi (Eq. 2.14) of the scene; warns when phi > 0.01. Mass "
+         "scaling (s:scale_mass) multiplies phi by its factor."},
         {"info", l_info, "s:info()",
          "dim, box, gravity, count, time, steps, force_evaluations, the laws."},
         {NULL, NULL, NULL, NULL}};
