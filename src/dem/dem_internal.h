@@ -16,6 +16,9 @@ typedef struct dem_wall {
     double friction;
     int material;
     double *hist[3];       /* SPRING law: tangential displacement per particle */
+    uint32_t *cand;        /* particles within r + skin of the wall at the last list build */
+    size_t ncand, cap_cand;
+    double point_build[3]; /* the wall's point at the last list build (skin test) */
 } dem_wall;
 
 /* The Verlet list: pairs (i < j) closer than r_i + r_j + skin at the last build, sorted by i then
@@ -62,6 +65,7 @@ struct dem_scene {
     double *gear[6][3];    /* Gear: scaled derivatives of positions */
     double *gear_w[6][3];  /* Gear: scaled derivatives of rotation angles */
     int gear_ready, prev_ready, forces_ready;
+    int suspect;           /* a kick saw a non-finite velocity: run the full checks */
     double gear_dt, prev_dt;
 
     dem_material *mats;

@@ -89,8 +89,10 @@ size_t dem_compute_forces(dem_scene *s, double dt)
     s->force_evals++;
     if (s->dim == 2) {
         pair_forces_2(s, dt);
-        return gather_2(s, dt);
+        gather_2(s);
+        return walls_2(s, dt);
     }
     pair_forces_3(s, dt);
-    return gather_3(s, dt);
+    gather_3(s);
+    return walls_3(s, dt);
 }

@@ -391,6 +391,35 @@ core_status dem_build_pairs(dem_scene *s, core_error *err)
         free(fill);
     }
 
+    /* Wall candidates: particles that can touch the wall before the next build (within r + skin,
+     * or already behind it so that the tunnelling check sees them). */
+    for (int w = 0; w < s->nwalls; w++) {
+        dem_wall *wl = &s->walls[w];
+        if (!wl->active)
+            continue;
+        wl->ncand = 0;
+        for (size_t i = 0; i < n; i++) {
+            double dist = 0;
+            for (int d = 0; d < D; d++)
+                dist += (s->x[d][i] - wl->point[d]) * wl->normal[d];
+            if (dist >= s->r[i] + s->skin)
+                continue;
+            if (wl->ncand == wl->cap_cand) {
+                size_t cap = wl->cap_cand ? 2 * wl->cap_cand : 256;
+                uint32_t *c = realloc(wl->cand, cap * sizeof *c);
+                if (!c) {
+                    dem_free_pairs(&old);
+                    return core_fail(err, CORE_ERR_NOMEM, "cannot allocate wall candidates");
+                }
+                wl->cand = c;
+                wl->cap_cand = cap;
+            }
+            wl->cand[wl->ncand++] = (uint32_t)i;
+        }
+        for (int d = 0; d < 3; d++)
+            wl->point_build[d] = wl->point[d];
+    }
+
     for (int d = 0; d < D; d++)
         memcpy(s->x_build[d], s->x[d], n * sizeof(double));
     dem_free_pairs(&old);

@@ -92,9 +92,11 @@ void dem_destroy(dem_scene *s)
             free(s->gear[k][d]), free(s->gear_w[k][d]);
     }
     free(s->r), free(s->m), free(s->inv_m), free(s->inv_inertia), free(s->mat), free(s->flags);
-    for (int w = 0; w < s->nwalls; w++)
+    for (int w = 0; w < s->nwalls; w++) {
         for (int d = 0; d < 3; d++)
             free(s->walls[w].hist[d]);
+        free(s->walls[w].cand);
+    }
     free(s->walls), free(s->mats);
     dem_free_pairs(&s->pairs);
     free(s->cell_start), free(s->cell_items);
@@ -443,7 +445,7 @@ int dem_add_wall(dem_scene *s, const dem_wall_def *w, core_error *err)
         s->cap_walls = cap;
     }
     s->walls[s->nwalls] = wl;
-    dem_invalidate(s, 0);
+    dem_invalidate(s, 1); /* the wall's candidate particles come with the next list build */
     return s->nwalls++;
 }
 
