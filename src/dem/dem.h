@@ -151,7 +151,8 @@ typedef struct dem_run_def {
                             * multiple of m (n + q)) */
     double dt;
     dem_integrator integrator;
-    int tt_m, tt_n, tt_q;  /* TWO_TIMESCALES cycle m(n + q) */
+    int tt_m, tt_n, tt_q;  /* TWO_TIMESCALES: cycles of one step n dt and q steps dt; m only names
+                            * the macro step N_S = m (n + q) of the paper (the cycle repeats) */
     progress *progress;    /* may be NULL */
 } dem_run_def;
 

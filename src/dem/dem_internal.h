@@ -61,7 +61,7 @@ struct dem_scene {
     double *x_build[3];    /* positions at the last list build (skin test) */
     double *fext[3];       /* external forces (NULL until set) */
     double *x_ref[3];      /* reference for displacements (NULL until set) */
-    double *x_prev[3];     /* position Verlet: previous positions */
+    double *x_prev[3];     /* position Verlet: the last step's displacement x(t) - x(t-dt) */
     double *gear[6][3];    /* Gear: scaled derivatives of positions */
     double *gear_w[6][3];  /* Gear: scaled derivatives of rotation angles */
     int gear_ready, prev_ready, forces_ready;

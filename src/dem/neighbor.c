@@ -258,8 +258,6 @@ core_status dem_build_pairs(dem_scene *s, core_error *err)
             double x = s->x[d][i];
             if (x < s->lo[d] || x >= s->hi[d]) {
                 double w = x - s->len[d] * floor((x - s->lo[d]) / s->len[d]);
-                if (s->x_prev[d])
-                    s->x_prev[d][i] += w - x;
                 if (s->gear[0][d])
                     s->gear[0][d][i] += w - x;
                 if (s->x_ref[d])

@@ -326,7 +326,7 @@ long dem_add_particle(dem_scene *s, const dem_particle_def *p, core_error *err)
         if (s->x_ref[d])
             s->x_ref[d][i] = p->x[d];
         if (s->x_prev[d])
-            s->x_prev[d][i] = p->x[d];
+            s->x_prev[d][i] = 0; /* re-initialised from v before the next position-Verlet step */
     }
     for (int d = 0; d < 3; d++) {
         if (s->w[d])

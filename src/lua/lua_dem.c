@@ -916,8 +916,9 @@ void bind_open_dem(lua_State *L)
          "'velocity_verlet'|'position_verlet'|'gear'|'two_timescales', m =, n =, q =, every =, "
          "on_step = function(s) end, progress = nil }",
          "Advances the scene. dt above the stability limit is refused unless force = true. "
-         "two_timescales (Padbidri Sec. 2.4) takes cycles of one step n dt and q steps dt; steps "
-         "count small-step equivalents. on_step runs every `every` steps; returning false stops "
+         "two_timescales (Padbidri Sec. 2.4) takes cycles of one step n dt and q steps dt (m names "
+         "the paper's macro step m(n + q) dt; the cycle simply repeats); steps count small-step "
+         "equivalents. on_step runs every `every` steps; returning false stops "
          "the run. Ctrl-C stops between steps with the scene intact. Returns {steps, time, dt, "
          "force_evaluations, stopped}."},
         {"measure", l_measure, "s:measure('energy'|'stress'|'coordination'|'slip'|'contacts'|'displacement', opts)",

@@ -306,6 +306,12 @@ do -- position Verlet keeps its velocity when dt changes between runs
   -- velocity = (x - x_prev)/dt: rounding of x ~ 0.5 against steps ~ 1e-7 leaves ~1e-9
   check.near(s:particles().vx[1], 0.1, 1e-8, "position Verlet: velocity survives a change of dt")
 end
+do -- position Verlet in summed form does not accumulate rounding (2e-6 m in the plain form)
+  local s = dem.scene{ dim = 2, box = { { 0, 0 }, { 1, 1 } }, gravity = { 9.81, 0 } }
+  s:add_disk{ pos = { 0.1, 0.5 }, radius = 1e-3 }
+  s:run{ steps = 200000, dt = 0.15 / 200000, integrator = "position_verlet", force = true }
+  check.near_abs(s:particles().x[1], 0.1 + 0.5 * 9.81 * 0.15 ^ 2, 1e-10, "position Verlet: free fall over 2e5 steps")
+end
 do -- two timescales with dt = "auto": the large step n dt is the automatic step
   local s = dem.scene{ dim = 2, box = { { 0, 0 }, { 0.01, 0.01 } }, gravity = { 0, -9.81 } }
   s:add_wall{ point = { 0, 0 }, normal = { 0, 1 } }
