@@ -538,19 +538,27 @@ core_status dem_set_external_force(dem_scene *s, size_t i, const double f[3], co
                 return err->status;
             memset(s->fext[d], 0, s->cap * sizeof(double));
         }
-    for (int d = 0; d < s->dim; d++)
+    /* The external force enters the total linearly: adjust the stored total rather than
+     * re-evaluating every contact before the next step. */
+    for (int d = 0; d < s->dim; d++) {
+        if (s->forces_ready)
+            s->f[d][i] += f[d] - s->fext[d][i];
         s->fext[d][i] = f[d];
-    dem_invalidate(s, 0);
+    }
+    s->gear_ready = s->prev_ready = 0;
     return CORE_OK;
 }
 
 void dem_clear_external_forces(dem_scene *s)
 {
     for (int d = 0; d < 3; d++) {
+        if (s->fext[d] && s->forces_ready)
+            for (size_t i = 0; i < s->n; i++)
+                s->f[d][i] -= s->fext[d][i];
         free(s->fext[d]);
         s->fext[d] = NULL;
     }
-    dem_invalidate(s, 0);
+    s->gear_ready = s->prev_ready = 0;
 }
 
 core_status dem_quasistatic(const dem_scene *s, double pressure, double strain_rate, double *phi,

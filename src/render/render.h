@@ -1,0 +1,134 @@
+/* grainlab's headless renderer: an OSMesa (llvmpipe) off-screen context draws anti-aliased disks,
+ * segments and FreeType text; images are written as PNG through core/fileio (temp + rename).
+ *
+ * Usage: create one render_context and reuse it (it holds the GL context, the shaders and the
+ * font); fill a render_grains_def from render_default_grains_def() and call render_dem, or a
+ * render_plot_def for render_plot; write the image with render_write_png. The same input gives
+ * the same pixels on the same machine. Nothing here knows about Lua. */
+#ifndef GRAINLAB_RENDER_H
+#define GRAINLAB_RENDER_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "core/error.h"
+#include "dem/dem.h"
+
+enum {
+    RENDER_MIN_SIZE = 16,   /* pixels per side, both limits included */
+    RENDER_MAX_SIZE = 8192,
+    RENDER_DEFAULT_WIDTH = 1024
+};
+
+typedef struct render_context render_context;
+
+/* Starts the off-screen GL context and loads the font (DejaVu Sans from fonts-dejavu-core, or
+ * the file named by the environment variable GRAINLAB_FONT). */
+core_status render_context_create(render_context **out, core_error *err);
+void render_context_destroy(render_context *rc);
+
+/* ---- images -------------------------------------------------------------------------------- */
+typedef struct render_image {
+    int width, height;
+    unsigned char *rgba; /* width * height * 4 bytes, top row first, opaque */
+} render_image;
+
+void render_image_free(render_image *img);
+/* Writes an 8-bit RGB PNG whole (temporary file + rename): on failure no file is left. */
+core_status render_write_png(const render_image *img, const char *path, core_error *err);
+/* Expands a frame pattern with one printf-style integer conversion ("out/frame_%05d.png",
+ * flags 0 and a width only; "%%" is a literal percent) with frame. A path without '%' is
+ * copied unchanged. */
+core_status render_frame_path(const char *pattern, long frame, char *out, size_t size,
+                              core_error *err);
+
+/* ---- colours ------------------------------------------------------------------------------- */
+typedef enum render_colormap {
+    RENDER_VIRIDIS, /* matplotlib's viridis (CC0), perceptually uniform, dark blue -> yellow */
+    RENDER_GRAY     /* linear in CIE lightness L*: black -> white */
+} render_colormap;
+
+/* t in [0, 1] (clamped; NaN gives mid grey) to 8-bit sRGB. */
+void render_colormap_rgb(render_colormap map, double t, unsigned char rgb[3]);
+/* Well-separated colours for integer labels (grain ids, materials, series): consecutive ids
+ * differ strongly in hue and lightness. */
+void render_label_rgb(long id, unsigned char rgb[3]);
+
+/* ---- 2D grain frames ----------------------------------------------------------------------- */
+typedef enum render_color_by {
+    RENDER_COLOR_GRAIN,    /* well-separated colours by grain id */
+    RENDER_COLOR_SPEED,    /* |v| through the colour map */
+    RENDER_COLOR_ROTATION, /* angular velocity omega_z (rad/s) through the colour map */
+    RENDER_COLOR_VALUES,   /* def.values[i] through the colour map */
+    RENDER_COLOR_LABELS    /* def.labels[i] as well-separated colours (materials, clusters) */
+} render_color_by;
+
+typedef struct render_wall {
+    double point[2], normal[2]; /* a line through point, normal into the domain */
+} render_wall;
+
+typedef struct render_grains_def {
+    int width, height;          /* 0: width 1024, height from the box's aspect */
+    render_color_by color;
+    const double *values;       /* RENDER_COLOR_VALUES: one per grain */
+    const int *labels;          /* RENDER_COLOR_LABELS: one per grain */
+    render_colormap colormap;
+    double range[2];            /* colour-map limits; range[0] == range[1]: min and max of data */
+    bool force_chains;          /* segments between contacting centres, width and shade ~ fn */
+    bool rotation;              /* a radius line at each grain's orientation angle */
+    const double *angles;       /* orientation per grain (rad) for the markers; NULL: 0 */
+    bool box;                   /* outline of the scene's box */
+    bool colorbar;              /* colour bar with ticks (colour-map modes only) */
+    const render_wall *walls;   /* drawn as thick lines on their outer side */
+    int nwalls;
+    const char *title;          /* UTF-8 or NULL, top left */
+    const char *stamp;          /* UTF-8 or NULL, top right (e.g. "t = 0.125 s") */
+    const char *colorbar_label; /* NULL: from the colour mode ("speed (m/s)", ...) */
+} render_grains_def;
+
+render_grains_def render_default_grains_def(void); /* grain colours, viridis, box outline */
+
+/* Where the box landed: pixel = (x - lo) * scale + origin (y downwards from the top). */
+typedef struct render_view {
+    double lo[2], hi[2];
+    double scale;        /* pixels per metre */
+    double origin[2];    /* pixel position of (lo[0], hi[1]): the top-left corner of the box */
+    double range[2];     /* colour-map limits used */
+} render_view;
+
+/* Draws a 2D scene. Fails (CORE_ERR_ARG) on a 3D scene, a bad size or missing arrays. */
+core_status render_dem(render_context *rc, dem_scene *s, const render_grains_def *def,
+                       render_image *out, render_view *view, core_error *err);
+
+/* ---- line plots ---------------------------------------------------------------------------- */
+typedef enum render_plot_style { RENDER_LINE, RENDER_POINTS, RENDER_BOTH } render_plot_style;
+
+typedef struct render_series {
+    const double *x, *y;
+    size_t n;
+    const char *label;   /* NULL: not in the legend */
+    render_plot_style style;
+} render_series;
+
+typedef struct render_plot_def {
+    int width, height;   /* 0: 800 x 560 */
+    const char *title, *xlabel, *ylabel;
+    bool xlog, ylog;
+    const render_series *series;
+    int nseries;
+} render_plot_def;
+
+render_plot_def render_default_plot_def(void);
+
+/* Where the axes landed: pixel x = px[0] + (X - lim[0]) / (lim[1] - lim[0]) * (px[1] - px[0])
+ * with X = log10(x) on a log axis (limits then also in log10), the same for y (py[0] is the
+ * bottom pixel row of the frame, py[1] the top one). */
+typedef struct render_plot_axes {
+    double xlim[2], ylim[2];
+    double px[2], py[2];
+} render_plot_axes;
+
+core_status render_plot(render_context *rc, const render_plot_def *def, render_image *out,
+                        render_plot_axes *axes, core_error *err);
+
+#endif
