@@ -109,6 +109,10 @@ const double *dem_positions(const dem_scene *s, int d);
 const double *dem_velocities(const dem_scene *s, int d);
 const double *dem_angular_velocities(const dem_scene *s, int d);
 const double *dem_radii(const dem_scene *s);
+/* 2D orientation angles (rad, integrated from omega; NULL when rotations are off or in 3D). */
+const double *dem_angles(const dem_scene *s);
+/* Material index of each particle. */
+const int *dem_particle_materials(const dem_scene *s);
 const double *dem_masses(const dem_scene *s);
 core_status dem_set_velocity(dem_scene *s, size_t i, const double v[3], core_error *err);
 
@@ -123,6 +127,10 @@ typedef struct dem_wall_def {
 int dem_add_wall(dem_scene *s, const dem_wall_def *w, core_error *err); /* wall id or -1 */
 core_status dem_remove_wall(dem_scene *s, int id, core_error *err);
 core_status dem_set_wall_velocity(dem_scene *s, int id, const double v[3], core_error *err);
+/* Wall slots (removed walls keep their id); geometry of wall id now, *active = 0 if removed. */
+int dem_wall_count(const dem_scene *s);
+core_status dem_wall_geometry(const dem_scene *s, int id, double point[3], double normal[3],
+                              int *active, core_error *err);
 /* Current position of the wall's reference point. */
 core_status dem_wall_point(const dem_scene *s, int id, double p[3], core_error *err);
 

@@ -57,6 +57,7 @@ struct dem_scene {
 
     int rot;               /* rotational state allocated */
     double *w[3], *tq[3];  /* 2D: w[2], tq[2] only */
+    double *angle;         /* 2D orientation, integrated from w[2] (allocated with rotations) */
 
     double *x_build[3];    /* positions at the last list build (skin test) */
     double *fext[3];       /* external forces (NULL until set) */

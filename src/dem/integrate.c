@@ -184,6 +184,19 @@ static void kick_rotation(dem_scene *s, double h)
     }
 }
 
+/* 2D orientation: theta += dt omega (omega at the half step in velocity Verlet). */
+static void advance_angles(dem_scene *s, double dt)
+{
+    if (!s->angle)
+        return;
+    const long n = (long)s->n;
+    double *restrict a = s->angle;
+    const double *restrict w = s->w[2];
+#pragma omp parallel for schedule(static) if (n > 4096)
+    for (long i = 0; i < n; i++)
+        a[i] += dt * w[i];
+}
+
 static double kick_drift(dem_scene *s, double h, double dt)
 {
     const long n = (long)s->n;
@@ -210,8 +223,10 @@ static double kick_drift(dem_scene *s, double h, double dt)
             m = d2 > m ? d2 : m;
         }
         s->suspect |= out;
-        if (s->rot)
+        if (s->rot) {
             kick_rotation(s, h);
+            advance_angles(s, dt);
+        }
         return m;
     }
     for (int d = 0; d < s->dim; d++) {
@@ -228,8 +243,10 @@ static double kick_drift(dem_scene *s, double h, double dt)
         }
     }
     s->suspect |= out;
-    if (s->rot)
+    if (s->rot) {
         kick_rotation(s, h);
+        advance_angles(s, dt);
+    }
     return max_displacement2(s);
 }
 
@@ -313,6 +330,7 @@ static core_status step_position_verlet(dem_scene *s, double dt, core_error *err
             for (int d = (D == 2 ? 2 : 0); d < 3; d++)
                 s->w[d][i] += dt * s->tq[d][i] * s->inv_inertia[i];
     }
+    advance_angles(s, dt);
     move_walls(s, dt);
     s->time += dt;
     return CORE_OK;
@@ -427,6 +445,7 @@ static core_status step_gear(dem_scene *s, double dt, core_error *err)
             s->w[d][i] = s->gear_w[1][d][i] / dt;
         }
     }
+    advance_angles(s, dt);
     return CORE_OK;
 }
 

@@ -92,6 +92,7 @@ void dem_destroy(dem_scene *s)
             free(s->gear[k][d]), free(s->gear_w[k][d]);
     }
     free(s->r), free(s->m), free(s->inv_m), free(s->inv_inertia), free(s->mat), free(s->flags);
+    free(s->angle);
     for (int w = 0; w < s->nwalls; w++) {
         for (int d = 0; d < 3; d++)
             free(s->walls[w].hist[d]);
@@ -230,6 +231,8 @@ static core_status grow(dem_scene *s, size_t need, core_error *err)
                     memset(s->walls[w].hist[d] + s->cap, 0, (cap - s->cap) * sizeof(double));
             }
     }
+    if (st == CORE_OK && s->angle)
+        st = dem_alloc_array(&s->angle, cap, err);
     if (st == CORE_OK)
         st = dem_alloc_array(&s->r, cap, err);
     if (st == CORE_OK)
@@ -268,6 +271,11 @@ core_status dem_ensure_rotation(dem_scene *s, core_error *err)
             return err ? err->status : CORE_ERR_NOMEM;
         memset(s->w[d], 0, cap * sizeof(double));
         memset(s->tq[d], 0, cap * sizeof(double));
+    }
+    if (s->dim == 2) {
+        if (dem_alloc_array(&s->angle, cap, err))
+            return err ? err->status : CORE_ERR_NOMEM;
+        memset(s->angle, 0, cap * sizeof(double));
     }
     s->rot = 1;
     dem_invalidate(s, 1);
@@ -337,6 +345,8 @@ long dem_add_particle(dem_scene *s, const dem_particle_def *p, core_error *err)
             if (s->walls[w].hist[d])
                 s->walls[w].hist[d][i] = 0;
     }
+    if (s->angle)
+        s->angle[i] = 0;
     s->r[i] = r;
     s->m[i] = m;
     s->inv_m[i] = (p->flags & (DEM_FIXED | DEM_PRESCRIBED)) ? 0 : 1 / m;
@@ -357,6 +367,8 @@ const double *dem_positions(const dem_scene *s, int d) { return s->x[d]; }
 const double *dem_velocities(const dem_scene *s, int d) { return s->v[d]; }
 const double *dem_angular_velocities(const dem_scene *s, int d) { return s->w[d]; }
 const double *dem_radii(const dem_scene *s) { return s->r; }
+const double *dem_angles(const dem_scene *s) { return s->angle; }
+const int *dem_particle_materials(const dem_scene *s) { return s->mat; }
 const double *dem_masses(const dem_scene *s) { return s->m; }
 double dem_time(const dem_scene *s) { return s->time; }
 long dem_steps_done(const dem_scene *s) { return s->steps; }
@@ -481,6 +493,21 @@ core_status dem_set_wall_velocity(dem_scene *s, int id, const double v[3], core_
         s->walls[id].velocity[d] = v[d];
     }
     dem_invalidate(s, 0); /* damping and friction see the wall's velocity */
+    return CORE_OK;
+}
+
+int dem_wall_count(const dem_scene *s) { return s->nwalls; }
+
+core_status dem_wall_geometry(const dem_scene *s, int id, double point[3], double normal[3],
+                              int *active, core_error *err)
+{
+    if (id < 0 || id >= s->nwalls)
+        return core_fail(err, CORE_ERR_ARG, "no wall %d", id + 1);
+    for (int d = 0; d < 3; d++) {
+        point[d] = s->walls[id].point[d];
+        normal[d] = s->walls[id].normal[d];
+    }
+    *active = s->walls[id].active;
     return CORE_OK;
 }
 

@@ -93,4 +93,10 @@ void bind_open_help(lua_State *L, int idx);
 /* Registers the global `dem` module (lua_dem.c). */
 void bind_open_dem(lua_State *L);
 
+/* The dem_scene of the dem.scene at idx, or a Lua error naming `call` (for other bindings). */
+struct dem_scene *bind_check_dem_scene(lua_State *L, int idx, const char *call);
+
+/* Registers the global `render` module (lua_render.c). */
+void bind_open_render(lua_State *L);
+
 #endif

@@ -23,6 +23,19 @@ static dem_scene *check_scene(lua_State *L, int idx)
     return u->s;
 }
 
+struct dem_scene *bind_check_dem_scene(lua_State *L, int idx, const char *call)
+{
+    lscene *u = luaL_testudata(L, idx, SCENE);
+    if (!u) {
+        char got[64];
+        bind_describe(L, idx, got, sizeof got);
+        luaL_error(L, "bad argument #%d to '%s' (dem.scene expected, got %s)", idx, call, got);
+    }
+    if (!u->s)
+        luaL_error(L, "%s: the dem.scene was closed", call);
+    return u->s;
+}
+
 /* ---- dem.scene{...} ------------------------------------------------------------------------ */
 static void read_box(lua_State *L, int arg, int dim, dem_scene_def *def)
 {

@@ -33,7 +33,11 @@ enum { PENDING_NONE, PENDING_DISKS, PENDING_SEGS };
 
 struct render_context {
     OSMesaContext osm;
-    unsigned char *buf;
+    unsigned char osm_buf[RENDER_MIN_SIZE * RENDER_MIN_SIZE * 4]; /* keeps the context current */
+    GLuint fbo, color_rb;  /* drawing goes here: OSMesa's own buffer does not follow size changes
+                            * reliably, a renderbuffer of the image's size does */
+    int fb_w, fb_h;
+    unsigned char *buf;    /* glReadPixels target */
     size_t buf_size;
     int w, h;
     GLuint vao_disk, vao_seg, vao_text, corner_vbo, disk_vbo, seg_vbo, text_tex;
@@ -78,6 +82,16 @@ static const char *DISK_FS =
     "  vec3 c = v_color.rgb;\n"
     "  if (v_disk.w > 0.0)\n"
     "    c = mix(c, c * 0.5, clamp(d - (v_disk.z - v_disk.w) + 0.5, 0.0, 1.0));\n"
+    "  else if (v_disk.w < 0.0) {\n" /* a sphere: Lambert + Blinn-Phong, light upper left */
+    "    vec2 q = (gl_FragCoord.xy - v_disk.xy) / v_disk.z;\n"
+    "    float q2 = min(dot(q, q), 1.0);\n"
+    "    vec3 n = vec3(q, sqrt(1.0 - q2));\n"
+    "    vec3 l = normalize(vec3(-0.45, 0.55, 0.70));\n"
+    "    vec3 h = normalize(l + vec3(0.0, 0.0, 1.0));\n"
+    "    float diff = max(dot(n, l), 0.0);\n"
+    "    float spec = pow(max(dot(n, h), 0.0), 40.0);\n"
+    "    c = min(c * (0.28 + 0.72 * diff) + vec3(0.35 * spec), vec3(1.0));\n"
+    "  }\n"
     "  frag = vec4(c, v_color.a * cov);\n"
     "}\n";
 
@@ -293,10 +307,12 @@ core_status render_context_create(render_context **out, core_error *err)
                          "render: no OpenGL 3.3 off-screen context (OSMesa from libosmesa6 is "
                          "needed: apt-get install libosmesa6)");
     }
-    /* A small buffer makes the context current so the shaders can be built. */
-    st = canvas_begin(rc, RENDER_MIN_SIZE, RENDER_MIN_SIZE, err);
-    if (st == CORE_OK)
-        st = setup_gl(rc, err);
+    if (!OSMesaMakeCurrent(rc->osm, rc->osm_buf, GL_UNSIGNED_BYTE, RENDER_MIN_SIZE,
+                           RENDER_MIN_SIZE)) {
+        render_context_destroy(rc);
+        return core_fail(err, CORE_ERR_STATE, "render: cannot make the OpenGL context current");
+    }
+    st = setup_gl(rc, err);
     if (st != CORE_OK) {
         render_context_destroy(rc);
         return st;
@@ -360,9 +376,35 @@ core_status canvas_begin(render_context *rc, int w, int h, core_error *err)
         rc->buf = b;
         rc->buf_size = need;
     }
-    if (!OSMesaMakeCurrent(rc->osm, rc->buf, GL_UNSIGNED_BYTE, w, h))
-        return core_fail(err, CORE_ERR_STATE, "render: cannot draw a %d x %d image", w, h);
-    OSMesaPixelStore(OSMESA_Y_UP, 0); /* row 0 of the buffer is the top of the image */
+    if (!OSMesaMakeCurrent(rc->osm, rc->osm_buf, GL_UNSIGNED_BYTE, RENDER_MIN_SIZE,
+                           RENDER_MIN_SIZE))
+        return core_fail(err, CORE_ERR_STATE, "render: cannot make the OpenGL context current");
+    while (glGetError() != GL_NO_ERROR)
+        ;
+    if (w != rc->fb_w || h != rc->fb_h) {
+        if (rc->fbo) {
+            glDeleteFramebuffers(1, &rc->fbo);
+            glDeleteRenderbuffers(1, &rc->color_rb);
+        }
+        glGenFramebuffers(1, &rc->fbo);
+        glGenRenderbuffers(1, &rc->color_rb);
+        glBindRenderbuffer(GL_RENDERBUFFER, rc->color_rb);
+        glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, w, h);
+        glBindFramebuffer(GL_FRAMEBUFFER, rc->fbo);
+        glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER,
+                                  rc->color_rb);
+        if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE ||
+            glGetError() != GL_NO_ERROR) {
+            glDeleteFramebuffers(1, &rc->fbo);
+            glDeleteRenderbuffers(1, &rc->color_rb);
+            rc->fbo = rc->color_rb = 0;
+            rc->fb_w = rc->fb_h = 0;
+            return core_fail(err, CORE_ERR_NOMEM, "render: cannot draw a %d x %d image", w, h);
+        }
+        rc->fb_w = w;
+        rc->fb_h = h;
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, rc->fbo);
     rc->w = w;
     rc->h = h;
     rc->ndisks = rc->nsegs = 0;
@@ -380,21 +422,25 @@ core_status canvas_begin(render_context *rc, int w, int h, core_error *err)
 core_status canvas_end(render_context *rc, render_image *out, core_error *err)
 {
     flush(rc);
-    glFinish();
     out->width = out->height = 0;
     out->rgba = NULL;
     if (rc->oom)
         return core_fail(err, CORE_ERR_NOMEM, "render: out of memory while drawing");
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadPixels(0, 0, rc->w, rc->h, GL_RGBA, GL_UNSIGNED_BYTE, rc->buf);
     if (glGetError() != GL_NO_ERROR)
         return core_fail(err, CORE_ERR_STATE, "render: OpenGL reported an error while drawing");
-    size_t n = (size_t)rc->w * (size_t)rc->h;
-    out->rgba = malloc(n * 4);
+    size_t row = (size_t)rc->w * 4;
+    out->rgba = malloc(row * rc->h);
     if (!out->rgba)
         return core_fail(err, CORE_ERR_NOMEM, "render: no memory for a %d x %d image", rc->w,
                          rc->h);
-    memcpy(out->rgba, rc->buf, n * 4);
-    for (size_t i = 0; i < n; i++)
-        out->rgba[4 * i + 3] = 255;
+    for (int y = 0; y < rc->h; y++) { /* GL rows go bottom-up, images top-down */
+        unsigned char *dst = out->rgba + row * y;
+        memcpy(dst, rc->buf + row * (rc->h - 1 - y), row);
+        for (int x = 0; x < rc->w; x++)
+            dst[4 * x + 3] = 255;
+    }
     out->width = rc->w;
     out->height = rc->h;
     return CORE_OK;

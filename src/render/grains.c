@@ -14,7 +14,105 @@ render_grains_def render_default_grains_def(void)
     d.color = RENDER_COLOR_GRAIN;
     d.colormap = RENDER_VIRIDIS;
     d.box = true;
+    d.camera.azimuth = -60;
+    d.camera.elevation = 25;
+    d.camera.fov = 30;
     return d;
+}
+
+/* ---- 3D camera ------------------------------------------------------------------------------ */
+typedef struct camera3 {
+    double c[3], eye[3];    /* box centre; eye position (perspective) */
+    double f[3], r[3], u[3]; /* forward (away from the eye), right, up on the image */
+    int perspective;
+} camera3;
+
+static void cross(const double a[3], const double b[3], double out[3])
+{
+    out[0] = a[1] * b[2] - a[2] * b[1];
+    out[1] = a[2] * b[0] - a[0] * b[2];
+    out[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+static void normalize(double v[3])
+{
+    double n = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    for (int d = 0; d < 3; d++)
+        v[d] /= n;
+}
+
+static void camera_setup(const render_camera *cam, const double lo[3], const double hi[3],
+                         const double g[3], camera3 *p)
+{
+    /* up: against the strongest gravity component, z without gravity */
+    int up = 2;
+    double sign = 1;
+    if (fabs(g[0]) + fabs(g[1]) + fabs(g[2]) > 0) {
+        up = fabs(g[0]) >= fabs(g[1]) && fabs(g[0]) >= fabs(g[2]) ? 0
+             : fabs(g[1]) >= fabs(g[2])                           ? 1
+                                                                  : 2;
+        sign = g[up] > 0 ? -1 : 1;
+    }
+    double U[3] = {0, 0, 0}, A[3] = {0, 0, 0}, B[3] = {0, 0, 0};
+    U[up] = sign;
+    A[(up + 1) % 3] = 1;
+    cross(U, A, B); /* A, B, U right-handed */
+    const double deg = 3.14159265358979323846 / 180;
+    double az = cam->azimuth * deg, el = cam->elevation * deg, diag = 0;
+    for (int d = 0; d < 3; d++) {
+        p->c[d] = 0.5 * (lo[d] + hi[d]);
+        double to_eye = cos(el) * (cos(az) * A[d] + sin(az) * B[d]) + sin(el) * U[d];
+        p->f[d] = -to_eye;
+        diag += (hi[d] - lo[d]) * (hi[d] - lo[d]);
+    }
+    if (fabs(cos(el)) < 1e-9) { /* looking straight down or up: right is A */
+        for (int d = 0; d < 3; d++)
+            p->r[d] = A[d];
+    } else {
+        cross(p->f, U, p->r);
+        normalize(p->r);
+    }
+    cross(p->r, p->f, p->u);
+    p->perspective = cam->perspective;
+    double dist = 0.5 * sqrt(diag) / tan(0.5 * cam->fov * deg);
+    for (int d = 0; d < 3; d++)
+        p->eye[d] = p->c[d] - p->f[d] * dist;
+}
+
+/* Image-plane position, projected radius and depth of a sphere; 0 when it is behind the eye. */
+static int project(const camera3 *p, const double q[3], double rad, double *X, double *Y,
+                   double *R, double *z)
+{
+    const double *o = p->perspective ? p->eye : p->c;
+    double rel[3] = {q[0] - o[0], q[1] - o[1], q[2] - o[2]};
+    double x = 0, y = 0, zz = 0;
+    for (int d = 0; d < 3; d++) {
+        x += rel[d] * p->r[d];
+        y += rel[d] * p->u[d];
+        zz += rel[d] * p->f[d];
+    }
+    *z = zz;
+    if (!p->perspective) {
+        *X = x, *Y = y, *R = rad;
+        return 1;
+    }
+    if (zz <= rad * 1.0001)
+        return 0;
+    *X = x / zz, *Y = y / zz, *R = rad / sqrt(zz * zz - rad * rad);
+    return 1;
+}
+
+typedef struct depth_key {
+    double z;
+    size_t i;
+} depth_key;
+
+static int far_first(const void *a, const void *b)
+{
+    const depth_key *x = a, *y = b;
+    if (x->z != y->z)
+        return x->z > y->z ? -1 : 1;
+    return x->i < y->i ? -1 : x->i > y->i;
 }
 
 typedef struct chain {
@@ -57,7 +155,9 @@ static int by_force(const void *a, const void *b)
     const chain *x = a, *y = b;
     if (x->fn != y->fn)
         return x->fn < y->fn ? -1 : 1;
-    return x->i < y->i ? -1 : x->i > y->i;
+    if (x->i != y->i)
+        return x->i < y->i ? -1 : 1;
+    return x->j < y->j ? -1 : x->j > y->j;
 }
 
 static const char *const COLOR_LABELS[] = {"grain", "speed (m/s)", "angular velocity (rad/s)",
@@ -98,15 +198,23 @@ core_status render_dem(render_context *rc, dem_scene *s, const render_grains_def
 {
     out->rgba = NULL;
     out->width = out->height = 0;
-    if (dem_dim(s) != 2)
-        return core_fail(err, CORE_ERR_ARG, "only 2D scenes are drawn so far (this one is 3D)");
+    const int D = dem_dim(s);
+    if (D == 3 && (def->force_chains || def->rotation || def->nwalls || def->arrows[0]))
+        return core_fail(err, CORE_ERR_ARG, "force chains, rotation markers, arrows and walls "
+                                            "are drawn in 2D scenes only");
+    if (def->arrows[0] && (!def->arrows[1] || !(def->arrow_scale >= 0) ||
+                           !isfinite(def->arrow_scale)))
+        return core_fail(err, CORE_ERR_ARG, "arrows need two arrays and a scale >= 0");
+    if (D == 3 && (!(def->camera.fov > 0 && def->camera.fov < 90) ||
+                   !isfinite(def->camera.azimuth) || !isfinite(def->camera.elevation)))
+        return core_fail(err, CORE_ERR_ARG, "camera: finite angles and fov in (0, 90) degrees "
+                                            "expected, got fov %g", def->camera.fov);
     int W = def->width ? def->width : RENDER_DEFAULT_WIDTH, H = def->height;
     if (W < RENDER_MIN_SIZE || W > RENDER_MAX_SIZE || (H && (H < RENDER_MIN_SIZE ||
                                                              H > RENDER_MAX_SIZE)))
         return core_fail(err, CORE_ERR_ARG, "image size %d x %d outside [%d, %d] pixels", W, H,
                          RENDER_MIN_SIZE, RENDER_MAX_SIZE);
     const size_t n = dem_count(s);
-    const double *x = dem_positions(s, 0), *y = dem_positions(s, 1), *r = dem_radii(s);
     int mapped = def->color == RENDER_COLOR_SPEED || def->color == RENDER_COLOR_ROTATION ||
                  def->color == RENDER_COLOR_VALUES;
     if (def->color == RENDER_COLOR_VALUES && n && !def->values)
@@ -117,9 +225,8 @@ core_status render_dem(render_context *rc, dem_scene *s, const render_grains_def
         return core_fail(err, CORE_ERR_ARG, "colour range [%g, %g] is not increasing",
                          def->range[0], def->range[1]);
 
-    double lo[3], hi[3], g[3];
-    dem_box(s, lo, hi, g);
-    const double hx = hi[0] - lo[0], hy = hi[1] - lo[1];
+    double box_lo[3], box_hi[3], g[3];
+    dem_box(s, box_lo, box_hi, g);
 
     /* ---- per-grain scalar and its range ---- */
     double *val = NULL;
@@ -128,12 +235,22 @@ core_status render_dem(render_context *rc, dem_scene *s, const render_grains_def
         val = malloc((n ? n : 1) * sizeof *val);
         if (!val)
             return core_fail(err, CORE_ERR_NOMEM, "render: out of memory");
-        const double *vx = dem_velocities(s, 0), *vy = dem_velocities(s, 1);
-        const double *w = dem_angular_velocities(s, 2);
-        for (size_t i = 0; i < n; i++)
-            val[i] = def->color == RENDER_COLOR_SPEED      ? hypot(vx[i], vy[i])
-                     : def->color == RENDER_COLOR_ROTATION ? (w ? w[i] : 0)
-                                                           : def->values[i];
+        const double *v[3] = {NULL, NULL, NULL}, *w[3] = {NULL, NULL, NULL};
+        for (int d = 0; d < D; d++) {
+            v[d] = dem_velocities(s, d);
+            w[d] = D == 3 || d == 0 ? dem_angular_velocities(s, D == 3 ? d : 2) : NULL;
+        }
+        for (size_t i = 0; i < n; i++) {
+            double v2 = 0, w2 = 0;
+            for (int d = 0; d < D; d++) {
+                v2 += v[d][i] * v[d][i];
+                w2 += w[d] ? w[d][i] * w[d][i] : 0;
+            }
+            val[i] = def->color == RENDER_COLOR_SPEED ? sqrt(v2)
+                     : def->color == RENDER_COLOR_ROTATION
+                         ? (D == 2 ? (w[0] ? w[0][i] : 0) : sqrt(w2))
+                         : def->values[i];
+        }
         if (def->range[0] < def->range[1]) {
             range[0] = def->range[0];
             range[1] = def->range[1];
@@ -156,10 +273,52 @@ core_status render_dem(render_context *rc, dem_scene *s, const render_grains_def
         }
     }
 
+    /* ---- geometry: 2D as it is; 3D projected, drawn far to near ---- */
+    double lo[2] = {box_lo[0], box_lo[1]}, hi[2] = {box_hi[0], box_hi[1]};
+    const double *x = dem_positions(s, 0), *y = dem_positions(s, 1), *r = dem_radii(s);
+    double *proj = NULL, box2[8][2];
+    depth_key *order = NULL;
+    size_t nshow = n;
+    if (D == 3) {
+        camera3 cam;
+        camera_setup(&def->camera, box_lo, box_hi, g, &cam);
+        proj = malloc((n ? n : 1) * 3 * sizeof *proj);
+        order = malloc((n ? n : 1) * sizeof *order);
+        if (!proj || !order) {
+            free(proj);
+            free(order);
+            free(val);
+            return core_fail(err, CORE_ERR_NOMEM, "render: out of memory");
+        }
+        const double *z = dem_positions(s, 2);
+        nshow = 0;
+        for (size_t i = 0; i < n; i++) {
+            double q[3] = {x[i], y[i], z[i]}, depth;
+            if (project(&cam, q, r[i], &proj[i], &proj[n + i], &proj[2 * n + i], &depth))
+                order[nshow++] = (depth_key){depth, i};
+        }
+        qsort(order, nshow, sizeof *order, far_first);
+        lo[0] = lo[1] = INFINITY;
+        hi[0] = hi[1] = -INFINITY;
+        for (int k = 0; k < 8; k++) {
+            double q[3] = {k & 1 ? box_hi[0] : box_lo[0], k & 2 ? box_hi[1] : box_lo[1],
+                           k & 4 ? box_hi[2] : box_lo[2]}, R, depth;
+            project(&cam, q, 0, &box2[k][0], &box2[k][1], &R, &depth);
+            for (int d = 0; d < 2; d++) {
+                lo[d] = fmin(lo[d], box2[k][d]);
+                hi[d] = fmax(hi[d], box2[k][d]);
+            }
+        }
+        x = proj;
+        y = proj + n;
+        r = proj + 2 * n;
+    }
+    const double hx = hi[0] - lo[0], hy = hi[1] - lo[1];
+
     /* ---- layout ---- */
     double fs = canvas_font_px(W, H ? H : W);
     int m = (int)lround(0.8 * fs);
-    int has_top = (def->title && *def->title) || (def->stamp && *def->stamp);
+    int has_top = (def->title && *def->title) || (def->stamp && *def->stamp) || def->arrows[0];
     int ay0 = m + (has_top ? (int)lround(1.7 * fs) : 0);
     int show_bar = mapped && def->colorbar;
     double ticks[16], step = 1;
@@ -183,6 +342,8 @@ core_status render_dem(render_context *rc, dem_scene *s, const render_grains_def
     int ax0 = m, ax1 = W - m - band;
     if (ax1 - ax0 < 4) {
         free(val);
+        free(proj);
+        free(order);
         return core_fail(err, CORE_ERR_ARG, "image width %d leaves no room for the scene", W);
     }
     if (!H) {
@@ -193,6 +354,8 @@ core_status render_dem(render_context *rc, dem_scene *s, const render_grains_def
     int ay1 = H - m;
     if (ay1 - ay0 < 4) {
         free(val);
+        free(proj);
+        free(order);
         return core_fail(err, CORE_ERR_ARG, "image height %d leaves no room for the scene", H);
     }
     double sc = fmin((ax1 - ax0) / hx, (ay1 - ay0) / hy);
@@ -225,7 +388,19 @@ core_status render_dem(render_context *rc, dem_scene *s, const render_grains_def
     if (st != CORE_OK) {
         free(chains.c);
         free(val);
+        free(proj);
+        free(order);
         return st;
+    }
+
+    /* ---- 3D: the box's edges behind the spheres ---- */
+    if (D == 3 && def->box) {
+        rgba8 bc = rgba(170, 170, 170, 255);
+        for (int a = 0; a < 8; a++)
+            for (int bit = 1; bit < 8; bit <<= 1)
+                if (!(a & bit))
+                    canvas_segment(rc, PX(box2[a][0]), PY(box2[a][1]), PX(box2[a | bit][0]),
+                                   PY(box2[a | bit][1]), 1, 1, bc);
     }
 
     /* ---- grains ---- */
@@ -234,17 +409,18 @@ core_status render_dem(render_context *rc, dem_scene *s, const render_grains_def
         mean_r += r[i];
     mean_r = n ? mean_r / n * sc : 1;
     const double span = range[1] - range[0];
-    for (size_t i = 0; i < n; i++) {
+    for (size_t k = 0; k < nshow; k++) {
+        size_t i = D == 3 ? order[k].i : k;
         unsigned char c[3];
         if (mapped)
             render_colormap_rgb(def->colormap, (val[i] - range[0]) / span, c);
         else
             render_label_rgb(def->color == RENDER_COLOR_LABELS ? def->labels[i] : (long)i, c);
         if (chains.n || def->force_chains) /* pale grains under the chains */
-            for (int k = 0; k < 3; k++)
-                c[k] = (unsigned char)(c[k] + (255 - c[k]) * 0.6);
+            for (int ch = 0; ch < 3; ch++)
+                c[ch] = (unsigned char)(c[ch] + (255 - c[ch]) * 0.6);
         double rp = r[i] * sc;
-        double edge = rp >= 3 ? fmin(1.2, 0.1 * rp) : 0;
+        double edge = D == 3 ? -1 : rp >= 3 ? fmin(1.2, 0.1 * rp) : 0;
         canvas_disk(rc, PX(x[i]), PY(y[i]), rp, edge, rgba(c[0], c[1], c[2], 255));
     }
 
@@ -279,6 +455,55 @@ core_status render_dem(render_context *rc, dem_scene *s, const render_grains_def
         }
     }
 
+    /* ---- arrows, with a reference arrow of a round length in the title band ---- */
+    if (def->arrows[0] && n) {
+        const double *ux = def->arrows[0], *uy = def->arrows[1];
+        double umax = 0;
+        for (size_t i = 0; i < n; i++)
+            if (isfinite(ux[i]) && isfinite(uy[i]))
+                umax = fmax(umax, hypot(ux[i], uy[i]));
+        double k = def->arrow_scale; /* scene metres per unit */
+        if (k == 0)
+            k = umax > 0 ? 3 * (mean_r / sc) / umax : 1;
+        rgba8 ac = rgba(190, 30, 30, 255);
+        double aw = fmin(3, fmax(1.2, 0.12 * mean_r));
+        for (size_t i = 0; i < n; i++) {
+            if (!isfinite(ux[i]) || !isfinite(uy[i]))
+                continue;
+            double len = hypot(ux[i], uy[i]) * k * sc;
+            if (len < 0.5)
+                continue;
+            double x0 = PX(x[i]), y0 = PY(y[i]);
+            double dx = ux[i] * k * sc / len, dy = -uy[i] * k * sc / len;
+            double x1 = x0 + dx * len, y1 = y0 + dy * len;
+            canvas_segment(rc, x0, y0, x1, y1, aw, 1, ac);
+            double hl = fmin(0.35 * len, fmax(3, 0.9 * mean_r)), c = 0.906, sn = 0.423; /* 25 deg */
+            canvas_segment(rc, x1, y1, x1 - hl * (c * dx - sn * dy), y1 - hl * (sn * dx + c * dy),
+                           aw, 1, ac);
+            canvas_segment(rc, x1, y1, x1 - hl * (c * dx + sn * dy), y1 - hl * (-sn * dx + c * dy),
+                           aw, 1, ac);
+        }
+        if (umax > 0) {
+            double ref = pow(10, floor(log10(umax)));
+            ref *= umax / ref >= 5 ? 5 : umax / ref >= 2 ? 2 : 1;
+            double len = ref * k * sc;
+            char label[64], num[48];
+            ticks_format(ref, ref, num, sizeof num);
+            snprintf(label, sizeof label, "%s m", num);
+            double tw = canvas_text_width(rc, label, fs);
+            double right = W - m - band -
+                           (def->stamp && *def->stamp ? canvas_text_width(rc, def->stamp, fs) + 2 * fs
+                                                      : 0);
+            double yb = ay0 - lround(0.45 * fs) - 0.35 * fs, x1 = right - tw - 0.5 * fs;
+            double x0 = x1 - len, hl = fmin(0.35 * len, fmax(3, 0.9 * mean_r));
+            canvas_segment(rc, x0, yb, x1, yb, aw, 1, ac);
+            canvas_segment(rc, x1, yb, x1 - hl * 0.906, yb - hl * 0.423, aw, 1, ac);
+            canvas_segment(rc, x1, yb, x1 - hl * 0.906, yb + hl * 0.423, aw, 1, ac);
+            canvas_text(rc, label, fs, right, ay0 - lround(0.45 * fs), 1, 1, 0,
+                        rgba(20, 20, 20, 255));
+        }
+    }
+
     /* ---- walls and box ---- */
     rgba8 wall_c = rgba(60, 60, 60, 255);
     double ww = fmax(2, lround(0.25 * fs));
@@ -295,7 +520,7 @@ core_status render_dem(render_context *rc, dem_scene *s, const render_grains_def
         canvas_segment(rc, PX(a[0]) + sx, PY(a[1]) + sy, PX(b[0]) + sx, PY(b[1]) + sy, ww, 1,
                        wall_c);
     }
-    if (def->box) {
+    if (D == 2 && def->box) {
         rgba8 bc = rgba(150, 150, 150, 255);
         double l = ox - 0.5, rt = ox + bw + 0.5, tp = oy - 0.5, bt = oy + bh + 0.5;
         canvas_segment(rc, l - 0.5, tp, rt + 0.5, tp, 1, 0, bc);
@@ -341,5 +566,7 @@ core_status render_dem(render_context *rc, dem_scene *s, const render_grains_def
 #undef PY
     free(chains.c);
     free(val);
+    free(proj);
+    free(order);
     return canvas_end(rc, out, err);
 }

@@ -39,37 +39,53 @@ static void decade_label(int e, char *buf, size_t size)
         strncat(buf, SUP[*d - '0'], size - strlen(buf) - 1);
 }
 
+/* Limits: the data range padded by 4% on each side (so markers at the extremes stay whole), in
+ * log10 units on a log axis. Ticks: decades on a log axis (1, 2, 5 steps when it spans less
+ * than two), nice linear steps otherwise. */
 static void axis_setup(axis *a, double mn, double mx)
 {
-    a->nminor = 0;
+    a->nminor = a->nticks = 0;
+    double span = mx - mn;
+    if (span <= 0)
+        span = a->log ? 1 : (mn != 0 ? 0.2 * fabs(mn) : 2);
+    if (mx == mn) {
+        mn -= 0.5 * span;
+        mx += 0.5 * span;
+    }
+    a->lim[0] = mn - 0.04 * span;
+    a->lim[1] = mx + 0.04 * span;
     if (a->log) {
-        double l0 = floor(mn + 1e-9), l1 = ceil(mx - 1e-9);
-        if (l1 <= l0)
-            l1 = l0 + 1;
-        a->lim[0] = l0;
-        a->lim[1] = l1;
-        int every = (int)ceil((l1 - l0) / 8);
-        a->nticks = 0;
-        for (double e = l0; e <= l1 + 1e-9 && a->nticks < 40; e += every) {
-            a->ticks[a->nticks] = e;
-            decade_label((int)e, a->labels[a->nticks], sizeof a->labels[0]);
-            a->nticks++;
+        double l0 = ceil(a->lim[0] - 1e-9), l1 = floor(a->lim[1] + 1e-9);
+        if (l1 - l0 >= 1) {
+            int every = (int)ceil((l1 - l0 + 1) / 9);
+            for (double e = l0; e <= l1 && a->nticks < 40; e += every) {
+                a->ticks[a->nticks] = e;
+                decade_label((int)e, a->labels[a->nticks], sizeof a->labels[0]);
+                a->nticks++;
+            }
+        } else {
+            static const int M[3] = {1, 2, 5};
+            for (double e = floor(a->lim[0]); e <= a->lim[1] && a->nticks < 40; e += 1)
+                for (int k = 0; k < 3 && a->nticks < 40; k++) {
+                    double v = log10(M[k]) + e;
+                    if (v < a->lim[0] || v > a->lim[1])
+                        continue;
+                    a->ticks[a->nticks] = v;
+                    ticks_format(M[k] * pow(10, e), pow(10, e), a->labels[a->nticks],
+                                 sizeof a->labels[0]);
+                    a->nticks++;
+                }
         }
-        if (l1 - l0 <= 6)
-            for (double e = l0; e < l1; e += 1)
-                for (int k = 2; k <= 9 && a->nminor < 80; k++)
-                    a->minor[a->nminor++] = e + log10(k);
+        if (a->lim[1] - a->lim[0] <= 6)
+            for (double e = floor(a->lim[0]); e <= a->lim[1]; e += 1)
+                for (int k = 2; k <= 9 && a->nminor < 80; k++) {
+                    double v = e + log10(k);
+                    if (v >= a->lim[0] && v <= a->lim[1])
+                        a->minor[a->nminor++] = v;
+                }
         return;
     }
-    if (mx == mn) {
-        double d = mn != 0 ? 0.1 * fabs(mn) : 1;
-        mn -= d;
-        mx += d;
-    }
     double step;
-    ticks_linear(mn, mx, 6, a->ticks, 40, &step);
-    a->lim[0] = floor(mn / step + 1e-9) * step;
-    a->lim[1] = ceil(mx / step - 1e-9) * step;
     a->nticks = ticks_linear(a->lim[0], a->lim[1], 6, a->ticks, 40, &step);
     for (int k = 0; k < a->nticks; k++)
         ticks_format(a->ticks[k], step, a->labels[k], sizeof a->labels[0]);
@@ -231,8 +247,31 @@ core_status render_plot(render_context *rc, const render_plot_def *def, render_i
     if (nl) {
         double sample = 2.2 * fs, pad = 0.6 * fs, rowh = lh;
         double bw = pad + sample + gap + lwid + pad, bh = 2 * pad + nl * rowh - (rowh - fs);
-        double x1 = floor(px[1] - 0.8 * fs) + 0.5, y0 = floor(py[1] + 0.8 * fs) + 0.5;
-        double x0 = floor(x1 - bw) + 0.5, y1 = floor(y0 + bh) + 0.5;
+        /* the frame corner whose box covers the fewest data points */
+        double inset = 0.8 * fs, best_x0 = 0, best_y0 = 0;
+        long best = -1;
+        for (int corner = 0; corner < 4; corner++) {
+            double cx0 = corner % 2 == 0 ? px[1] - inset - bw : px[0] + inset;
+            double cy0 = corner < 2 ? py[1] + inset : py[0] - inset - bh;
+            long count = 0;
+            for (int k = 0; k < def->nseries; k++)
+                for (size_t i = 0; i < def->series[k].n; i++) {
+                    double x = def->series[k].x[i], y = def->series[k].y[i];
+                    if (!isfinite(x) || !isfinite(y))
+                        continue;
+                    double X = map(&ax, def->xlog ? log10(x) : x, px);
+                    double Y = map(&ay, def->ylog ? log10(y) : y, py);
+                    count += X >= cx0 - mr && X <= cx0 + bw + mr && Y >= cy0 - mr &&
+                             Y <= cy0 + bh + mr;
+                }
+            if (best < 0 || count < best) {
+                best = count;
+                best_x0 = cx0;
+                best_y0 = cy0;
+            }
+        }
+        double x0 = floor(best_x0) + 0.5, y0 = floor(best_y0) + 0.5;
+        double x1 = floor(x0 + bw) + 0.5, y1 = floor(y0 + bh) + 0.5;
         canvas_rect(rc, x0, y0, x1, y1, rgba(255, 255, 255, 235));
         rgba8 edge = rgba(190, 190, 190, 255);
         canvas_segment(rc, x0 - 0.5, y0, x1 + 0.5, y0, 1, 0, edge);

@@ -58,7 +58,7 @@ void render_label_rgb(long id, unsigned char rgb[3]);
 typedef enum render_color_by {
     RENDER_COLOR_GRAIN,    /* well-separated colours by grain id */
     RENDER_COLOR_SPEED,    /* |v| through the colour map */
-    RENDER_COLOR_ROTATION, /* angular velocity omega_z (rad/s) through the colour map */
+    RENDER_COLOR_ROTATION, /* angular velocity omega_z (2D) or |omega| (3D), rad/s */
     RENDER_COLOR_VALUES,   /* def.values[i] through the colour map */
     RENDER_COLOR_LABELS    /* def.labels[i] as well-separated colours (materials, clusters) */
 } render_color_by;
@@ -67,19 +67,34 @@ typedef struct render_wall {
     double point[2], normal[2]; /* a line through point, normal into the domain */
 } render_wall;
 
+/* 3D scenes: the camera looks at the box's centre from the direction given by azimuth (degrees,
+ * around the up axis, which is opposite to gravity, or z without gravity) and elevation (degrees
+ * above the horizontal). Perspective: field of view fov (degrees, in (0, 90)), the camera as close
+ * as keeps the whole box in view. */
+typedef struct render_camera {
+    double azimuth, elevation;
+    bool perspective;
+    double fov;
+} render_camera;
+
 typedef struct render_grains_def {
     int width, height;          /* 0: width 1024, height from the box's aspect */
+    render_camera camera;       /* 3D only: default azimuth -60, elevation 25, orthographic */
     render_color_by color;
     const double *values;       /* RENDER_COLOR_VALUES: one per grain */
     const int *labels;          /* RENDER_COLOR_LABELS: one per grain */
     render_colormap colormap;
     double range[2];            /* colour-map limits; range[0] == range[1]: min and max of data */
-    bool force_chains;          /* segments between contacting centres, width and shade ~ fn */
-    bool rotation;              /* a radius line at each grain's orientation angle */
+    bool force_chains;          /* 2D: segments between contacting centres, width and shade ~ fn */
+    bool rotation;              /* 2D: a radius line at each grain's orientation angle */
     const double *angles;       /* orientation per grain (rad) for the markers; NULL: 0 */
     bool box;                   /* outline of the scene's box */
     bool colorbar;              /* colour bar with ticks (colour-map modes only) */
-    const render_wall *walls;   /* drawn as thick lines on their outer side */
+    const double *arrows[2];    /* 2D: a vector per grain (e.g. displacement, m) drawn as an arrow
+                                 * from its centre; NULL: none */
+    double arrow_scale;         /* arrow length per unit of vector; 0: the longest arrow is three
+                                 * mean radii. A reference arrow is drawn in the title band. */
+    const render_wall *walls;   /* 2D: drawn as thick lines on their outer side */
     int nwalls;
     const char *title;          /* UTF-8 or NULL, top left */
     const char *stamp;          /* UTF-8 or NULL, top right (e.g. "t = 0.125 s") */
@@ -88,7 +103,8 @@ typedef struct render_grains_def {
 
 render_grains_def render_default_grains_def(void); /* grain colours, viridis, box outline */
 
-/* Where the box landed: pixel = (x - lo) * scale + origin (y downwards from the top). */
+/* Where the box landed: pixel = (x - lo) * scale + origin (y downwards from the top). In 3D, x
+ * and y are the camera's image-plane coordinates (perspective: divided by the depth). */
 typedef struct render_view {
     double lo[2], hi[2];
     double scale;        /* pixels per metre */
@@ -96,7 +112,8 @@ typedef struct render_view {
     double range[2];     /* colour-map limits used */
 } render_view;
 
-/* Draws a 2D scene. Fails (CORE_ERR_ARG) on a 3D scene, a bad size or missing arrays. */
+/* Draws a scene: 2D disks, or 3D shaded spheres far to near (force chains, rotation markers and
+ * walls are 2D only). Fails (CORE_ERR_ARG) on a bad size, camera or missing arrays. */
 core_status render_dem(render_context *rc, dem_scene *s, const render_grains_def *def,
                        render_image *out, render_view *view, core_error *err);
 

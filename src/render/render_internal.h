@@ -15,8 +15,9 @@ core_status canvas_begin(render_context *rc, int w, int h, core_error *err);
 /* Finishes drawing and copies the pixels into out (allocated here). */
 core_status canvas_end(render_context *rc, render_image *out, core_error *err);
 
-/* A filled disk of radius r pixels; edge > 0 darkens a rim of that width. Disks below 0.7 px
- * are drawn at 0.7 px with their alpha reduced to keep the covered area. */
+/* A filled disk of radius r pixels; edge > 0 darkens a rim of that width; edge < 0 shades it as
+ * a sphere lit from the upper left. Disks below 0.7 px are drawn at 0.7 px with their alpha
+ * reduced to keep the covered area. */
 void canvas_disk(render_context *rc, double x, double y, double r, double edge, rgba8 c);
 /* A segment of full width w; round caps when round, else it ends exactly at its end points
  * (a rectangle when drawn along an axis). Widths below 1 px are drawn 1 px wide, fainter. */
