@@ -40,9 +40,10 @@ struct render_context {
     unsigned char *buf;    /* glReadPixels target */
     size_t buf_size;
     int w, h;
-    GLuint vao_disk, vao_seg, vao_text, corner_vbo, disk_vbo, seg_vbo, text_tex;
-    GLuint prog_disk, prog_seg, prog_text;
+    GLuint vao_disk, vao_seg, vao_text, corner_vbo, disk_vbo, seg_vbo, text_tex, pixels_tex;
+    GLuint prog_disk, prog_seg, prog_text, prog_pixels;
     GLint u_disk_view, u_seg_view, u_text_view, u_text_box, u_text_color, u_text_tex;
+    GLint u_pixels_view, u_pixels_box, u_pixels_tex;
     disk_inst *disks;
     size_t ndisks, cap_disks;
     seg_inst *segs;
@@ -161,6 +162,19 @@ static const char *TEXT_FS =
     "  frag = vec4(color.rgb, color.a * cov);\n"
     "}\n";
 
+/* Pixel blocks: the box's texels one to one (top row first), alpha 0 left out. */
+static const char *PIXELS_FS =
+    "#version 330 core\n"
+    "uniform vec4 box;\n"
+    "uniform sampler2D tex;\n"
+    "out vec4 frag;\n"
+    "void main() {\n"
+    "  ivec2 p = ivec2(floor(gl_FragCoord.xy - box.xy));\n"
+    "  vec4 c = texelFetch(tex, ivec2(p.x, int(box.w) - 1 - p.y), 0);\n"
+    "  if (c.a <= 0.0) discard;\n"
+    "  frag = c;\n"
+    "}\n";
+
 static GLuint compile(GLenum type, const char *src, core_error *err)
 {
     GLuint sh = glCreateShader(type);
@@ -225,7 +239,8 @@ static core_status setup_gl(render_context *rc, core_error *err)
 {
     if (!(rc->prog_disk = program(DISK_VS, DISK_FS, err)) ||
         !(rc->prog_seg = program(SEG_VS, SEG_FS, err)) ||
-        !(rc->prog_text = program(TEXT_VS, TEXT_FS, err)))
+        !(rc->prog_text = program(TEXT_VS, TEXT_FS, err)) ||
+        !(rc->prog_pixels = program(TEXT_VS, PIXELS_FS, err)))
         return err ? err->status : CORE_ERR_STATE;
     rc->u_disk_view = glGetUniformLocation(rc->prog_disk, "view");
     rc->u_seg_view = glGetUniformLocation(rc->prog_seg, "view");
@@ -233,6 +248,9 @@ static core_status setup_gl(render_context *rc, core_error *err)
     rc->u_text_box = glGetUniformLocation(rc->prog_text, "box");
     rc->u_text_color = glGetUniformLocation(rc->prog_text, "color");
     rc->u_text_tex = glGetUniformLocation(rc->prog_text, "tex");
+    rc->u_pixels_view = glGetUniformLocation(rc->prog_pixels, "view");
+    rc->u_pixels_box = glGetUniformLocation(rc->prog_pixels, "box");
+    rc->u_pixels_tex = glGetUniformLocation(rc->prog_pixels, "tex");
 
     static const float corners[8] = {-1, -1, 1, -1, -1, 1, 1, 1};
     glGenBuffers(1, &rc->corner_vbo);
@@ -261,6 +279,10 @@ static core_status setup_gl(render_context *rc, core_error *err)
     corner_attrib(rc->corner_vbo);
     glGenTextures(1, &rc->text_tex);
     glBindTexture(GL_TEXTURE_2D, rc->text_tex);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glGenTextures(1, &rc->pixels_tex); /* complete without mipmaps, as texelFetch needs */
+    glBindTexture(GL_TEXTURE_2D, rc->pixels_tex);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
     glBindVertexArray(0);
@@ -519,6 +541,34 @@ void canvas_rect(render_context *rc, double x0, double y0, double x1, double y1,
         y1 = t;
     }
     canvas_segment(rc, x0, 0.5 * (y0 + y1), x1, 0.5 * (y0 + y1), y1 - y0, 0, c);
+}
+
+void canvas_arrow(render_context *rc, double x0, double y0, double x1, double y1, double dx,
+                  double dy, double w, double hl, rgba8 c)
+{
+    const double cs = 0.906, sn = 0.423; /* cos and sin of 25 degrees */
+    canvas_segment(rc, x0, y0, x1, y1, w, 1, c);
+    canvas_segment(rc, x1, y1, x1 - hl * (cs * dx - sn * dy), y1 - hl * (sn * dx + cs * dy), w, 1,
+                   c);
+    canvas_segment(rc, x1, y1, x1 - hl * (cs * dx + sn * dy), y1 - hl * (-sn * dx + cs * dy), w,
+                   1, c);
+}
+
+void canvas_pixels(render_context *rc, int x, int y, int w, int h, const unsigned char *rgba)
+{
+    if (w < 1 || h < 1)
+        return;
+    flush(rc);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, rc->pixels_tex);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, w, h, 0, GL_RGBA, GL_UNSIGNED_BYTE, rgba);
+    glUseProgram(rc->prog_pixels);
+    glUniform2f(rc->u_pixels_view, (float)rc->w, (float)rc->h);
+    glUniform4f(rc->u_pixels_box, (float)x, (float)(rc->h - y - h), (float)w, (float)h);
+    glUniform1i(rc->u_pixels_tex, 0);
+    glBindVertexArray(rc->vao_text);
+    glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
 }
 
 /* ---- text ---------------------------------------------------------------------------------- */

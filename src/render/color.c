@@ -104,33 +104,22 @@ int ticks_linear(double lo, double hi, int target, double *ticks, int max, doubl
     return n;
 }
 
-void ticks_format(double v, double step, char *buf, size_t size)
+void ticks_format(double v, double step, double vmax, char *buf, size_t size)
 {
     char tmp[64];
-    double a = fabs(v);
+    vmax = fabs(vmax);
     if (v == 0) {
         snprintf(tmp, sizeof tmp, "0");
-    } else if (a >= 1e5 || a < 1e-3) {
-        /* mantissa digits enough to tell neighbours apart */
-        int digits = (int)floor(log10(a)) - (int)floor(log10(step));
+    } else if (vmax >= 1e5 || vmax < 1e-3) {
+        /* One exponent and one precision for the whole set (that of its largest value), with
+         * enough mantissa digits to tell neighbours apart: 2.0e6, 1.5e6, 1.0e6, 0.5e6. */
+        int e = (int)floor(log10(vmax));
+        int digits = e - (int)floor(log10(step));
         if (digits < 0)
             digits = 0;
         if (digits > 6)
             digits = 6;
-        snprintf(tmp, sizeof tmp, "%.*e", digits, v);
-        /* 1.5e-05 -> 1.5e-5 */
-        char *e = strchr(tmp, 'e');
-        if (e) {
-            char *d = e + 1;
-            int neg = *d == '-';
-            if (*d == '-' || *d == '+')
-                d++;
-            while (*d == '0' && d[1])
-                d++;
-            char exp[16];
-            snprintf(exp, sizeof exp, "e%s%s", neg ? "-" : "", d);
-            strcpy(e, exp);
-        }
+        snprintf(tmp, sizeof tmp, "%.*fe%d", digits, v / pow(10, e), e);
     } else {
         int dec = step >= 1 ? 0 : (int)ceil(-log10(step) - 1e-9);
         if (dec > 8)
@@ -142,4 +131,82 @@ void ticks_format(double v, double step, char *buf, size_t size)
         snprintf(buf, size, "\xe2\x88\x92%s", tmp + 1);
     else
         snprintf(buf, size, "%s", tmp);
+}
+
+/* ---- colour bars and reference arrows ------------------------------------------------------ */
+int colorbar_layout(render_context *rc, colorbar *cb, const double range[2], const char *label,
+                    double fs)
+{
+    cb->range[0] = range[0];
+    cb->range[1] = range[1];
+    cb->fs = fs;
+    cb->label = label;
+    cb->bar_w = (int)lround(1.1 * fs);
+    cb->gap = (int)lround(0.8 * fs);
+    cb->tick_len = (int)lround(0.35 * fs);
+    cb->lgap = (int)lround(0.3 * fs);
+    cb->maxlabel = 0;
+    cb->nticks = ticks_linear(range[0], range[1], 5, cb->ticks, 16, &cb->step);
+    double vmax = 0;
+    for (int k = 0; k < cb->nticks; k++)
+        vmax = fmax(vmax, fabs(cb->ticks[k]));
+    for (int k = 0; k < cb->nticks; k++) {
+        ticks_format(cb->ticks[k], cb->step, vmax, cb->labels[k], sizeof cb->labels[k]);
+        double tw = canvas_text_width(rc, cb->labels[k], fs);
+        cb->maxlabel = tw > cb->maxlabel ? tw : cb->maxlabel;
+    }
+    return cb->gap + cb->bar_w + cb->tick_len + cb->lgap + (int)ceil(cb->maxlabel) +
+           (label && *label ? (int)lround(0.5 * fs + 1.3 * fs) : 0);
+}
+
+/* One rectangle per pixel row, so the bar shows every colour the map has at this size. */
+void colorbar_draw(render_context *rc, const colorbar *cb, render_colormap map, double right,
+                   double top, double bottom)
+{
+    double bx0 = right + cb->gap, bx1 = bx0 + cb->bar_w;
+    double y0 = round(top), y1 = round(bottom);
+    int rows = (int)(y1 - y0);
+    for (int k = 0; k < rows; k++) {
+        unsigned char c[3];
+        render_colormap_rgb(map, 1 - (k + 0.5) / rows, c);
+        canvas_rect(rc, bx0, y0 + k, bx1, y0 + k + 1, rgba(c[0], c[1], c[2], 255));
+    }
+    rgba8 fc = rgba(80, 80, 80, 255), ink = rgba(20, 20, 20, 255);
+    canvas_segment(rc, bx0 - 1, y0 - 0.5, bx1 + 1, y0 - 0.5, 1, 0, fc);
+    canvas_segment(rc, bx0 - 1, y1 + 0.5, bx1 + 1, y1 + 0.5, 1, 0, fc);
+    canvas_segment(rc, bx0 - 0.5, y0, bx0 - 0.5, y1, 1, 0, fc);
+    canvas_segment(rc, bx1 + 0.5, y0, bx1 + 0.5, y1, 1, 0, fc);
+    const double span = cb->range[1] - cb->range[0];
+    for (int k = 0; k < cb->nticks; k++) {
+        double ty = y1 - (cb->ticks[k] - cb->range[0]) / span * rows;
+        ty = floor(ty) + 0.5;
+        canvas_segment(rc, bx1 + 1, ty, bx1 + 1 + cb->tick_len, ty, 1, 0, fc);
+        canvas_text(rc, cb->labels[k], cb->fs, bx1 + 1 + cb->tick_len + cb->lgap, ty, 0, 0.5, 0,
+                    ink);
+    }
+    if (cb->label && *cb->label)
+        canvas_text(rc, cb->label, cb->fs,
+                    bx1 + 1 + cb->tick_len + cb->lgap + cb->maxlabel + 0.5 * cb->fs,
+                    0.5 * (y0 + y1), 0.5, 0, 1, ink);
+}
+
+void reference_arrow(render_context *rc, double umax, double k, double sc, const char *unit,
+                     double right, double bottom, double fs, double w, double head, rgba8 c)
+{
+    if (!(umax > 0) || !isfinite(umax))
+        return;
+    double ref = pow(10, floor(log10(umax)));
+    ref *= umax / ref >= 5 ? 5 : umax / ref >= 2 ? 2 : 1;
+    double len = ref * k * sc;
+    char label[96], num[48];
+    ticks_format(ref, ref, ref, num, sizeof num);
+    if (unit && *unit)
+        snprintf(label, sizeof label, "%s %s", num, unit);
+    else
+        snprintf(label, sizeof label, "%s", num);
+    double tw = canvas_text_width(rc, label, fs);
+    double yb = bottom - 0.35 * fs, x1 = right - tw - 0.5 * fs;
+    double x0 = x1 - len, hl = fmin(0.35 * len, head);
+    canvas_arrow(rc, x0, yb, x1, yb, 1, 0, w, hl, c);
+    canvas_text(rc, label, fs, right, bottom, 1, 1, 0, rgba(20, 20, 20, 255));
 }

@@ -321,24 +321,9 @@ core_status render_dem(render_context *rc, dem_scene *s, const render_grains_def
     int has_top = (def->title && *def->title) || (def->stamp && *def->stamp) || def->arrows[0];
     int ay0 = m + (has_top ? (int)lround(1.7 * fs) : 0);
     int show_bar = mapped && def->colorbar;
-    double ticks[16], step = 1;
-    int nticks = 0;
-    char labels[16][64];
     const char *bar_label = def->colorbar_label ? def->colorbar_label : COLOR_LABELS[def->color];
-    int bar_w = (int)lround(1.1 * fs), gap = (int)lround(0.8 * fs);
-    int tick_len = (int)lround(0.35 * fs), lgap = (int)lround(0.3 * fs);
-    double maxlabel = 0;
-    int band = 0;
-    if (show_bar) {
-        nticks = ticks_linear(range[0], range[1], 5, ticks, 16, &step);
-        for (int k = 0; k < nticks; k++) {
-            ticks_format(ticks[k], step, labels[k], sizeof labels[k]);
-            double tw = canvas_text_width(rc, labels[k], fs);
-            maxlabel = tw > maxlabel ? tw : maxlabel;
-        }
-        band = gap + bar_w + tick_len + lgap + (int)ceil(maxlabel) +
-               (bar_label && *bar_label ? (int)lround(0.5 * fs + 1.3 * fs) : 0);
-    }
+    colorbar bar;
+    int band = show_bar ? colorbar_layout(rc, &bar, range, bar_label, fs) : 0;
     int ax0 = m, ax1 = W - m - band;
     if (ax1 - ax0 < 4) {
         free(val);
@@ -476,32 +461,14 @@ core_status render_dem(render_context *rc, dem_scene *s, const render_grains_def
             double x0 = PX(x[i]), y0 = PY(y[i]);
             double dx = ux[i] * k * sc / len, dy = -uy[i] * k * sc / len;
             double x1 = x0 + dx * len, y1 = y0 + dy * len;
-            canvas_segment(rc, x0, y0, x1, y1, aw, 1, ac);
-            double hl = fmin(0.35 * len, fmax(3, 0.9 * mean_r)), c = 0.906, sn = 0.423; /* 25 deg */
-            canvas_segment(rc, x1, y1, x1 - hl * (c * dx - sn * dy), y1 - hl * (sn * dx + c * dy),
-                           aw, 1, ac);
-            canvas_segment(rc, x1, y1, x1 - hl * (c * dx + sn * dy), y1 - hl * (-sn * dx + c * dy),
-                           aw, 1, ac);
+            canvas_arrow(rc, x0, y0, x1, y1, dx, dy, aw, fmin(0.35 * len, fmax(3, 0.9 * mean_r)),
+                         ac);
         }
-        if (umax > 0) {
-            double ref = pow(10, floor(log10(umax)));
-            ref *= umax / ref >= 5 ? 5 : umax / ref >= 2 ? 2 : 1;
-            double len = ref * k * sc;
-            char label[64], num[48];
-            ticks_format(ref, ref, num, sizeof num);
-            snprintf(label, sizeof label, "%s m", num);
-            double tw = canvas_text_width(rc, label, fs);
-            double right = W - m - band -
-                           (def->stamp && *def->stamp ? canvas_text_width(rc, def->stamp, fs) + 2 * fs
-                                                      : 0);
-            double yb = ay0 - lround(0.45 * fs) - 0.35 * fs, x1 = right - tw - 0.5 * fs;
-            double x0 = x1 - len, hl = fmin(0.35 * len, fmax(3, 0.9 * mean_r));
-            canvas_segment(rc, x0, yb, x1, yb, aw, 1, ac);
-            canvas_segment(rc, x1, yb, x1 - hl * 0.906, yb - hl * 0.423, aw, 1, ac);
-            canvas_segment(rc, x1, yb, x1 - hl * 0.906, yb + hl * 0.423, aw, 1, ac);
-            canvas_text(rc, label, fs, right, ay0 - lround(0.45 * fs), 1, 1, 0,
-                        rgba(20, 20, 20, 255));
-        }
+        double right = W - m - band -
+                       (def->stamp && *def->stamp ? canvas_text_width(rc, def->stamp, fs) + 2 * fs
+                                                  : 0);
+        reference_arrow(rc, umax, k, sc, "m", right, ay0 - lround(0.45 * fs), fs, aw,
+                        fmax(3, 0.9 * mean_r), ac);
     }
 
     /* ---- walls and box ---- */
@@ -537,31 +504,8 @@ core_status render_dem(render_context *rc, dem_scene *s, const render_grains_def
     if (def->stamp && *def->stamp)
         canvas_text(rc, def->stamp, fs, W - m - band, ty, 1, 1, 0, ink);
 
-    /* ---- colour bar: one rectangle per pixel row ---- */
-    if (show_bar) {
-        double bx0 = ox + bw + gap, bx1 = bx0 + bar_w;
-        double y0 = round(oy), y1 = round(oy + bh);
-        int rows = (int)(y1 - y0);
-        for (int k = 0; k < rows; k++) {
-            unsigned char c[3];
-            render_colormap_rgb(def->colormap, 1 - (k + 0.5) / rows, c);
-            canvas_rect(rc, bx0, y0 + k, bx1, y0 + k + 1, rgba(c[0], c[1], c[2], 255));
-        }
-        rgba8 fc = rgba(80, 80, 80, 255);
-        canvas_segment(rc, bx0 - 1, y0 - 0.5, bx1 + 1, y0 - 0.5, 1, 0, fc);
-        canvas_segment(rc, bx0 - 1, y1 + 0.5, bx1 + 1, y1 + 0.5, 1, 0, fc);
-        canvas_segment(rc, bx0 - 0.5, y0, bx0 - 0.5, y1, 1, 0, fc);
-        canvas_segment(rc, bx1 + 0.5, y0, bx1 + 0.5, y1, 1, 0, fc);
-        for (int k = 0; k < nticks; k++) {
-            double ty_ = y1 - (ticks[k] - range[0]) / span * rows;
-            ty_ = floor(ty_) + 0.5;
-            canvas_segment(rc, bx1 + 1, ty_, bx1 + 1 + tick_len, ty_, 1, 0, fc);
-            canvas_text(rc, labels[k], fs, bx1 + 1 + tick_len + lgap, ty_, 0, 0.5, 0, ink);
-        }
-        if (bar_label && *bar_label)
-            canvas_text(rc, bar_label, fs, bx1 + 1 + tick_len + lgap + maxlabel + 0.5 * fs,
-                        0.5 * (y0 + y1), 0.5, 0, 1, ink);
-    }
+    if (show_bar)
+        colorbar_draw(rc, &bar, def->colormap, ox + bw, oy, oy + bh);
 #undef PX
 #undef PY
     free(chains.c);

@@ -71,8 +71,8 @@ static void axis_setup(axis *a, double mn, double mx)
                     if (v < a->lim[0] || v > a->lim[1])
                         continue;
                     a->ticks[a->nticks] = v;
-                    ticks_format(M[k] * pow(10, e), pow(10, e), a->labels[a->nticks],
-                                 sizeof a->labels[0]);
+                    ticks_format(M[k] * pow(10, e), pow(10, e), M[k] * pow(10, e),
+                                 a->labels[a->nticks], sizeof a->labels[0]);
                     a->nticks++;
                 }
         }
@@ -87,8 +87,11 @@ static void axis_setup(axis *a, double mn, double mx)
     }
     double step;
     a->nticks = ticks_linear(a->lim[0], a->lim[1], 6, a->ticks, 40, &step);
+    double vmax = 0;
     for (int k = 0; k < a->nticks; k++)
-        ticks_format(a->ticks[k], step, a->labels[k], sizeof a->labels[0]);
+        vmax = fmax(vmax, fabs(a->ticks[k]));
+    for (int k = 0; k < a->nticks; k++)
+        ticks_format(a->ticks[k], step, vmax, a->labels[k], sizeof a->labels[0]);
 }
 
 static double map(const axis *a, double v, const double px[2])

@@ -3,7 +3,9 @@
  *
  * Usage: create one render_context and reuse it (it holds the GL context, the shaders and the
  * font); fill a render_grains_def from render_default_grains_def() and call render_dem, or a
- * render_plot_def for render_plot; write the image with render_write_png. The same input gives
+ * render_plot_def for render_plot, a render_field_def for render_field (grid fields of MPM and
+ * DSMC), a render_points_def for render_points (point clouds); write the image with
+ * render_write_png. The same input gives
  * the same pixels on the same machine. Nothing here knows about Lua. */
 #ifndef GRAINLAB_RENDER_H
 #define GRAINLAB_RENDER_H
@@ -116,6 +118,68 @@ typedef struct render_view {
  * walls are 2D only). Fails (CORE_ERR_ARG) on a bad size, camera or missing arrays. */
 core_status render_dem(render_context *rc, dem_scene *s, const render_grains_def *def,
                        render_image *out, render_view *view, core_error *err);
+
+/* ---- grid fields (MPM, DSMC) ------------------------------------------------------------------
+ * nx x ny cells over the rectangle extent, cell-centred: cell (i, j) covers
+ * [x0 + i dx, x0 + (i + 1) dx] x [y0 + j dy, y0 + (j + 1) dy] and is element j * nx + i of the
+ * arrays (row-major, the first row at the bottom, y = y0). Each pixel takes the colour of the cell
+ * its centre falls in (RENDER_NEAREST), or the bilinear interpolation between the centres of the
+ * four nearest cells with values, clamped at the edges (RENDER_BILINEAR). A cell without a value
+ * (NaN, or mask 0) shows the background in its whole area, in both modes. Arrows shorter than
+ * two line widths are left out. */
+typedef enum render_interp { RENDER_NEAREST, RENDER_BILINEAR } render_interp;
+
+typedef struct render_field_def {
+    int width, height;          /* 0: width 1024, height from the extent's aspect */
+    int nx, ny;                 /* cells along x and y, >= 1 */
+    double extent[2][2];        /* {{x0, y0}, {x1, y1}} with x1 > x0, y1 > y0 */
+    const double *values;       /* nx * ny; NULL: no colours (arrows only) */
+    const unsigned char *mask;  /* NULL, or nx * ny flags: 0 hides the cell */
+    const unsigned char *background; /* NULL, or the RGB of cells without a value (NULL: the
+                                      * page's white; with RENDER_GRAY white reads as large) */
+    render_interp interp;
+    render_colormap colormap;   /* principal stress difference: RENDER_GRAY (white = large) */
+    double range[2];            /* colour-map limits; range[0] == range[1]: min and max of data */
+    bool colorbar;              /* with ticks and colorbar_label (when there are values) */
+    bool box;                   /* outline of the extent */
+    const double *arrows[2];    /* NULL, or nx * ny vector components (u, v) drawn as arrows from
+                                 * the cell centres; NaN or hidden cells: none */
+    double arrow_scale;         /* scene length per unit of vector; 0: the longest arrow is 0.9 of
+                                 * the arrow spacing. A reference arrow sits in the title band. */
+    int arrow_every;            /* an arrow every k-th cell along x and y; 0: k such that arrows
+                                 * are at least 1.5 font sizes apart */
+    const char *arrow_unit;     /* after the reference arrow's value ("m/s"); NULL: none */
+    const char *title, *stamp, *colorbar_label; /* UTF-8 or NULL */
+} render_field_def;
+
+render_field_def render_default_field_def(void); /* nearest, viridis, colour bar, box */
+
+/* view: as for render_dem (lo, hi = the extent). Fails (CORE_ERR_ARG) on a bad size, grid,
+ * extent, range or scale, or with neither values nor arrows. */
+core_status render_field(render_context *rc, const render_field_def *def, render_image *out,
+                         render_view *view, core_error *err);
+
+/* ---- point clouds (material points, DSMC particles) ------------------------------------------ */
+typedef struct render_points_def {
+    int width, height;          /* 0: width 1024, height from the extent's aspect */
+    const double *x, *y;        /* positions (scene units); non-finite ones are not drawn */
+    size_t n;
+    const double *values;       /* NULL: one colour; else through the colour map (NaN: grey) */
+    render_colormap colormap;
+    double range[2];            /* colour-map limits; range[0] == range[1]: min and max of data */
+    double size;                /* diameter in pixels (anti-aliased disks); 0: 4 */
+    double extent[2][2];        /* the scene's rectangle; x1 <= x0 or y1 <= y0 (the default):
+                                 * the points' bounding box padded by 2%. Points whose centre lies
+                                 * outside are not drawn. */
+    bool colorbar, box;
+    const char *title, *stamp, *colorbar_label;
+} render_points_def;
+
+render_points_def render_default_points_def(void); /* viridis, 4 px, colour bar, box */
+
+/* Points are drawn in input order (later ones on top). view: as for render_dem. */
+core_status render_points(render_context *rc, const render_points_def *def, render_image *out,
+                          render_view *view, core_error *err);
 
 /* ---- line plots ---------------------------------------------------------------------------- */
 typedef enum render_plot_style { RENDER_LINE, RENDER_POINTS, RENDER_BOTH } render_plot_style;

@@ -24,6 +24,13 @@ void canvas_disk(render_context *rc, double x, double y, double r, double edge, 
 void canvas_segment(render_context *rc, double x0, double y0, double x1, double y1, double w,
                     int round, rgba8 c);
 void canvas_rect(render_context *rc, double x0, double y0, double x1, double y1, rgba8 c);
+/* An arrow from (x0, y0) to (x1, y1) along the unit vector (dx, dy): a round-capped shaft of
+ * width w and a head of two strokes of length hl at 25 degrees to it. */
+void canvas_arrow(render_context *rc, double x0, double y0, double x1, double y1, double dx,
+                  double dy, double w, double hl, rgba8 c);
+/* A block of w x h pixels (RGBA, top row first) copied with its top-left corner on the whole
+ * pixel (x, y); pixels of alpha 0 leave the canvas as it is. Exact: no filtering. */
+void canvas_pixels(render_context *rc, int x, int y, int w, int h, const unsigned char *rgba);
 
 /* Text of pixel size px anchored at (x, y): ha 0 left, 0.5 centre, 1 right of the advance box;
  * va 0 top, 0.5 middle, 1 bottom of the ascent-descent box. vertical: rotated 90 degrees
@@ -38,7 +45,30 @@ double canvas_font_px(int width, int height);
 /* Up to max "nice" ticks (1, 2, 5 x 10^k steps) inside [lo, hi]; returns their number. */
 int ticks_linear(double lo, double hi, int target, double *ticks, int max, double *step);
 /* A tick label for v on a grid of spacing step ("0.25", "1.5e-05", "−3"). */
-void ticks_format(double v, double step, char *buf, size_t size);
+/* Tick label for v in a set of ticks `step` apart whose largest magnitude is vmax (labels of one
+ * set share their notation, exponent and precision). */
+void ticks_format(double v, double step, double vmax, char *buf, size_t size);
+
+/* A vertical colour bar with ticks and a rotated label, right of a scene (grains, fields, points). */
+typedef struct colorbar {
+    double range[2], fs, step, maxlabel;
+    double ticks[16];
+    char labels[16][64];
+    int nticks, bar_w, gap, tick_len, lgap;
+    const char *label;
+} colorbar;
+/* Ticks and labels for range at font size fs; returns the width of the band it needs right of
+ * the scene (gap, bar, ticks, labels and the label). */
+int colorbar_layout(render_context *rc, colorbar *cb, const double range[2], const char *label,
+                    double fs);
+/* Draws the bar gap pixels right of column right, from row top to row bottom (rounded). */
+void colorbar_draw(render_context *rc, const colorbar *cb, render_colormap map, double right,
+                   double top, double bottom);
+/* A reference arrow of a round length (1, 2 or 5 x 10^k, at most umax) for arrows drawn k * sc
+ * pixels per unit, followed by its value and unit ("0.02 m"; unit may be NULL) right-aligned at
+ * column right, the text's box ending at row bottom; head: the head length's upper limit. */
+void reference_arrow(render_context *rc, double umax, double k, double sc, const char *unit,
+                     double right, double bottom, double fs, double w, double head, rgba8 c);
 
 static inline rgba8 rgba(unsigned char r, unsigned char g, unsigned char b, unsigned char a)
 {

@@ -197,4 +197,144 @@ do
   end
   check.ge(rows, 55, "the scene's wall at x = 0.035 is drawn without opts.walls")
 end
+-- ---- grid fields and point clouds on plain arrays (MPM, DSMC) ----------------------------------
+do
+  local fdir = os.tmpname()
+  os.remove(fdir)
+  assert(os.execute("mkdir -p '" .. fdir .. "'"))
+  local function ls()
+    local p = io.popen("ls -A '" .. fdir .. "'")
+    local list = {}
+    for name in p:lines() do list[#list + 1] = name end
+    p:close()
+    table.sort(list)
+    return table.concat(list, " ")
+  end
+  -- 4 x 2 cells over [0, 4] x [0, 2], value i + 4 j (first row at the bottom), grey: white = large
+  local flat = { 0, 1, 2, 3, 4, 5, 6, 7 }
+  local rows = { { 0, 1, 2, 3 }, { 4, 5, 6, 7 } }
+  local opts = { values = flat, nx = 4, ny = 2, extent = { { 0, 0 }, { 4, 2 } }, colormap = "gray",
+                 width = 200, height = 120, colorbar = false, box = false }
+  local a = render.field(opts)
+  opts.values, opts.nx, opts.ny = rows, nil, nil
+  local b = render.field(opts)
+  local W, H = a:size()
+  local same = true
+  for y = 1, H, 3 do for x = 1, W, 3 do
+    local r1, g1, b1 = a:pixel(x, y)
+    local r2, g2, b2 = b:pixel(x, y)
+    same = same and r1 == r2 and g1 == g2 and b1 == b2
+  end end
+  check.is_true(same, "a flat array and an array of rows draw the same field")
+  -- margins 7 px (font 9), scale min(186 / 4, 106 / 2) = 46.5 px per unit, centred: column of
+  -- cell 3 (x in [3, 4]) ends at the right margin, the top row (j = 1) at the top
+  local ox, oy = math.floor(7 + (186 - 4 * 46.5) / 2 + 0.5), math.floor(7 + (106 - 2 * 46.5) / 2 + 0.5)
+  local function cell(im, i, j)
+    return im:pixel(ox + math.floor((i + 0.5) * 46.5) + 1, oy + math.floor((2 - j - 0.5) * 46.5) + 1)
+  end
+  check.eq(cell(a, 3, 1), 255, "largest value white")
+  check.eq(cell(a, 0, 0), 0, "smallest value black")
+  check.gt(cell(a, 2, 1), cell(a, 1, 1), "grey grows with the value")
+  check.gt(cell(a, 1, 1), cell(a, 3, 0), "the top row holds the larger values")
+  -- NaN and masked cells show the background
+  local nan = { 0, 0 / 0, 2, 3, 4, 5, 6, 7 }
+  local c = render.field{ values = nan, nx = 4, ny = 2, extent = { { 0, 0 }, { 4, 2 } }, width = 200, height = 120,
+                          colorbar = false, box = false, mask = { true, true, true, true, true, true, false, true },
+                          background = { 0, 0, 255 } }
+  check.eq(select(3, cell(c, 1, 0)), 255, "NaN cell: background blue")
+  check.eq(select(1, cell(c, 1, 0)), 0, "NaN cell: background blue, no red")
+  check.eq(select(3, cell(c, 2, 1)), 255, "masked cell: background")
+  -- arrows only: a uniform field to the right draws red ink right of a cell centre
+  local u, v = {}, {}
+  for k = 1, 25 do u[k], v[k] = 1, 0 end
+  local d = render.field{ nx = 5, ny = 5, extent = { { 0, 0 }, { 1, 1 } }, arrows = { u = u, v = v, scale = 0.1, every = 1 },
+                          width = 200, height = 200 }
+  local red = 0
+  for y = 1, 200 do for x = 1, 200 do
+    local r, g, bb = d:pixel(x, y)
+    if r > 150 and g < 80 and bb < 80 then red = red + 1 end
+  end end
+  check.gt(red, 25 * 10, "arrow ink")
+  -- a point lights its pixel; files, patterns and identical bytes
+  local p = render.points{ x = { 0.25 }, y = { 0.75 }, values = { 1 }, range = { 0, 1 }, size = 10,
+                           extent = { { 0, 0 }, { 1, 1 } }, width = 100, height = 100, colorbar = false }
+  -- scale 86 px per unit from (7, 7): the point at pixel (7 + 21.5, 7 + 21.5)
+  local r, g, bb = p:pixel(29, 29)
+  check.near_abs(r, 0xfd, 2, "point: viridis(1) red")
+  check.near_abs(bb, 0x25, 2, "point: viridis(1) blue")
+  check.eq(select(1, p:pixel(40, 29)), 255, "beside the point")
+  local big = {}
+  for k = 1, 300 do big[k] = math.sin(k) end
+  local fopts = { file = fdir .. "/f.png", values = big, nx = 20, ny = 15, title = "field", label = "s",
+                  interpolation = "bilinear", arrows = { u = big, v = big, unit = "m/s" } }
+  check.eq(render.field(fopts), fdir .. "/f.png", "field returns the file name")
+  fopts.file = fdir .. "/g.png"
+  render.field(fopts)
+  local function read(path) local f = assert(io.open(path, "rb")); local s = f:read("a"); f:close(); return s end
+  check.is_true(read(fdir .. "/f.png") == read(fdir .. "/g.png"), "identical field PNGs")
+  check.eq(render.points{ file = fdir .. "/p_%02d.png", x = big, y = big }, fdir .. "/p_00.png", "points frame pattern")
+  check.eq(render.points{ file = fdir .. "/p_%02d.png", x = big, y = big, frame = 7 }, fdir .. "/p_07.png", "given frame")
+
+  local function fbad(o, text, what) check.errors(function() render.field(o) end, text, what) end
+  local function pbad(o, text, what) check.errors(function() render.points(o) end, text, what) end
+  local out = fdir .. "/bad.png"
+  fbad({ file = out, values = flat, nx = 0, ny = 2 },
+    "bad field 'nx' in argument #1 to 'field' (positive integer expected, got 0)", "nx zero")
+  fbad({ file = out, values = flat, nx = 4 },
+    "bad field 'ny' in argument #1 to 'field' (positive integer (with a flat array of cells) expected, got nil)", "ny missing")
+  fbad({ file = out, values = flat, nx = 3, ny = 2 },
+    "bad field 'values' in argument #1 to 'field' (nx * ny = 6 numbers expected, got 8)", "flat length")
+  fbad({ file = out, values = { { 1, 2 }, { 3 } } },
+    "bad field 'values' in argument #1 to 'field' (rows of 2 numbers expected, got 1 at row 2)", "ragged rows")
+  fbad({ file = out, values = rows, nx = 3 },
+    "bad field 'values' in argument #1 to 'field' (rows of 3 entries expected, got 4 at row 1)", "rows against nx")
+  fbad({ file = out, values = { 1, "x", 3, 4 }, nx = 2, ny = 2 },
+    "bad field 'values' in argument #1 to 'field' (numbers (NaN for no value) expected, got 'x' at entry 2)", "a string")
+  fbad({ file = out, values = { 1, 2, 1 / 0, 4 }, nx = 2, ny = 2 },
+    "bad field 'values' in argument #1 to 'field' (numbers (NaN for no value) expected, got inf at entry 3)", "infinity")
+  fbad({ file = out, nx = 2, ny = 2 },
+    "bad field 'values' in argument #1 to 'field' (array of numbers, or array of rows (or arrows) expected, got nil)", "nothing")
+  fbad({ file = out, values = rows, mask = { { true, 1, true, true }, { true, true, true, true } } },
+    "bad field 'mask' in argument #1 to 'field' (booleans expected, got 1 at row 1, entry 2)", "mask")
+  fbad({ file = out, values = rows, extent = { { 0, 0 }, { 0, 1 } } },
+    "bad field 'extent' in argument #1 to 'field' ({{x0, y0}, {x1, y1}} with x0 < x1 and y0 < y1 expected, got table)", "extent")
+  fbad({ file = out, values = rows, range = { 1, 1 } },
+    "bad field 'range' in argument #1 to 'field' ({lo, hi} with lo < hi expected, got table)", "range")
+  fbad({ file = out, values = rows, colormap = "jet" },
+    "bad field 'colormap' in argument #1 to 'field' (one of 'viridis', 'gray' expected, got 'jet')", "colormap")
+  fbad({ file = out, values = rows, interpolation = "cubic" },
+    "bad field 'interpolation' in argument #1 to 'field' (one of 'nearest', 'bilinear' expected, got 'cubic')", "interpolation")
+  fbad({ file = out, values = rows, width = 8 },
+    "bad field 'width' in argument #1 to 'field' (integer in [16, 8192] expected, got 8)", "width")
+  fbad({ file = out, values = rows, background = { 0, 0, 300 } },
+    "bad field 'background' in argument #1 to 'field' ({r, g, b} with integers in [0, 255] expected, got table)", "background")
+  fbad({ file = out, values = rows, colour = "gray" },
+    "bad argument #1 to 'field' (unknown field 'colour'; valid fields:", "unknown field")
+  fbad({ file = out, values = rows, arrows = { u = rows } },
+    "bad field 'arrows.v' in argument #1 to 'field' (array of numbers, or array of rows expected, got nil)", "arrows without v")
+  fbad({ file = out, values = rows, arrows = { u = rows, v = rows, scale = 0 } },
+    "bad field 'arrows.scale' in argument #1 to 'field' (positive number expected, got 0)", "arrow scale")
+  fbad({ file = out, values = rows, arrows = { u = rows, v = rows, every = 0 } },
+    "bad field 'arrows.every' in argument #1 to 'field' (positive integer expected, got 0)", "arrow spacing")
+  fbad({ file = out, values = rows, arrows = { u = rows, v = rows, w = rows } },
+    "bad field 'arrows' in argument #1 to 'field' (unknown key 'w'; valid keys: u, v, scale, every, unit)", "arrow key")
+  fbad({ file = out, values = rows, arrows = { u = { { 1 } }, v = rows } },
+    "bad field 'arrows.u' in argument #1 to 'field' (2 rows expected, got 1 rows)", "arrows shape")
+  fbad({ file = fdir .. "/missing/f.png", values = rows }, "field: cannot write '" .. fdir .. "/missing/f.png'", "field path")
+  fbad("x", "bad argument #1 to 'field' (table expected, got string)", "not a table")
+  pbad({ file = out, x = { 1, 2 }, y = { 1 } },
+    "bad field 'y' in argument #1 to 'points' (array as long as x (2) expected, got table)", "lengths")
+  pbad({ file = out, x = { 1, 0 / 0 }, y = { 1, 2 } },
+    "bad field 'x' in argument #1 to 'points' (finite numbers expected, got", "NaN position")
+  pbad({ file = out, x = { 1 }, y = { 1 }, size = 0 },
+    "bad field 'size' in argument #1 to 'points' (diameter in (0, 8192] pixels expected, got 0)", "size")
+  pbad({ file = out, x = { 1 }, y = { 1 }, values = { 1, 2 } },
+    "bad field 'values' in argument #1 to 'points' (array as long as x (1) expected, got table)", "values length")
+  pbad({ file = out, y = { 1 } }, "bad field 'x' in argument #1 to 'points' (array of finite numbers expected, got nil)", "no x")
+  pbad({ file = out, x = { 1 }, y = { 1 }, height = 100000 },
+    "bad field 'height' in argument #1 to 'points' (integer in [16, 8192] expected, got 100000)", "height")
+  pbad({ file = out, x = { 1 }, y = { 1 }, extent = { 0, 1 } }, "bad field 'extent' in argument #1 to 'points'", "extent")
+  check.eq(ls(), "f.png g.png p_00.png p_07.png", "no file from failed calls")
+  os.execute("rm -rf '" .. fdir .. "'")
+end
 check.done()

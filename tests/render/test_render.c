@@ -1,6 +1,7 @@
 /* The renderer at pixel level, without Lua: disk area from anti-aliased coverage, colour maps
  * against matplotlib's values, plot axes and a data point where the axes say, identical renders,
- * text inside its box, and refused sizes, scenes and paths that leave no file behind. */
+ * text inside its box, grid fields (cell colours, no-value cells, bilinear, arrows) and point
+ * clouds, and refused sizes, scenes, grids and paths that leave no file behind. */
 #define _POSIX_C_SOURCE 200809L
 #include <dirent.h>
 #include <math.h>
@@ -398,13 +399,279 @@ static void test_errors(void **state)
     assert_int_equal(render_plot(rc, &pd, &img, NULL, &err), CORE_ERR_ARG); /* no series */
 }
 
+/* ---- grid fields and point clouds ---------------------------------------------------------- */
+/* The pixel at the centre of cell (i, j) of a field drawn with view. */
+static const unsigned char *cell_px(const render_image *img, const render_view *v, int nx, int ny,
+                                    int i, int j)
+{
+    double dx = (v->hi[0] - v->lo[0]) / nx, dy = (v->hi[1] - v->lo[1]) / ny;
+    int x = (int)floor(v->origin[0] + (i + 0.5) * dx * v->scale);
+    int y = (int)floor(v->origin[1] + (ny - j - 0.5) * dy * v->scale);
+    return px(img, x, y);
+}
+
+/* A 4 x 2 gradient (value i + 4 j, first row at the bottom) in grey: each cell's centre pixel has
+ * exactly the colour map's colour, the largest value is white; NaN and masked cells show the
+ * background; bilinear interpolation halfway between two cell centres gives their mean. */
+static void test_field_cells(void **state)
+{
+    (void)state;
+    double values[8];
+    for (int k = 0; k < 8; k++)
+        values[k] = k;
+    render_field_def def = render_default_field_def();
+    def.width = 400;
+    def.nx = 4;
+    def.ny = 2;
+    def.extent[0][0] = -1;
+    def.extent[1][0] = 3;
+    def.extent[1][1] = 2; /* square cells */
+    def.values = values;
+    def.colormap = RENDER_GRAY;
+    def.range[1] = 7;
+    render_image img;
+    render_view view;
+    core_error err;
+    assert_int_equal(render_field(rc, &def, &img, &view, &err), CORE_OK);
+    assert_true(view.range[0] == 0 && view.range[1] == 7);
+    for (int j = 0; j < 2; j++)
+        for (int i = 0; i < 4; i++) {
+            unsigned char c[3];
+            render_colormap_rgb(RENDER_GRAY, (i + 4 * j) / 7.0, c);
+            char what[32];
+            snprintf(what, sizeof what, "cell (%d, %d)", i, j);
+            near_rgb(cell_px(&img, &view, 4, 2, i, j), c[0], c[1], c[2], 0, what);
+        }
+    near_rgb(cell_px(&img, &view, 4, 2, 3, 1), 255, 255, 255, 0, "largest value is white");
+    near_rgb(cell_px(&img, &view, 4, 2, 0, 0), 0, 0, 0, 0, "smallest value is black");
+    render_image_free(&img);
+
+    /* no value: NaN, or masked; the page's white, or the background given */
+    unsigned char mask[8] = {1, 1, 1, 1, 1, 1, 0, 1}, bg[3] = {10, 200, 30};
+    values[1] = NAN;
+    def.mask = mask;
+    def.colormap = RENDER_VIRIDIS;
+    assert_int_equal(render_field(rc, &def, &img, &view, &err), CORE_OK);
+    near_rgb(cell_px(&img, &view, 4, 2, 1, 0), 255, 255, 255, 0, "NaN cell");
+    near_rgb(cell_px(&img, &view, 4, 2, 2, 1), 255, 255, 255, 0, "masked cell");
+    render_image_free(&img);
+    def.background = bg;
+    def.interp = RENDER_BILINEAR;
+    assert_int_equal(render_field(rc, &def, &img, &view, &err), CORE_OK);
+    near_rgb(cell_px(&img, &view, 4, 2, 1, 0), 10, 200, 30, 0, "NaN cell, bilinear, background");
+    near_rgb(cell_px(&img, &view, 4, 2, 2, 1), 10, 200, 30, 0, "masked cell, background");
+    /* bilinear: the edge between cells (2, 0) and (3, 0) (values 2 and 3) is 2.5 */
+    double cpx = view.scale; /* a cell is 1 x 1 */
+    int x = (int)floor(view.origin[0] + 3 * cpx), y = (int)floor(view.origin[1] + 1.5 * cpx);
+    unsigned char lo[3], hi[3];
+    render_colormap_rgb(RENDER_VIRIDIS, 2.4 / 7, lo);
+    render_colormap_rgb(RENDER_VIRIDIS, 2.6 / 7, hi);
+    const unsigned char *p = px(&img, x, y);
+    for (int c = 0; c < 3; c++)
+        if (p[c] < (lo[c] < hi[c] ? lo[c] : hi[c]) || p[c] > (lo[c] > hi[c] ? lo[c] : hi[c]))
+            fail_msg("bilinear between 2 and 3: channel %d = %d, not within [%d, %d]", c, p[c],
+                     lo[c], hi[c]);
+    render_image_free(&img);
+}
+
+/* A uniform field (1, 0) on 5 x 5 cells of 0.2 m, arrows 0.1 m per unit: each arrow starts at its
+ * cell centre and points right, so red ink lies 0.05 m right of a centre and none 0.05 m left of
+ * it or above it. */
+static void test_field_arrows(void **state)
+{
+    (void)state;
+    double u[25], v[25];
+    for (int k = 0; k < 25; k++)
+        u[k] = 1, v[k] = 0;
+    render_field_def def = render_default_field_def();
+    def.width = def.height = 300;
+    def.nx = def.ny = 5;
+    def.extent[1][0] = def.extent[1][1] = 1;
+    def.arrows[0] = u;
+    def.arrows[1] = v;
+    def.arrow_scale = 0.1;
+    def.arrow_every = 1;
+    render_image img;
+    render_view view;
+    core_error err;
+    assert_int_equal(render_field(rc, &def, &img, &view, &err), CORE_OK);
+    for (int j = 0; j < 5; j++)
+        for (int i = 0; i < 5; i++) {
+            double cx = view.origin[0] + (0.2 * i + 0.1) * view.scale;
+            double cy = view.origin[1] + (1 - 0.2 * j - 0.1) * view.scale;
+            double d = 0.05 * view.scale;
+            near_rgb(px(&img, (int)floor(cx + d), (int)floor(cy)), 190, 30, 30, 0, "shaft");
+            near_rgb(px(&img, (int)floor(cx - d), (int)floor(cy)), 255, 255, 255, 0, "behind");
+            near_rgb(px(&img, (int)floor(cx + d), (int)floor(cy - d)), 255, 255, 255, 0, "above");
+        }
+    render_image_free(&img);
+}
+
+/* One point of 8 px at (0.3, 0.7) in [0, 1]^2: its centre pixel has the colour map's colour, a
+ * pixel 6 px away is white, and the anti-aliased coverage sums to pi (4 px)^2 within 2%. */
+static void test_points(void **state)
+{
+    (void)state;
+    double x = 0.3, y = 0.7, value = 0.25;
+    render_points_def def = render_default_points_def();
+    def.width = def.height = 200;
+    def.x = &x;
+    def.y = &y;
+    def.n = 1;
+    def.values = &value;
+    def.colormap = RENDER_GRAY;
+    def.range[1] = 1;
+    def.size = 8;
+    def.extent[1][0] = def.extent[1][1] = 1;
+    def.colorbar = def.box = false;
+    render_image img;
+    render_view view;
+    core_error err;
+    assert_int_equal(render_points(rc, &def, &img, &view, &err), CORE_OK);
+    double X = view.origin[0] + x * view.scale, Y = view.origin[1] + (1 - y) * view.scale;
+    unsigned char c[3];
+    render_colormap_rgb(RENDER_GRAY, 0.25, c);
+    near_rgb(px(&img, (int)floor(X), (int)floor(Y)), c[0], c[1], c[2], 0, "the point");
+    near_rgb(px(&img, (int)floor(X) + 6, (int)floor(Y)), 255, 255, 255, 0, "beside it");
+    double cover = 0;
+    for (int yy = 0; yy < img.height; yy++)
+        for (int xx = 0; xx < img.width; xx++)
+            cover += (255 - px(&img, xx, yy)[0]) / (255.0 - c[0]);
+    if (fabs(cover / (3.14159265358979323846 * 16) - 1) > 0.02)
+        fail_msg("point coverage %.2f, pi r^2 = %.2f", cover, 3.14159265358979323846 * 16);
+    render_image_free(&img);
+}
+
+/* The same field or cloud twice, something else in between: the same pixels. */
+static void test_field_identical(void **state)
+{
+    (void)state;
+    enum { NX = 37, NY = 23, NP = 500 };
+    double values[NX * NY], u[NX * NY], v[NX * NY], x[NP], y[NP];
+    for (int k = 0; k < NX * NY; k++) {
+        values[k] = sin(0.3 * k) * cos(0.11 * k);
+        u[k] = cos(0.2 * k);
+        v[k] = sin(0.17 * k);
+    }
+    for (int k = 0; k < NP; k++) {
+        x[k] = fmod(k * 0.618034, 1.0);
+        y[k] = fmod(k * 0.414214, 1.0);
+    }
+    render_field_def fd = render_default_field_def();
+    fd.width = 320;
+    fd.nx = NX;
+    fd.ny = NY;
+    fd.extent[1][0] = 2;
+    fd.extent[1][1] = 1;
+    fd.values = values;
+    fd.interp = RENDER_BILINEAR;
+    fd.arrows[0] = u;
+    fd.arrows[1] = v;
+    fd.title = "same";
+    render_points_def pd = render_default_points_def();
+    pd.width = 320;
+    pd.x = x;
+    pd.y = y;
+    pd.n = NP;
+    pd.values = x;
+    render_image a, b, other;
+    core_error err;
+    assert_int_equal(render_field(rc, &fd, &a, NULL, &err), CORE_OK);
+    assert_int_equal(render_points(rc, &pd, &other, NULL, &err), CORE_OK);
+    assert_int_equal(render_field(rc, &fd, &b, NULL, &err), CORE_OK);
+    assert_int_equal(a.width, b.width);
+    assert_int_equal(a.height, b.height);
+    assert_memory_equal(a.rgba, b.rgba, (size_t)a.width * a.height * 4);
+    render_image_free(&b);
+    assert_int_equal(render_points(rc, &pd, &b, NULL, &err), CORE_OK);
+    assert_memory_equal(other.rgba, b.rgba, (size_t)b.width * b.height * 4);
+    render_image_free(&a);
+    render_image_free(&b);
+    render_image_free(&other);
+}
+
+static void test_field_errors(void **state)
+{
+    (void)state;
+    double values[4] = {1, 2, 3, 4};
+    render_image img = {0};
+    core_error err;
+    render_field_def def = render_default_field_def();
+    def.nx = def.ny = 2;
+    def.extent[1][0] = def.extent[1][1] = 1;
+    def.values = values;
+    def.width = 15;
+    assert_int_equal(render_field(rc, &def, &img, NULL, &err), CORE_ERR_ARG);
+    assert_non_null(strstr(err.msg, "[16, 8192]"));
+    def.width = 64;
+    def.height = 9000;
+    assert_int_equal(render_field(rc, &def, &img, NULL, &err), CORE_ERR_ARG);
+    def.height = 0;
+    def.nx = 0;
+    assert_int_equal(render_field(rc, &def, &img, NULL, &err), CORE_ERR_ARG);
+    assert_non_null(strstr(err.msg, "0 x 2 cells"));
+    def.nx = 2;
+    def.extent[1][0] = 0;
+    assert_int_equal(render_field(rc, &def, &img, NULL, &err), CORE_ERR_ARG);
+    assert_non_null(strstr(err.msg, "x1 > x0"));
+    def.extent[1][0] = NAN;
+    assert_int_equal(render_field(rc, &def, &img, NULL, &err), CORE_ERR_ARG);
+    def.extent[1][0] = 1;
+    def.range[0] = 2;
+    def.range[1] = 1;
+    assert_int_equal(render_field(rc, &def, &img, NULL, &err), CORE_ERR_ARG);
+    def.range[0] = def.range[1] = 0;
+    def.arrows[0] = values; /* without v */
+    assert_int_equal(render_field(rc, &def, &img, NULL, &err), CORE_ERR_ARG);
+    def.arrows[1] = values;
+    def.arrow_scale = -1;
+    assert_int_equal(render_field(rc, &def, &img, NULL, &err), CORE_ERR_ARG);
+    def.arrow_scale = 0;
+    def.values = NULL;
+    def.arrows[0] = def.arrows[1] = NULL;
+    assert_int_equal(render_field(rc, &def, &img, NULL, &err), CORE_ERR_ARG);
+    assert_non_null(strstr(err.msg, "values, arrows or both"));
+    assert_null(img.rgba);
+    /* a single value: still drawn, mid-map */
+    def.values = values;
+    def.nx = def.ny = 1;
+    def.width = 200;
+    assert_int_equal(render_field(rc, &def, &img, NULL, &err), CORE_OK);
+    render_image_free(&img);
+
+    render_points_def pd = render_default_points_def();
+    double x[2] = {0, 1};
+    pd.x = x;
+    pd.y = x;
+    pd.n = 2;
+    pd.size = -1;
+    assert_int_equal(render_points(rc, &pd, &img, NULL, &err), CORE_ERR_ARG);
+    assert_non_null(strstr(err.msg, "point size"));
+    pd.size = 3;
+    pd.width = 100000;
+    assert_int_equal(render_points(rc, &pd, &img, NULL, &err), CORE_ERR_ARG);
+    pd.width = 64;
+    pd.y = NULL;
+    assert_int_equal(render_points(rc, &pd, &img, NULL, &err), CORE_ERR_ARG);
+    pd.y = x;
+    pd.extent[1][0] = 1; /* x given, y not increasing */
+    assert_int_equal(render_points(rc, &pd, &img, NULL, &err), CORE_ERR_ARG);
+    assert_null(img.rgba);
+    pd.n = 0; /* nothing to draw is fine */
+    pd.extent[1][0] = 0;
+    assert_int_equal(render_points(rc, &pd, &img, NULL, &err), CORE_OK);
+    render_image_free(&img);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_disk_area), cmocka_unit_test(test_colormaps),
         cmocka_unit_test(test_plot_axes), cmocka_unit_test(test_identical),
         cmocka_unit_test(test_text),      cmocka_unit_test(test_sphere_shading),
-        cmocka_unit_test(test_errors),
+        cmocka_unit_test(test_errors),    cmocka_unit_test(test_field_cells),
+        cmocka_unit_test(test_field_arrows), cmocka_unit_test(test_points),
+        cmocka_unit_test(test_field_identical), cmocka_unit_test(test_field_errors),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
