@@ -56,7 +56,7 @@
 --    fit; the basin heap below the box floor. A CSV (param `csv`, default out/repose.csv) with
 --    columns mu, atan_mu_deg, theta_r_deg, particles_left, fit_points (means over the seeds).
 --    `surface=FILE` also writes the final surface profiles (mu, seed, x_m, top_m). A PNG plot of
---    theta_r against mu = tan theta will follow once the renderer exists.
+--    theta_r against mu beside mu = tan theta (param `png`, default images/repose.png).
 --
 -- Measured (n = 2000, defaults, seeds 1-4 one by one; mean and sd over the 4 packings):
 --     mu     atan(mu)   theta_r (seeds 1 / 2 / 3 / 4)         mean +- sd   grains left (of 2000)
@@ -87,6 +87,7 @@ local v_rest = params.v_rest or 5e-3
 local T_max = params.T_max or 4
 local rms_limit = params.rms_limit or 1
 local csv = params.csv or "out/repose.csv"
+local png = params.png or "images/repose.png"
 local verbose = params.verbose == true
 assert(n and n >= 50, "n must be an integer >= 50")
 assert(seed and seed >= 0, "seed must be a non-negative integer")
@@ -320,6 +321,21 @@ if dir and dir ~= "" and dir ~= "out" then
 end
 assert(grainlab.write_file(csv, table.concat(rows, "\n") .. "\n"))
 print("wrote " .. csv)
+do -- theta_r against mu, beside the Coulomb slope mu = tan theta
+  local mx, my, tx, ty = {}, {}, {}, {}
+  for _, r in ipairs(results) do mx[#mx + 1] = r.mu; my[#my + 1] = r.theta end
+  for k = 0, 50 do
+    local mu = 0.9 * k / 50
+    tx[#tx + 1] = mu
+    ty[#ty + 1] = math.deg(math.atan(mu))
+  end
+  render.plot{ file = png, width = 900, height = 560,
+               title = string.format("angle of repose, %d disks (mean of %d packings)", n, seeds),
+               xlabel = "friction coefficient mu", ylabel = "angle (degrees)",
+               series = { { x = mx, y = my, label = "theta_r measured", style = "both" },
+                          { x = tx, y = ty, label = "mu = tan theta", style = "line" } } }
+  print("wrote " .. png)
+end
 if params.surface then
   local lines = { "mu,seed,x_m,top_m" }
   for _, r in ipairs(results) do

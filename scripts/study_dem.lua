@@ -66,6 +66,7 @@
 --                                  [fracs=10,20,50,100,200,500,1000]
 
 local csv_path = params.csv or "out/study_dem.csv"
+local png = params.png or "images/study_dem.png"
 local v0 = params.v0 or 1.0                 -- approach speed, m/s
 local k = params.k or 1e5                   -- linear stiffness, N/m
 local e_lin = params.e or 0.5               -- restitution of the linear case
@@ -313,6 +314,30 @@ end
 if csv_path:find("/") then os.execute("mkdir -p '" .. csv_path:match("^(.*)/[^/]*$") .. "'") end
 assert(grainlab.write_file(csv_path, table.concat(lines, "\n") .. "\n"))
 print("\nwrote " .. csv_path .. " (" .. (#lines - 1) .. " rows)")
+
+do -- error against wall time on the damped linear collision, one line per integrator
+  local series = {}
+  local case = collision_cases[1].name
+  for _, integ in ipairs(INTEGRATORS) do
+    local pts = {}
+    for _, r in ipairs(runs) do
+      if r.test == "collision" and r.case == case and r.integ == integ and r.errs and r.wall then
+        local worst = 0
+        for _, e in ipairs(r.errs) do worst = math.max(worst, e[2]) end
+        if worst > 0 then pts[#pts + 1] = { r.wall, worst } end
+      end
+    end
+    table.sort(pts, function(a, b) return a[1] < b[1] end)
+    local x, y = {}, {}
+    for i, p in ipairs(pts) do x[i], y[i] = p[1], p[2] end
+    if #x > 0 then series[#series + 1] = { x = x, y = y, label = integ, style = "both" } end
+  end
+  render.plot{ file = png, width = 900, height = 560, xlog = true, ylog = true,
+               title = "collision (" .. case .. "): error against cost, dt = t_c/10 ... t_c/1000",
+               xlabel = "wall time per collision (s)", ylabel = "worst relative error (e, t_c)",
+               series = series }
+  print("wrote " .. png)
+end
 
 -- ---- analysis ------------------------------------------------------------------------------
 local metrics, checks = {}, {}

@@ -103,6 +103,7 @@ local seed = params.seed or 1
 local update = params.update or 2500      -- small-step equivalents between boundary updates
 local tol_time = params.tol_time or 0.15
 local csv_path = params.csv or "out/two_timescales.csv"
+local png_prefix = params.png or "images/two_timescales"  -- _volumetric.png, _slip.png
 local NS = 50
 local p = 1e5                              -- confining pressure, Pa
 local mass_scale = 1e5
@@ -551,6 +552,26 @@ end
 local dir = csv_path:match("^(.*)/[^/]*$")
 if dir then os.execute("mkdir -p '" .. dir .. "'") end
 assert(grainlab.write_file(csv_path, table.concat(lines, "\n") .. "\n"))
+
+-- ---- figures: volumetric strain and mean slip against axial strain (Padbidri Figs. 2.3, 2.4) --
+do
+  local ev, sl = {}, {}
+  for _, r in ipairs(runs) do
+    local x, y, z = {}, {}, {}
+    for _, row in ipairs(r.rows) do
+      x[#x + 1] = 100 * row.ea
+      y[#y + 1] = 100 * row.ev
+      z[#z + 1] = row.slip
+    end
+    ev[#ev + 1] = { x = x, y = y, label = r.name, style = "line" }
+    sl[#sl + 1] = { x = x, y = z, label = r.name, style = "line" }
+  end
+  local title = string.format("%d disks: two-timescales runs II against I and III", n_disks)
+  render.plot{ file = png_prefix .. "_volumetric.png", width = 900, height = 560, title = title,
+               xlabel = "axial strain (%)", ylabel = "volumetric strain (%)", series = ev }
+  render.plot{ file = png_prefix .. "_slip.png", width = 900, height = 560, title = title,
+               xlabel = "axial strain (%)", ylabel = "mean |slip velocity| / v_R", series = sl }
+end
 
 metrics.phi = qs.phi
 metrics.psi = qs.psi

@@ -2,10 +2,11 @@
 --   pack.random(s, {…})   random sequential addition: no overlaps, uniform in a region;
 --   pack.deposit(s, {…})  gravity deposition, Jodrey-Tory style (Padbidri Sec. 2.5): each disk is
 --                         dropped at a random abscissa and followed as it falls and rolls over the
---                         pile until it rests on two supports (2D); then a short damped relaxation
+--                         pile until it rests on two supports (2D); then pack.settle relaxes it
 --                         at the scene's real stiffness. In 3D, spheres are placed by random
 --                         addition and settled dynamically with softened contacts and drag, then
---                         the stiffness is ramped back.
+--                         the stiffness is ramped back;
+--   pack.settle(s, {…})   damps a packing into a quiescent state (critical background drag).
 local pack = {}
 
 local function fail(call, field, expected, got)
@@ -288,74 +289,272 @@ function pack.deposit(s, opts)
     local id = s:add_disk{ pos = { x, y + 1e-12 }, radius = r, material = opts.material }
     ids[#ids + 1] = id
   end
-  -- Relax under gravity at the real stiffness, with drag to kill the elastic ringing.
-  local drag = opts.drag or 200
-  local old = s:drag()
-  s:drag(drag)
-  s:run{ steps = opts.relax_steps or 3000 }
-  s:drag(old)
-  return ids, { placed = #ids }
+  -- Relax under gravity at the real stiffness (pack.settle: critical drag, quasi-static dt): the
+  -- pile only has to sag by its elastic compression.
+  local relax = opts.relax_steps or 20000
+  if math.type(relax) ~= "integer" or relax < 0 then fail(call, "relax_steps", "non-negative integer", relax) end
+  local settled
+  if relax > 0 then settled = pack.settle(s, { drag = opts.drag, max_steps = relax, final_steps = 0 }) end
+  return ids, { placed = #ids, settle = settled }
 end
 
--- Settles a scene into a quiescent state cheaply: contacts softened by `soften` (time steps grow
--- like soften^(-2/5) for Hertz), a background drag, at least min_steps until the rms speed is below
--- `quiet`; then the stiffness is restored gently (ramp_stages factors, each followed by ramp_steps
--- steps with the drag on: a sudden stiffening releases the stored elastic energy at once and
--- blows the pile apart); then drag off and `final_steps` steps at dt_final.
+-- Speeds of the particles: the largest, the rms, and the particle table.
+local function speeds(s)
+  local P = s:particles()
+  local vx, vy, vz = P.vx, P.vy, P.vz
+  local vmax2, sum = 0, 0
+  for i = 1, P.count do
+    local v2 = vx[i] * vx[i] + vy[i] * vy[i] + (vz and vz[i] * vz[i] or 0)
+    sum = sum + v2
+    if v2 > vmax2 then vmax2 = v2 end
+  end
+  return math.sqrt(vmax2), math.sqrt(sum / math.max(1, P.count)), P
+end
+
+-- A bound on the highest frequency of the loaded packing (Gershgorin, from the tangent stiffness
+-- a f_n / overlap of every contact, a = the law's exponent): velocity Verlet is stable for
+-- dt < 2 / omega_max. 0 when nothing touches.
+local function contact_omega(s, P)
+  local c = s:measure("contacts")
+  local law = s:info().normal
+  local a = law == "linear" and 1 or law == "hertz" and 1.5 or 2
+  local m, w2, best = P.mass, {}, 0
+  local ci, cj, fn, ov = c.i, c.j, c.fn, c.overlap
+  for q = 1, #ci do
+    local d = ov[q]
+    if d > 0 then
+      local k, i, j = a * math.abs(fn[q]) / d, ci[q], cj[q]
+      local wi = (w2[i] or 0) + (j > 0 and 2 or 1) * k / m[i]
+      w2[i] = wi
+      if wi > best then best = wi end
+      if j > 0 then
+        local wj = (w2[j] or 0) + 2 * k / m[j]
+        w2[j] = wj
+        if wj > best then best = wj end
+      end
+    end
+  end
+  return math.sqrt(best)
+end
+
+-- The relaxation step: the stability limit (1/10 of the contact time) of a collision at the
+-- current top speed (at least v_floor), and at most 1/omega_max of the loaded contacts (half the
+-- Verlet limit). Returns dt and the impact velocity to pass to run.
+local function relax_dt(s, vmax, P, v_floor, with_contacts)
+  local v = math.max(v_floor, vmax)
+  local dt = s:timestep{ impact_velocity = v }.limit
+  if with_contacts then
+    local w = contact_omega(s, P)
+    if w > 0 then dt = math.min(dt, 1 / w) end
+  end
+  return dt, v
+end
+
+-- Settles a scene into a quiescent state (see the doc string at the bottom).
+--
+-- Why this way (measured on the 2D benchmark pile, Hertz + Brilliantov + Cundall-Strack, from
+-- pack.deposit): the contact damping T k d^(1/2) d' is stiffness-proportional, so a mode of
+-- frequency w is damped at a ratio of about w T / 3: ~1e-3 for the whole-pile vertical mode
+-- (w ~ 1.4e3 rad/s for 20,000 disks, ~9e3 for 2,000), i.e. not at all. Only the background drag
+-- damps that mode, best near critical, drag = 2 w (20,000 disks: v_rms < 1e-4 m/s after ~4500
+-- steps with drag 2000-3000/s, 8000 with 1000/s, > 9000 with 10000/s); 20/s leaves it ringing.
+-- Softening does not pay for Hertz: under a fixed load the tangent stiffness goes like k^(2/3),
+-- the pile's frequencies like k^(1/3), so longer steps are eaten by longer periods, the soft pile
+-- creeps more, and every re-stiffening stage releases stored elastic energy (20,000 disks, soften
+-- 1e-3: still v_rms ~1e-3 m/s after 200,000 soft steps, 214 s). A geometric deposition is already
+-- close to equilibrium: at full stiffness it only has to sag by its elastic compression, about a
+-- period of the fundamental with critical drag. Near rest the contacts are soft too (small
+-- overlaps): dt ~1e-6 s is stable here (4e-6 s is not), 10x the dt of an impact at 1 m/s.
 function pack.settle(s, opts)
   local call = "pack.settle"
   opts = opts or {}
   check_opts(call, opts, { soften = true, drag = true, quiet = true, min_steps = true,
                            max_steps = true, ramp_stages = true, ramp_steps = true,
-                           final_steps = true, dt_final = true, verbose = true })
-  local soften = opts.soften or 1e-3
+                           final_steps = true, dt_final = true, verbose = true, dt = true,
+                           v_floor = true, check_steps = true, collapse = true,
+                           collapse_drag = true, collapse_quiet = true })
+  local soften = opts.soften or 1
   if type(soften) ~= "number" or not (soften > 0 and soften <= 1) then fail(call, "soften", "number in (0, 1]", soften) end
-  local quiet = opts.quiet or 1e-3
-  local drag = opts.drag or 20
-  local stages = positive_int(call, opts, "ramp_stages", 30)
-  local ramp_steps = positive_int(call, opts, "ramp_steps", 1000)
-  local min_steps = positive_int(call, opts, "min_steps", 20000)
+  local quiet = opts.quiet or 1e-5
+  if type(quiet) ~= "number" or not (quiet > 0) then fail(call, "quiet", "positive number", quiet) end
+  local drag = opts.drag or "auto"
+  if drag ~= "auto" and (type(drag) ~= "number" or not (drag >= 0)) then
+    fail(call, "drag", "non-negative number or 'auto'", drag)
+  end
+  local v_floor = opts.v_floor or 0.01
+  if type(v_floor) ~= "number" or not (v_floor > 0) then fail(call, "v_floor", "positive number", v_floor) end
+  if opts.dt ~= nil and (type(opts.dt) ~= "number" or not (opts.dt > 0)) then fail(call, "dt", "positive number", opts.dt) end
+  if opts.dt_final ~= nil and (type(opts.dt_final) ~= "number" or not (opts.dt_final > 0)) then
+    fail(call, "dt_final", "positive number", opts.dt_final)
+  end
+  local stages = positive_int(call, opts, "ramp_stages", 10)
+  local ramp_steps = positive_int(call, opts, "ramp_steps", nil)
+  local min_steps = opts.min_steps or 0
+  if math.type(min_steps) ~= "integer" or min_steps < 0 then fail(call, "min_steps", "non-negative integer", min_steps) end
   local max_steps = positive_int(call, opts, "max_steps", 200000)
+  local check_steps = positive_int(call, opts, "check_steps", nil)
   local final_steps = opts.final_steps or 2000
-  local function rms()
-    local P, s2 = s:particles(), 0
-    for i = 1, P.count do
-      s2 = s2 + P.vx[i] ^ 2 + P.vy[i] ^ 2 + (P.vz and P.vz[i] ^ 2 or 0)
-    end
-    return math.sqrt(s2 / math.max(1, P.count))
+  if math.type(final_steps) ~= "integer" or final_steps < 0 then fail(call, "final_steps", "non-negative integer", final_steps) end
+  local collapse = opts.collapse or 0
+  if type(collapse) ~= "number" or not (collapse >= 0) then fail(call, "collapse", "non-negative number (s)", collapse) end
+  local collapse_drag = opts.collapse_drag or 20
+  if type(collapse_drag) ~= "number" or not (collapse_drag >= 0) then
+    fail(call, "collapse_drag", "non-negative number", collapse_drag)
   end
+  local collapse_quiet = opts.collapse_quiet or 1e-4
+  if type(collapse_quiet) ~= "number" or not (collapse_quiet > 0) then
+    fail(call, "collapse_quiet", "positive number", collapse_quiet)
+  end
+  -- Under a fixed load the pile's frequencies scale like k^(1/3) for Hertz (overlap ~ k^(-2/3)),
+  -- k^(1/2) for a linear spring: the drag follows them through a stiffness ramp.
+  local w_exp = s:info().normal == "linear" and 0.5 or 1 / 3
+  local function log(fmt, ...)
+    if opts.verbose then io.stderr:write(string.format("settle: " .. fmt .. "\n", ...)) end
+  end
+
   local old_drag = s:drag()
-  local steps = 0
-  s:scale_stiffness(soften)
-  s:drag(drag)
-  local v = math.huge
-  while (steps < min_steps or v > quiet) and steps < max_steps do
-    local r = s:run{ steps = 2000, impact_velocity = 0.1, progress = false }
+  local steps, t_start = 0, s:info().time
+  local vmax, vrms, P = speeds(s)
+  local dt, vimp = 0, 0
+  local function pick_dt(with_contacts)
+    if opts.dt then dt, vimp = opts.dt, nil else dt, vimp = relax_dt(s, vmax, P, v_floor, with_contacts) end
+  end
+  local function run(n)
+    local r = s:run{ steps = n, dt = dt, impact_velocity = vimp, force = opts.dt ~= nil, progress = false }
     steps = steps + r.steps
-    v = rms()
-    if opts.verbose then io.stderr:write(string.format("settle: %d soft steps, v_rms %.3g m/s\n", steps, v)) end
+    vmax, vrms, P = speeds(s)
   end
-  local factor = (1 / soften) ^ (1 / stages)
-  for k = 1, stages do
-    s:scale_stiffness(k < stages and factor or (1 / soften) / factor ^ (stages - 1))
-    steps = steps + s:run{ steps = ramp_steps, impact_velocity = 0.1, progress = false }.steps
+
+  if soften < 1 then s:scale_stiffness(soften) end
+
+  -- Drag: critical for the slowest mode. From rest, a packing falls into its contacts and the
+  -- kinetic energy peaks a quarter period t_p = pi / (2 w) later: drag = 2 w = pi / t_p.
+  local t_peak
+  if drag == "auto" then
+    s:drag(0)
+    local e0 = s:measure("energy").kinetic
+    local emax, t_max, t0 = e0, 0, s:info().time
+    pick_dt(true)
+    local cap = math.min(max_steps, math.max(2000, max_steps // 4))
+    while steps < cap do
+      run(math.min(cap - steps, math.max(10, steps // 10)))
+      local e, t = s:measure("energy").kinetic, s:info().time - t0
+      if e > emax then emax, t_max = e, t end
+      if e < 0.7 * emax then break end
+      pick_dt(false)
+    end
+    if t_max > 0 and emax > 10 * e0 then -- a peak the fall made, not motion already there
+      t_peak = t_max
+      drag = math.pi / t_peak
+    else
+      drag = 1000 -- moving at the start (not from rest): no peak to read the frequency from
+    end
+    log("kinetic energy peaked at %.3g s: drag %.4g /s (%d steps, dt %.3g s)", t_max, drag, steps, dt)
   end
+  s:drag(drag)
+  local check = check_steps or
+                math.max(100, math.min(2000, math.floor((t_peak or math.pi / math.max(drag, 1)) / math.max(dt, 1e-300) + 0.5)))
+
+  -- Relax until the rms speed is below `quiet`, or below 10 quiet and no longer falling (by 10%
+  -- over 3 checks, ~1 period of the slowest mode): what is left then is a few grains creeping at
+  -- their terminal speed under the drag, which more steps would not stop.
+  local function relax(label)
+    local hist, start = {}, steps
+    while steps - start < max_steps do
+      if steps >= min_steps and (vrms <= quiet or (vrms < 10 * quiet and #hist >= 3 and vrms > 0.9 * hist[#hist - 2])) then
+        break
+      end
+      hist[#hist + 1] = vrms
+      pick_dt(true)
+      run(check)
+      log("%s: %d steps (dt %.3g s, drag %.4g /s): v_max %.3g, v_rms %.3g m/s", label, steps, dt, s:drag(), vmax, vrms)
+    end
+  end
+  relax(soften < 1 and "soft" or "relax")
+
+  -- Collapse: a packing built geometrically (pack.deposit) has a few grains in frictionally
+  -- unstable spots; the critical drag holds them at a creeping speed (~1e-3 m/s), and without
+  -- drag they fail and trigger small cascades for a few tenths of a second. With collapse = t,
+  -- the packing may do so under a weak drag (fast: a stronger drag slows the cascades) until the
+  -- fastest grain is below collapse_quiet, for at most t seconds; then it is relaxed again.
+  local function collapse_phase()
+    if collapse <= 0 then return end
+    local t_end = s:info().time + collapse
+    s:drag(collapse_drag)
+    while s:info().time < t_end do
+      pick_dt(true)
+      run(math.max(1, math.min(2000, math.ceil((t_end - s:info().time) / dt))))
+      log("collapse: %d steps (dt %.3g s, drag %.4g /s): v_max %.3g, v_rms %.3g m/s", steps, dt, collapse_drag, vmax, vrms)
+      if vmax < collapse_quiet then break end
+    end
+    s:drag(drag)
+    relax("relax")
+  end
+  if soften == 1 then collapse_phase() end
+
+  if soften < 1 then
+    -- Ramp the stiffness back in `stages` factors; each stage lasts about one period of the
+    -- slowest mode (or ramp_steps), with the drag kept critical as the frequencies rise.
+    local factor = (1 / soften) ^ (1 / stages)
+    local period = 4 * (t_peak or math.pi / math.max(drag, 1))
+    for k = 1, stages do
+      local f = k < stages and factor or (1 / soften) / factor ^ (stages - 1)
+      s:scale_stiffness(f)
+      drag = drag * f ^ w_exp
+      period = period / f ^ w_exp
+      s:drag(drag)
+      pick_dt(true)
+      run(ramp_steps or math.max(100, math.floor(period / dt + 0.5)))
+      log("ramp %d/%d: %d steps (dt %.3g s, drag %.4g /s): v_max %.3g, v_rms %.3g m/s", k, stages, steps, dt, drag, vmax, vrms)
+    end
+    relax("relax")
+    collapse_phase()
+  end
+  local settled = s:measure("coordination")
+  local res = { steps = steps, time = s:info().time - t_start, drag = drag, dt = dt, t_peak = t_peak,
+                v_rms_settled = vrms, v_max_settled = vmax, z_settled = settled.z }
+
   s:drag(old_drag)
   if final_steps > 0 then
-    steps = steps + s:run{ steps = final_steps, dt = opts.dt_final, progress = false }.steps
+    if not opts.dt_final then pick_dt(true) end
+    local r = s:run{ steps = final_steps, dt = opts.dt_final or dt, impact_velocity = math.max(v_floor, vmax),
+                     force = opts.dt_final == nil and opts.dt ~= nil, progress = false }
+    steps = steps + r.steps
+    vmax, vrms = speeds(s)
+    log("final: %d steps without drag (dt %.3g s): v_max %.3g, v_rms %.3g m/s", final_steps, r.dt, vmax, vrms)
   end
   local z = s:measure("coordination")
-  return { steps = steps, v_rms = rms(), z = z.z, z_no_rattlers = z.z_no_rattlers }
+  res.steps, res.v_rms, res.v_max, res.z, res.z_no_rattlers = steps, vrms, vmax, z.z, z.z_no_rattlers
+  return res
 end
 
 grainlab.doc(pack, { name = "grainlab.pack", doc = [[Packing generators (reproducible from seed):
   pack.random(s, { n =, radius = r | {min, max}, region = {{lo},{hi}}, seed =, material =, speed = })
     random sequential addition without overlaps; returns ids, {placed, tries, fraction}
-  pack.deposit(s, { n =, radius = {0.5e-3, 1e-3}, region =, seed =, material =, relax_steps = 3000, drag = 200 })
-    gravity deposition: 2D drop-and-roll (Jodrey-Tory style) onto the floor of the region, then a
-    damped relaxation at the scene's stiffness; 3D: random addition and dynamic settling.
-  pack.settle(s, { soften = 1e-3, drag = 20, quiet = 1e-3, min_steps = 20000, max_steps = 200000,
-                   ramp_stages = 30, ramp_steps = 1000, final_steps = 2000, dt_final = nil })
-    settles a scene with softened contacts and drag, then restores the stiffness gently;
-    returns {steps, v_rms, z, z_no_rattlers}.]] })
+  pack.deposit(s, { n =, radius = {0.5e-3, 1e-3}, region =, seed =, material =, relax_steps = 20000, drag = 'auto' })
+    gravity deposition: 2D drop-and-roll (Jodrey-Tory style) onto the floor of the region, then
+    pack.settle at the scene's stiffness with at most relax_steps steps (0: none; set the contact
+    law first); returns ids, {placed, settle = pack.settle's result}. 3D: random addition and
+    dynamic settling (softened contacts, drag 50, relax_steps = 2000 per decade of stiffness).
+  pack.settle(s, { drag = 'auto', quiet = 1e-5, min_steps = 0, max_steps = 200000, dt = nil,
+                   v_floor = 0.01, check_steps = nil, collapse = 0, collapse_drag = 20,
+                   collapse_quiet = 1e-4, final_steps = 2000, dt_final = nil,
+                   soften = 1, ramp_stages = 10, ramp_steps = nil, verbose = false })
+    relaxes a packing at rest (e.g. from pack.deposit) into a quiescent one at full stiffness: a
+    background drag, critical for the slowest mode (drag = 'auto': pi / t_p, t_p the time the
+    kinetic energy takes to peak when the packing falls into its contacts from rest; 1000/s if
+    it was moving at the start), in chunks of check_steps (default t_p / dt, 100..2000) until
+    the rms speed is below quiet, or below 10 quiet and no longer falling (grains creeping at
+    their terminal speed), or max_steps. dt: the stability limit of an impact at max(v_floor,
+    fastest speed), at most 1 / (highest frequency of the loaded contacts).
+    collapse = t (s): then lets the grains that the drag only holds (frictionally unstable spots
+    of a geometric packing) fail under the weak collapse_drag until the fastest grain is below
+    collapse_quiet m/s (at most t seconds of simulated time), and relaxes again: a static pile
+    (2D, mu 0.45: ~0.2-0.3 s, 1.2e5-3e5 steps). Then the old drag is restored and final_steps
+    steps are run at dt_final (default: the relaxation dt).
+    soften < 1 first relaxes with the stiffness scaled by soften, then ramps it back in
+    ramp_stages factors of ramp_steps steps (default: a period of the slowest mode) with the drag
+    kept critical (slower and less robust for Hertz piles; kept for comparison).
+    Returns {steps, time, drag, dt, t_peak, v_rms, v_max, z, z_no_rattlers (after the final
+    steps), v_rms_settled, v_max_settled, z_settled (before them)}.]] })
 return pack

@@ -15,7 +15,7 @@ typedef struct dem_wall {
     double point[3], normal[3], velocity[3];
     double friction;
     int material;
-    double *hist[3];       /* SPRING law: tangential displacement per particle */
+    double *hist[4];       /* SPRING law, per particle: see dem_pairs.hist */
     uint32_t *cand;        /* particles within r + skin of the wall at the last list build */
     size_t ncand, cap_cand;
     double point_build[3]; /* the wall's point at the last list build (skin test) */
@@ -29,7 +29,8 @@ typedef struct dem_pairs {
     double *k;        /* normal stiffness (k or K) of the pair */
     double *gamma;    /* viscous normal damping of the pair, N s/m */
     double *mu;       /* friction of the pair */
-    double *hist[3];  /* tangential spring displacement (SPRING law only) */
+    double *hist[4];  /* SPRING law: the tangential force on i ([0..2]; 2D: [0] along t) and
+                       * [3] the spring stiffness of the last step (for the unloading rescale) */
     double *f[3];     /* force on i of the last evaluation (j gets the opposite) */
     double *c[3];     /* n x f_t: torque on i is -r_i c, on j -r_j c (2D: c[2] only) */
     size_t np;        /* particles when the list was built */

@@ -26,7 +26,9 @@ static core_status prepare(dem_scene *s, const dem_run_def *run, core_error *err
         for (int w = 0; w < s->nwalls; w++) {
             if (!s->walls[w].active || s->walls[w].hist[0])
                 continue;
-            for (int d = 0; d < D; d++) {
+            for (int d = 0; d < 4; d++) {
+                if (d >= D && d < 3)
+                    continue; /* components up to dim, and [3] the last stiffness */
                 if (dem_alloc_array(&s->walls[w].hist[d], s->cap, err))
                     return err->status;
                 memset(s->walls[w].hist[d], 0, s->cap * sizeof(double));

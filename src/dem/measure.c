@@ -30,24 +30,10 @@ static double wall_overlap(const dem_scene *s, const dem_wall *w, size_t i)
     return s->r[i] - dist;
 }
 
-static double spring_energy(const dem_scene *s, double k, double delta, const double *h3)
+/* Energy stored in a tangential spring: |f|^2 / (2 kt), from the stored force and stiffness. */
+static double spring_energy(double f2, double kt)
 {
-    if (s->contact.tangential != DEM_TANGENT_SPRING)
-        return 0;
-    double kt = s->contact.kt > 0 ? s->contact.kt : 0;
-    if (kt == 0) { /* the same default as forces.c */
-        double sq = sqrt(delta);
-        switch (s->contact.normal) {
-        case DEM_NORMAL_LINEAR: kt = 2.0 / 7.0 * k; break;
-        case DEM_NORMAL_POWER:
-            kt = 2.0 / 7.0 * s->contact.beta * k *
-                 (s->contact.beta == 1 ? 1 : s->contact.beta == 2 ? delta : sq);
-            break;
-        default: kt = 2.0 / 7.0 * 1.5 * k * sq;
-        }
-    }
-    double h2 = h3[0] * h3[0] + h3[1] * h3[1] + h3[2] * h3[2];
-    return 0.5 * kt * h2;
+    return kt > 0 ? 0.5 * f2 / kt : 0;
 }
 
 void dem_measure_energy(dem_scene *s, dem_energy *e)
@@ -82,10 +68,10 @@ void dem_measure_energy(dem_scene *s, dem_energy *e)
             continue;
         e->elastic += dem_elastic_energy(&s->contact, p->k[q], delta);
         if (p->hist[0]) {
-            double h[3] = {0, 0, 0};
+            double f2 = 0;
             for (int d = 0; d < D; d++)
-                h[d] = p->hist[d][q];
-            e->elastic += spring_energy(s, p->k[q], delta, h);
+                f2 += p->hist[d][q] * p->hist[d][q];
+            e->elastic += spring_energy(f2, p->hist[3][q]);
         }
     }
     for (int w = 0; w < s->nwalls; w++) {
@@ -100,10 +86,10 @@ void dem_measure_energy(dem_scene *s, dem_energy *e)
             dem_wall_parameters(s, wl, i, &k, &gamma, &mu);
             e->elastic += dem_elastic_energy(&s->contact, k, delta);
             if (wl->hist[0]) {
-                double h[3] = {0, 0, 0};
+                double f2 = 0;
                 for (int d = 0; d < D; d++)
-                    h[d] = wl->hist[d][i];
-                e->elastic += spring_energy(s, k, delta, h);
+                    f2 += wl->hist[d][i] * wl->hist[d][i];
+                e->elastic += spring_energy(f2, wl->hist[3][i]);
             }
         }
     }
@@ -146,14 +132,14 @@ static double wall_tangential(const dem_scene *s, const dem_wall *wl, size_t i, 
         double x = wall_slip(s, wl, i) / c->v_r;
         return x >= 1 ? mu * fn : mu * fn * pow(x, 1 / c->exponent);
     }
-    case DEM_TANGENT_SPRING: {
+    case DEM_TANGENT_SPRING: { /* the stored force (already capped at mu f_n) */
         if (!wl->hist[0])
             return 0;
-        double h[3] = {0, 0, 0};
+        double f2 = 0;
         for (int d = 0; d < s->dim; d++)
-            h[d] = wl->hist[d][i];
-        double e = spring_energy(s, k, delta, h), h2 = h[0] * h[0] + h[1] * h[1] + h[2] * h[2];
-        return h2 > 0 ? fmin(2 * e / sqrt(h2), mu * fn) : 0; /* kt |xi| */
+            f2 += wl->hist[d][i] * wl->hist[d][i];
+        (void)k, (void)delta;
+        return fmin(sqrt(f2), mu * fn);
     }
     default:
         return 0;

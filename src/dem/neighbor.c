@@ -13,6 +13,7 @@ void dem_free_pairs(dem_pairs *p)
     free(p->i), free(p->j), free(p->k), free(p->gamma), free(p->mu);
     for (int d = 0; d < 3; d++)
         free(p->hist[d]), free(p->f[d]), free(p->c[d]);
+    free(p->hist[3]);
     free(p->start), free(p->jstart), free(p->jpair);
     memset(p, 0, sizeof *p);
 }
@@ -115,6 +116,8 @@ static core_status reserve_pairs(dem_scene *s, size_t n, core_error *err)
         if (!st && s->contact.tangential == DEM_TANGENT_SPRING && d < s->dim)
             st = dem_alloc_array(&p->hist[d], cap, err);
     }
+    if (!st && s->contact.tangential == DEM_TANGENT_SPRING)
+        st = dem_alloc_array(&p->hist[3], cap, err);
     if (!st)
         p->cap = cap;
     return st;
@@ -357,6 +360,7 @@ core_status dem_build_pairs(dem_scene *s, core_error *err)
                 int same = o < oe && old.j[o] == p->j[q];
                 for (int d = 0; d < D; d++)
                     p->hist[d][q] = same ? old.hist[d][o] : 0;
+                p->hist[3][q] = same ? old.hist[3][o] : 0;
             }
         }
     }

@@ -94,7 +94,7 @@ void dem_destroy(dem_scene *s)
     free(s->r), free(s->m), free(s->inv_m), free(s->inv_inertia), free(s->mat), free(s->flags);
     free(s->angle);
     for (int w = 0; w < s->nwalls; w++) {
-        for (int d = 0; d < 3; d++)
+        for (int d = 0; d < 4; d++)
             free(s->walls[w].hist[d]);
         free(s->walls[w].cand);
     }
@@ -170,7 +170,7 @@ core_status dem_set_contact(dem_scene *s, const dem_contact_def *c, core_error *
             return st;
     }
     if (spring_before != (c->tangential == DEM_TANGENT_SPRING)) {
-        for (int d = 0; d < 3; d++) { /* history is meaningless under another law */
+        for (int d = 0; d < 4; d++) { /* history is meaningless under another law */
             free(s->pairs.hist[d]);
             s->pairs.hist[d] = NULL;
             for (int w = 0; w < s->nwalls; w++) {
@@ -225,11 +225,12 @@ static core_status grow(dem_scene *s, size_t need, core_error *err)
             if (s->gear_w[k][d])
                 st = dem_alloc_array(&s->gear_w[k][d], cap, err);
         for (int w = 0; w < s->nwalls && st == CORE_OK; w++)
-            if (s->walls[w].hist[d]) {
-                st = dem_alloc_array(&s->walls[w].hist[d], cap, err);
-                if (st == CORE_OK)
-                    memset(s->walls[w].hist[d] + s->cap, 0, (cap - s->cap) * sizeof(double));
-            }
+            for (int k = d; k < 4; k += 3) /* components d, and [3] once (with d = 0) */
+                if (s->walls[w].hist[k] && (k < 3 || d == 0)) {
+                    st = dem_alloc_array(&s->walls[w].hist[k], cap, err);
+                    if (st == CORE_OK)
+                        memset(s->walls[w].hist[k] + s->cap, 0, (cap - s->cap) * sizeof(double));
+                }
     }
     if (st == CORE_OK && s->angle)
         st = dem_alloc_array(&s->angle, cap, err);
@@ -345,6 +346,9 @@ long dem_add_particle(dem_scene *s, const dem_particle_def *p, core_error *err)
             if (s->walls[w].hist[d])
                 s->walls[w].hist[d][i] = 0;
     }
+    for (int w = 0; w < s->nwalls; w++)
+        if (s->walls[w].hist[3])
+            s->walls[w].hist[3][i] = 0;
     if (s->angle)
         s->angle[i] = 0;
     s->r[i] = r;
@@ -473,7 +477,7 @@ core_status dem_remove_wall(dem_scene *s, int id, core_error *err)
     core_status st = check_wall(s, id, err);
     if (st == CORE_OK) {
         s->walls[id].active = 0;
-        for (int d = 0; d < 3; d++) {
+        for (int d = 0; d < 4; d++) {
             free(s->walls[id].hist[d]);
             s->walls[id].hist[d] = NULL;
         }

@@ -334,4 +334,21 @@ do -- coincident centres are refused when the run starts, naming both particles
   s:add_disk{ pos = { 0.005, 0.005 }, radius = 0.5e-3 }
   check.errors(function() s:run{ steps = 1 } end, "run: particles 1 and 2 are at the same position", "coincident particles")
 end
+do -- the Cundall-Strack spring with the default (overlap-dependent) stiffness creates no energy
+  local s = dem.scene{ dim = 2, box = { { 0, 0 }, { 0.01, 0.01 } }, gravity = { 0, -9.81 } }
+  local mat = grainlab.material{ density = 2650, young = 30e9, poisson = 0.3, friction = 10 }
+  s:add_wall{ point = { 0, 0 }, normal = { 0, 1 } }
+  s:contact{ normal = "hertz", tangential = "spring" }
+  local id = s:add_disk{ pos = { 0.005, 1e-3 + 1e-12 }, radius = 1e-3, material = mat }
+  s:drag(3e5); s:run{ steps = 20000, dt = 1e-8 }; s:drag(0)
+  s:set_velocity(id, { 1e-4, 1e-4 })
+  local e0 = s:measure("energy").total
+  local k0 = 0.5 * s:particles().mass[1] * 2e-8
+  local worst = -math.huge
+  for _ = 1, 20 do
+    s:run{ steps = 5000, dt = 1e-8 }
+    worst = math.max(worst, (s:measure("energy").total - e0) / k0)
+  end
+  check.le(worst, 1e-6, "spring law: energy never rises (it rose 34x the kinetic energy before the fix)")
+end
 check.done()
