@@ -255,15 +255,31 @@ function pack.deposit(s, opts)
   local lo, hi = region_of(call, s, opts.region, dim)
   local g = info.gravity
   if dim == 3 then
-    -- 3D: random addition in the region, then dynamic settling (softened, dragged, re-stiffened).
+    -- 3D: random addition in the region, a fall with softened contacts and a mild drag (grains
+    -- land at ~ g/drag), the stiffness restored in small steps under the drag (a sudden
+    -- stiffening would release the stored elastic energy at once), then pack.settle at full
+    -- stiffness.
     local ids = pack.random(s, { n = n, radius = opts.radius, region = { lo, hi }, seed = opts.seed,
                                  material = opts.material })
-    local drag = opts.drag or 50
-    s:scale_stiffness(1e-4)
-    s:drag(drag)
-    s:run{ time = 0.3 }
-    for _ = 1, 4 do s:scale_stiffness(10); s:run{ steps = opts.relax_steps or 2000 } end
-    s:drag(0)
+    local old_drag, soften, stages = s:drag(), 1e-3, 30
+    s:scale_stiffness(soften)
+    s:drag(opts.drag or 30)
+    local function v_rms()
+      local P, s2 = s:particles(), 0
+      for i = 1, P.count do s2 = s2 + P.vx[i] ^ 2 + P.vy[i] ^ 2 + P.vz[i] ^ 2 end
+      return math.sqrt(s2 / P.count)
+    end
+    local steps = 0
+    repeat
+      steps = steps + s:run{ steps = 2000, impact_velocity = 0.5, progress = false }.steps
+    until (steps >= 10000 and v_rms() < 1e-3) or steps >= 400000
+    local f = (1 / soften) ^ (1 / stages)
+    for k = 1, stages do
+      s:scale_stiffness(k < stages and f or (1 / soften) / f ^ (stages - 1))
+      s:run{ steps = 500, impact_velocity = 0.1, progress = false }
+    end
+    s:drag(old_drag)
+    if (opts.relax_steps or 20000) > 0 then pack.settle(s, { max_steps = opts.relax_steps or 20000 }) end
     return ids, { placed = #ids }
   end
   if not (g[1] == 0 and g[2] < 0) then
