@@ -18,6 +18,8 @@
 -- OpenMP threads can make it many times slower).
 --   grainlab scripts/bench/dem_dense.lua [n=20000] [steps=20000] [threads=N] [quiet=1e-5]
 --                                        [collapse=0|0.5] [prep_threads=1] [verbose=1]
+--   valgrind --tool=callgrind --instr-atstart=no grainlab scripts/bench/dem_dense.lua \
+--       steps=200 threads=1 callgrind=true   (instructions per particle-step: total / (n steps))
 -- Metrics: particle_steps_per_s (per thread count), wall_s, contacts_per_particle.
 local n = params.n or 20000
 local steps = params.steps or 20000
@@ -51,11 +53,17 @@ io.stderr:write(string.format(
   n, t_prep, t_deposit, settle.steps - check_steps, settle.dt, settle.drag, settle.v_rms_settled,
   settle.v_max_settled, settle.z_settled, check_steps, dt, settle.v_rms, z.z))
 
+-- callgrind=true: run under `valgrind --tool=callgrind --instr-atstart=no`; instrumentation is
+-- switched on for the timed steps only, so the profile's total / (n * steps) is the instruction
+-- count per particle-step (stable on a busy machine, unlike wall time).
+local callgrind = params.callgrind == true
 local function timed(threads)
   grainlab.threads(threads)
+  if callgrind then os.execute("callgrind_control -i on >/dev/null") end
   local c0, w0 = grainlab.cpu_clock(), grainlab.clock()
   s:run{ steps = steps, dt = dt, progress = false }
   local wall = grainlab.clock() - w0
+  if callgrind then os.execute("callgrind_control -i off >/dev/null") end
   return n * steps / wall, wall, grainlab.cpu_clock() - c0
 end
 
