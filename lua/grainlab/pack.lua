@@ -108,17 +108,23 @@ local function existing(s, dim)
   return list, rmax
 end
 
-function pack.random(s, opts)
-  local call = "pack.random"
-  check_opts(call, opts, { n = true, radius = true, region = true, seed = true, material = true,
-                           max_tries = true, speed = true })
+-- The options both packers share: n, the seeded stream, the radius sampler, the region.
+local function common(call, s, opts, fields)
+  check_opts(call, opts, fields)
   local info = s:info()
-  local dim = info.dim
   local n = positive_int(call, opts, "n", nil)
   if not n then fail(call, "n", "positive integer", nil) end
   local rng = grainlab.rng{ seed = opts.seed or 0 }
   local sample, rmax_new = radius_sampler(call, opts.radius, rng)
-  local lo, hi = region_of(call, s, opts.region, dim)
+  local lo, hi = region_of(call, s, opts.region, info.dim)
+  return info, n, rng, sample, rmax_new, lo, hi
+end
+
+function pack.random(s, opts)
+  local call = "pack.random"
+  local info, n, rng, sample, rmax_new, lo, hi = common(call, s, opts,
+    { n = true, radius = true, region = true, seed = true, material = true, max_tries = true, speed = true })
+  local dim = info.dim
   local max_tries = positive_int(call, opts, "max_tries", 1000 * n)
   local speed = opts.speed or 0
   if type(speed) ~= "number" or not (speed >= 0) then fail(call, "speed", "non-negative number", speed) end
@@ -244,15 +250,9 @@ end
 
 function pack.deposit(s, opts)
   local call = "pack.deposit"
-  check_opts(call, opts, { n = true, radius = true, region = true, seed = true, material = true,
-                           relax_steps = true, drag = true })
-  local info = s:info()
+  local info, n, rng, sample, rmax_new, lo, hi = common(call, s, opts,
+    { n = true, radius = true, region = true, seed = true, material = true, relax_steps = true, drag = true })
   local dim = info.dim
-  local n = positive_int(call, opts, "n", nil)
-  if not n then fail(call, "n", "positive integer", nil) end
-  local rng = grainlab.rng{ seed = opts.seed or 0 }
-  local sample, rmax_new = radius_sampler(call, opts.radius, rng)
-  local lo, hi = region_of(call, s, opts.region, dim)
   local g = info.gravity
   if dim == 3 then
     -- 3D: random addition in the region, a fall with softened contacts and a mild drag (grains
