@@ -96,6 +96,9 @@ void bind_open_dem(lua_State *L);
 /* The dem_scene of the dem.scene at idx, or a Lua error naming `call` (for other bindings). */
 struct dem_scene *bind_check_dem_scene(lua_State *L, int idx, const char *call);
 
+/* Registers the global `mpm` module (lua_mpm.c). */
+void bind_open_mpm(lua_State *L);
+
 /* Registers the global `render` module (lua_render.c). */
 void bind_open_render(lua_State *L);
 

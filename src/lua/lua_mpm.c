@@ -1,0 +1,726 @@
+/* The Lua module `mpm`: material-point scenes over src/mpm. Translates and checks arguments,
+ * calls the kernels, raises their errors named after the call. */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "core/progress.h"
+#include "lua/bind.h"
+#include "mpm/mpm.h"
+
+static const char *SCENE = "mpm.scene";
+static const char *MATERIAL = "mpm.material";
+
+typedef struct lscene {
+    mpm_scene *s;
+} lscene;
+
+static mpm_scene *check_scene(lua_State *L, int idx)
+{
+    lscene *u = luaL_checkudata(L, idx, SCENE);
+    if (!u->s)
+        luaL_error(L, "the mpm.scene was closed");
+    return u->s;
+}
+
+/* ---- mpm.material{...} ------------------------------------------------------------------------ */
+static const char *const MODEL_NAMES[] = {"elastic", "vonmises", NULL};
+
+static int l_material(lua_State *L)
+{
+    static const char *const fields[] = {"model", "density", "shear", "bulk", "yield", "hardening",
+                                         NULL};
+    bind_check_table(L, 1, "material");
+    bind_check_fields(L, 1, "material", fields);
+    mpm_material m = mpm_default_material();
+    m.model = (mpm_model)bind_field_option(L, 1, "material", "model", MODEL_NAMES, MPM_ELASTIC, 0);
+    m.density = bind_field_number(L, 1, "material", "density", 0, BIND_REQUIRED | BIND_POSITIVE);
+    m.shear = bind_field_number(L, 1, "material", "shear", 0, BIND_REQUIRED | BIND_POSITIVE);
+    m.bulk = bind_field_number(L, 1, "material", "bulk", 0, BIND_REQUIRED | BIND_POSITIVE);
+    if (m.model == MPM_VONMISES) {
+        m.yield = bind_field_number(L, 1, "material", "yield", 0, BIND_REQUIRED | BIND_POSITIVE);
+        m.hardening = bind_field_number(L, 1, "material", "hardening", 0, BIND_NONNEG);
+    } else {
+        const char *plastic[] = {"yield", "hardening"};
+        for (int k = 0; k < 2; k++)
+            if (lua_getfield(L, 1, plastic[k]) != LUA_TNIL)
+                return bind_field_error(L, 1, "material", plastic[k],
+                                        "nothing for model 'elastic' (use model = 'vonmises')");
+            else
+                lua_pop(L, 1);
+    }
+    core_error err;
+    if (mpm_check_material(&m, &err))
+        return bind_raise(L, "material", &err);
+    mpm_material *u = lua_newuserdatauv(L, sizeof *u, 0);
+    *u = m;
+    luaL_setmetatable(L, MATERIAL);
+    return 1;
+}
+
+static int material_index(lua_State *L)
+{
+    const mpm_material *m = luaL_checkudata(L, 1, MATERIAL);
+    const char *k = luaL_checkstring(L, 2);
+    double E = 9 * m->bulk * m->shear / (3 * m->bulk + m->shear);
+    double nu = (3 * m->bulk - 2 * m->shear) / (2 * (3 * m->bulk + m->shear));
+    if (strcmp(k, "model") == 0)
+        lua_pushstring(L, MODEL_NAMES[m->model]);
+    else if (strcmp(k, "density") == 0)
+        lua_pushnumber(L, m->density);
+    else if (strcmp(k, "shear") == 0)
+        lua_pushnumber(L, m->shear);
+    else if (strcmp(k, "bulk") == 0)
+        lua_pushnumber(L, m->bulk);
+    else if (strcmp(k, "yield") == 0)
+        lua_pushnumber(L, m->yield);
+    else if (strcmp(k, "hardening") == 0)
+        lua_pushnumber(L, m->hardening);
+    else if (strcmp(k, "young") == 0)
+        lua_pushnumber(L, E);
+    else if (strcmp(k, "poisson") == 0)
+        lua_pushnumber(L, nu);
+    else if (strcmp(k, "wave_speed") == 0)
+        lua_pushnumber(L, mpm_wave_speed(m));
+    else
+        lua_pushnil(L);
+    return 1;
+}
+
+static int material_tostring(lua_State *L)
+{
+    const mpm_material *m = luaL_checkudata(L, 1, MATERIAL);
+    char buf[256];
+    if (m->model == MPM_VONMISES)
+        snprintf(buf, sizeof buf, "mpm.material vonmises (density %g, shear %g, bulk %g, yield %g, "
+                 "hardening %g)", m->density, m->shear, m->bulk, m->yield, m->hardening);
+    else
+        snprintf(buf, sizeof buf, "mpm.material elastic (density %g, shear %g, bulk %g)",
+                 m->density, m->shear, m->bulk);
+    lua_pushstring(L, buf);
+    return 1;
+}
+
+/* ---- mpm.scene{...} --------------------------------------------------------------------------- */
+static const char *const WALL_NAMES[] = {"noslip", "slip", "none", NULL};
+static const char *const UPDATE_NAMES[] = {"usl", "musl", NULL};
+
+static void read_pair(lua_State *L, int arg, const char *field, const char *expected, int *is_int,
+                      double out[2], int required)
+{
+    int t = lua_getfield(L, arg, field);
+    if (t == LUA_TNIL && !required) {
+        lua_pop(L, 1);
+        return;
+    }
+    if (t != LUA_TTABLE || luaL_len(L, -1) != 2)
+        bind_field_error(L, arg, "scene", field, expected);
+    for (int k = 0; k < 2; k++) {
+        lua_rawgeti(L, -1, k + 1);
+        int ok = is_int ? lua_isinteger(L, -1) && lua_tointeger(L, -1) >= 1 &&
+                              lua_tointeger(L, -1) <= (1 << 20)
+                        : lua_type(L, -1) == LUA_TNUMBER && lua_tonumber(L, -1) > 0 &&
+                              isfinite(lua_tonumber(L, -1));
+        double v = lua_tonumber(L, -1);
+        lua_pop(L, 1);
+        if (!ok)
+            bind_field_error(L, arg, "scene", field, expected);
+        out[k] = v;
+        if (is_int)
+            is_int[k] = (int)v;
+    }
+    lua_pop(L, 1);
+}
+
+static void read_walls(lua_State *L, mpm_scene_def *def)
+{
+    static const char *const sides[] = {"left", "right", "bottom", "top", NULL};
+    const char *expected = "'noslip', 'slip', 'none' or a table {left =, right =, bottom =, top =}";
+    int t = lua_getfield(L, 1, "walls");
+    if (t == LUA_TNIL) {
+        lua_pop(L, 1);
+        return;
+    }
+    if (t == LUA_TSTRING) {
+        lua_pop(L, 1);
+        int w = bind_field_option(L, 1, "scene", "walls", WALL_NAMES, 0, 0);
+        for (int k = 0; k < 4; k++)
+            def->walls[k] = (mpm_wall)w;
+        return;
+    }
+    if (t != LUA_TTABLE)
+        bind_field_error(L, 1, "scene", "walls", expected);
+    int tab = lua_gettop(L);
+    bind_check_fields(L, tab, "scene", sides);
+    for (int k = 0; k < 4; k++) {
+        if (lua_getfield(L, tab, sides[k]) == LUA_TNIL) {
+            lua_pop(L, 1);
+            continue;
+        }
+        int w = -1;
+        if (lua_type(L, -1) == LUA_TSTRING)
+            for (int i = 0; WALL_NAMES[i]; i++)
+                if (strcmp(lua_tostring(L, -1), WALL_NAMES[i]) == 0)
+                    w = i;
+        if (w < 0) {
+            char field[32];
+            snprintf(field, sizeof field, "walls.%s", sides[k]);
+            bind_field_error(L, 1, "scene", field, "one of 'noslip', 'slip', 'none'");
+        }
+        def->walls[k] = (mpm_wall)w;
+        lua_pop(L, 1);
+    }
+    lua_pop(L, 1);
+}
+
+static int l_scene(lua_State *L)
+{
+    static const char *const fields[] = {"cells", "size", "origin", "periodic", "gravity", "walls",
+                                         "update", "pic", NULL};
+    bind_check_table(L, 1, "scene");
+    bind_check_fields(L, 1, "scene", fields);
+    mpm_scene_def def = mpm_default_scene_def();
+    double cells[2];
+    read_pair(L, 1, "cells", "array of 2 integers in [1, 1048576]", def.cells, cells, 1);
+    read_pair(L, 1, "size", "array of 2 positive numbers", NULL, def.size, 1);
+    bind_field_vector(L, 1, "scene", "origin", 2, def.origin, 0);
+    bind_field_vector(L, 1, "scene", "gravity", 2, def.gravity, 0);
+    if (lua_getfield(L, 1, "periodic") != LUA_TNIL) {
+        if (lua_type(L, -1) != LUA_TTABLE || luaL_len(L, -1) != 2)
+            bind_field_error(L, 1, "scene", "periodic", "array of 2 booleans");
+        for (int d = 0; d < 2; d++) {
+            int t = lua_rawgeti(L, -1, d + 1);
+            def.periodic[d] = lua_toboolean(L, -1);
+            lua_pop(L, 1);
+            if (t != LUA_TBOOLEAN)
+                bind_field_error(L, 1, "scene", "periodic", "array of 2 booleans");
+        }
+    }
+    lua_pop(L, 1);
+    read_walls(L, &def);
+    def.update = (mpm_update)bind_field_option(L, 1, "scene", "update", UPDATE_NAMES, MPM_MUSL, 0);
+    def.pic = bind_field_number(L, 1, "scene", "pic", 0, BIND_NONNEG);
+    if (def.pic > 1) {
+        lua_getfield(L, 1, "pic");
+        return bind_field_error(L, 1, "scene", "pic", "number in [0, 1]");
+    }
+    lscene *u = lua_newuserdatauv(L, sizeof *u, 1);
+    u->s = NULL;
+    luaL_setmetatable(L, SCENE);
+    lua_newtable(L); /* mpm.material -> material index */
+    lua_setiuservalue(L, -2, 1);
+    core_error err;
+    if (mpm_create(&def, &u->s, &err) != CORE_OK)
+        return bind_raise(L, "scene", &err);
+    return 1;
+}
+
+/* Material index of the mpm.material in field `material` of the table at arg (registered with
+ * the scene on first use). */
+static int material_of(lua_State *L, int scene, int arg, const char *call)
+{
+    mpm_scene *s = check_scene(L, scene);
+    lua_getfield(L, arg, "material");
+    const mpm_material *m = luaL_testudata(L, -1, MATERIAL);
+    if (!m)
+        return bind_field_error(L, arg, call, "material", "mpm.material");
+    lua_getiuservalue(L, scene, 1);
+    lua_pushvalue(L, -2);
+    if (lua_rawget(L, -2) == LUA_TNUMBER) {
+        int idx = (int)lua_tointeger(L, -1);
+        lua_pop(L, 3);
+        return idx;
+    }
+    lua_pop(L, 1);
+    core_error err;
+    int idx = mpm_add_material(s, m, &err);
+    if (idx < 0)
+        return bind_raise(L, call, &err);
+    lua_pushvalue(L, -2);
+    lua_pushinteger(L, idx);
+    lua_rawset(L, -3);
+    lua_pop(L, 2);
+    return idx;
+}
+
+/* ---- grains ---------------------------------------------------------------------------------- */
+static int add_grain(lua_State *L, const char *call, mpm_shape shape)
+{
+    static const char *const disk_fields[] = {"center", "radius", "material", "points_per_cell",
+                                              "velocity", "omega", NULL};
+    static const char *const rect_fields[] = {"lo", "hi", "material", "points_per_cell",
+                                              "velocity", "omega", NULL};
+    mpm_scene *s = check_scene(L, 1);
+    bind_check_table(L, 2, call);
+    bind_check_fields(L, 2, call, shape == MPM_DISK ? disk_fields : rect_fields);
+    mpm_grain_def g = mpm_default_grain_def();
+    g.shape = shape;
+    if (shape == MPM_DISK) {
+        bind_field_vector(L, 2, call, "center", 2, g.center, BIND_REQUIRED);
+        g.radius = bind_field_number(L, 2, call, "radius", 0, BIND_REQUIRED | BIND_POSITIVE);
+    } else {
+        bind_field_vector(L, 2, call, "lo", 2, g.lo, BIND_REQUIRED);
+        bind_field_vector(L, 2, call, "hi", 2, g.hi, BIND_REQUIRED);
+    }
+    g.points_per_cell = (int)bind_field_integer(L, 2, call, "points_per_cell", 2, 1, 64, 0);
+    bind_field_vector(L, 2, call, "velocity", 2, g.velocity, 0);
+    g.omega = bind_field_number(L, 2, call, "omega", 0, 0);
+    g.material = material_of(L, 1, 2, call);
+    core_error err;
+    long id = mpm_add_grain(s, &g, &err);
+    if (id < 0)
+        return bind_raise(L, call, &err);
+    lua_pushinteger(L, id + 1);
+    return 1;
+}
+
+static int l_add_disk(lua_State *L) { return add_grain(L, "add_disk", MPM_DISK); }
+static int l_add_rect(lua_State *L) { return add_grain(L, "add_rect", MPM_RECT); }
+
+/* ---- contact --------------------------------------------------------------------------------- */
+static int l_contact(lua_State *L)
+{
+    static const char *const fields[] = {"model", "mu", NULL};
+    static const char *const names[] = {"noslip", "friction", NULL};
+    mpm_scene *s = check_scene(L, 1);
+    bind_check_table(L, 2, "contact");
+    bind_check_fields(L, 2, "contact", fields);
+    int model = bind_field_option(L, 2, "contact", "model", names, 0, BIND_REQUIRED);
+    if (model == MPM_CONTACT_NOSLIP && lua_getfield(L, 2, "mu") != LUA_TNIL)
+        return bind_field_error(L, 2, "contact", "mu", "nothing for model 'noslip'");
+    core_error err;
+    if (mpm_set_contact(s, (mpm_contact_model)model, &err))
+        return bind_raise(L, "contact", &err);
+    return 0;
+}
+
+/* ---- time stepping ------------------------------------------------------------------------- */
+static void push_timestep(lua_State *L, const mpm_timestep *t)
+{
+    lua_createtable(L, 0, 4);
+    lua_pushnumber(L, t->wave_speed);
+    lua_setfield(L, -2, "wave_speed");
+    lua_pushnumber(L, t->max_speed);
+    lua_setfield(L, -2, "max_speed");
+    lua_pushnumber(L, t->limit);
+    lua_setfield(L, -2, "limit");
+    lua_pushnumber(L, t->dt_auto);
+    lua_setfield(L, -2, "dt_auto");
+}
+
+static int l_timestep(lua_State *L)
+{
+    mpm_scene *s = check_scene(L, 1);
+    double cfl = MPM_DEFAULT_CFL;
+    if (!lua_isnoneornil(L, 2)) {
+        static const char *const fields[] = {"cfl", NULL};
+        bind_check_table(L, 2, "timestep");
+        bind_check_fields(L, 2, "timestep", fields);
+        cfl = bind_field_number(L, 2, "timestep", "cfl", cfl, BIND_POSITIVE);
+    }
+    mpm_timestep t;
+    core_error err;
+    if (mpm_timestep_info(s, cfl, &t, &err))
+        return bind_raise(L, "timestep", &err);
+    push_timestep(L, &t);
+    return 1;
+}
+
+static int l_run(lua_State *L)
+{
+    static const char *const fields[] = {"steps", "time", "dt", "cfl", "force", "every", "on_step",
+                                         "progress", NULL};
+    mpm_scene *s = check_scene(L, 1);
+    bind_check_table(L, 2, "run");
+    bind_check_fields(L, 2, "run", fields);
+    mpm_run_def run = mpm_default_run_def();
+    run.cfl = bind_field_number(L, 2, "run", "cfl", MPM_DEFAULT_CFL, BIND_POSITIVE);
+    if (run.cfl > 1) {
+        lua_getfield(L, 2, "cfl");
+        return bind_field_error(L, 2, "run", "cfl", "number in (0, 1]");
+    }
+    int force = bind_field_boolean(L, 2, "run", "force", 0);
+    mpm_timestep ts;
+    core_error err;
+    if (mpm_timestep_info(s, run.cfl, &ts, &err))
+        return bind_raise(L, "run", &err);
+    lua_getfield(L, 2, "dt");
+    if (lua_isnil(L, -1) ||
+        (lua_type(L, -1) == LUA_TSTRING && strcmp(lua_tostring(L, -1), "auto") == 0)) {
+        run.dt = 0; /* re-evaluated every step from the CFL condition */
+    } else {
+        lua_pop(L, 1);
+        run.dt = bind_field_number(L, 2, "run", "dt", 0, BIND_POSITIVE);
+        lua_pushnil(L);
+        if (run.dt > ts.limit && !force) {
+            char msg[512];
+            snprintf(msg, sizeof msg,
+                     "run: dt = %g s exceeds the CFL limit %g s (h / (c + max|v|) with h = the "
+                     "smaller cell side, wave speed c = %g m/s, fastest point %g m/s); use dt = "
+                     "\"auto\" (%g s at cfl = %g), a smaller dt, or force = true",
+                     run.dt, ts.limit, ts.wave_speed, ts.max_speed, ts.dt_auto, run.cfl);
+            return luaL_error(L, "%s", msg);
+        }
+    }
+    lua_pop(L, 1);
+    long steps = (long)bind_field_integer(L, 2, "run", "steps", -1, 0, LUA_MAXINTEGER, 0);
+    double time = bind_field_number(L, 2, "run", "time", -1, BIND_NONNEG);
+    if ((steps >= 0) == (time >= 0))
+        return luaL_error(L, "run: give exactly one of steps and time");
+    double t0 = mpm_time(s);
+    long expect = steps; /* for progress and the default `every` */
+    if (time >= 0) {
+        run.time_end = t0 + time;
+        expect = (long)ceil(time / (run.dt > 0 ? run.dt : ts.dt_auto) - 1e-9);
+        steps = LUA_MAXINTEGER;
+    }
+    long every = (long)bind_field_integer(L, 2, "run", "every", 0, 1, LUA_MAXINTEGER, 0);
+    int has_cb = lua_getfield(L, 2, "on_step") != LUA_TNIL;
+    if (has_cb && lua_type(L, -1) != LUA_TFUNCTION)
+        return bind_field_error(L, 2, "run", "on_step", "function");
+    int cb = lua_gettop(L);
+    if (has_cb && every == 0)
+        every = expect > 100 ? expect / 100 : 1;
+    if (every == 0)
+        every = steps;
+    int want_progress = bind_field_boolean(L, 2, "run", "progress", -1);
+    progress prog;
+    prog.active = 0;
+    if (want_progress == 1 || (want_progress == -1 && expect >= 1000 &&
+                               progress_default_style() != PROGRESS_QUIET)) {
+        progress_begin(&prog, "mpm run", (double)expect, "steps");
+        if (want_progress == -1 && prog.style != PROGRESS_BAR)
+            prog.active = 0;
+    }
+    long s0 = mpm_steps_done(s), done = 0;
+    int stopped = 0;
+    while (done < steps && !stopped) {
+        run.steps = steps - done < every ? steps - done : every;
+        long chunk;
+        core_status st = mpm_run(s, &run, &chunk, &err);
+        done += chunk;
+        if (prog.active)
+            progress_update(&prog, (double)done);
+        if (st != CORE_OK) {
+            if (prog.active)
+                progress_end(&prog);
+            return bind_raise(L, "run", &err);
+        }
+        if (chunk < run.steps)
+            stopped = 2; /* reached the end time */
+        if (has_cb && chunk > 0) {
+            lua_pushvalue(L, cb);
+            lua_pushvalue(L, 1);
+            if (lua_pcall(L, 1, 1, 0) != LUA_OK) {
+                if (prog.active)
+                    progress_end(&prog);
+                return lua_error(L);
+            }
+            if (lua_type(L, -1) == LUA_TBOOLEAN && !lua_toboolean(L, -1))
+                stopped = 1;
+            lua_pop(L, 1);
+        }
+    }
+    if (prog.active)
+        progress_end(&prog);
+    lua_createtable(L, 0, 4);
+    lua_pushinteger(L, mpm_steps_done(s) - s0);
+    lua_setfield(L, -2, "steps");
+    lua_pushnumber(L, mpm_time(s) - t0);
+    lua_setfield(L, -2, "time");
+    lua_pushnumber(L, run.dt > 0 ? run.dt : ts.dt_auto);
+    lua_setfield(L, -2, "dt");
+    lua_pushboolean(L, stopped == 1);
+    lua_setfield(L, -2, "stopped");
+    return 1;
+}
+
+/* ---- measurements ---------------------------------------------------------------------------- */
+static void set_number(lua_State *L, const char *k, double v)
+{
+    lua_pushnumber(L, v);
+    lua_setfield(L, -2, k);
+}
+
+static void push_pair(lua_State *L, const double v[2])
+{
+    lua_createtable(L, 2, 0);
+    for (int d = 0; d < 2; d++) {
+        lua_pushnumber(L, v[d]);
+        lua_rawseti(L, -2, d + 1);
+    }
+}
+
+static int l_measure(lua_State *L)
+{
+    static const char *const what_names[] = {"energy", "momentum", NULL};
+    mpm_scene *s = check_scene(L, 1);
+    int what = luaL_checkoption(L, 2, NULL, what_names);
+    if (what == 0) {
+        mpm_energy e;
+        mpm_measure_energy(s, &e);
+        lua_createtable(L, 0, 5);
+        set_number(L, "kinetic", e.kinetic);
+        set_number(L, "elastic", e.elastic);
+        set_number(L, "plastic", e.plastic);
+        set_number(L, "potential", e.potential);
+        set_number(L, "total", e.total);
+        return 1;
+    }
+    double p[2], lz;
+    mpm_measure_momentum(s, p, &lz);
+    lua_createtable(L, 0, 2);
+    push_pair(L, p);
+    lua_setfield(L, -2, "linear");
+    set_number(L, "angular", lz);
+    return 1;
+}
+
+static int l_grain(lua_State *L)
+{
+    mpm_scene *s = check_scene(L, 1);
+    lua_Integer id = luaL_checkinteger(L, 2);
+    if (id < 1 || (size_t)id > mpm_grain_count(s))
+        return luaL_error(L, "bad argument #1 to 'grain' (grain id in [1, %d] expected, got %d)",
+                          (int)mpm_grain_count(s), (int)id);
+    mpm_grain_info g;
+    core_error err;
+    if (mpm_grain(s, (size_t)(id - 1), &g, &err))
+        return bind_raise(L, "grain", &err);
+    lua_createtable(L, 0, 7);
+    set_number(L, "mass", g.mass);
+    push_pair(L, g.center);
+    lua_setfield(L, -2, "center");
+    push_pair(L, g.velocity);
+    lua_setfield(L, -2, "velocity");
+    set_number(L, "angular_momentum", g.angular_momentum);
+    set_number(L, "inertia", g.inertia);
+    set_number(L, "omega", g.omega);
+    lua_pushinteger(L, (lua_Integer)g.points);
+    lua_setfield(L, -2, "points");
+    return 1;
+}
+
+static void push_array(lua_State *L, const double *a, size_t n, const char *name)
+{
+    lua_createtable(L, (int)n, 0);
+    for (size_t i = 0; i < n; i++) {
+        lua_pushnumber(L, a[i]);
+        lua_rawseti(L, -2, (lua_Integer)i + 1);
+    }
+    lua_setfield(L, -2, name);
+}
+
+static int l_points(lua_State *L)
+{
+    mpm_scene *s = check_scene(L, 1);
+    size_t n = mpm_point_count(s);
+    mpm_points p;
+    mpm_get_points(s, &p);
+    lua_createtable(L, 0, 16);
+    push_array(L, p.x, n, "x");
+    push_array(L, p.y, n, "y");
+    push_array(L, p.vx, n, "vx");
+    push_array(L, p.vy, n, "vy");
+    push_array(L, p.mass, n, "mass");
+    static const char *const sig[4] = {"sxx", "syy", "sxy", "szz"};
+    static const char *const F[4] = {"Fxx", "Fxy", "Fyx", "Fyy"};
+    for (int k = 0; k < 4; k++) {
+        push_array(L, p.sigma[k], n, sig[k]);
+        push_array(L, p.F[k], n, F[k]);
+    }
+    push_array(L, p.eps_p, n, "eps_p");
+    lua_createtable(L, (int)n, 0);
+    for (size_t i = 0; i < n; i++) {
+        lua_pushinteger(L, p.grain[i] + 1);
+        lua_rawseti(L, -2, (lua_Integer)i + 1);
+    }
+    lua_setfield(L, -2, "grain");
+    lua_createtable(L, (int)n, 0);
+    for (size_t i = 0; i < n; i++) {
+        double J = p.F[0][i] * p.F[3][i] - p.F[1][i] * p.F[2][i];
+        lua_pushnumber(L, p.volume0[i] * J);
+        lua_rawseti(L, -2, (lua_Integer)i + 1);
+    }
+    lua_setfield(L, -2, "volume");
+    lua_pushinteger(L, (lua_Integer)n);
+    lua_setfield(L, -2, "count");
+    return 1;
+}
+
+/* m:set_velocities{ vx = {...}, vy = {...} }: one entry per point. */
+static int l_set_velocities(lua_State *L)
+{
+    static const char *const fields[] = {"vx", "vy", NULL};
+    mpm_scene *s = check_scene(L, 1);
+    bind_check_table(L, 2, "set_velocities");
+    bind_check_fields(L, 2, "set_velocities", fields);
+    size_t n = mpm_point_count(s);
+    char expected[96];
+    snprintf(expected, sizeof expected, "array of %zu finite numbers (one per point)", n);
+    double *v[2];
+    static const char *const comp[2] = {"vx", "vy"};
+    for (int d = 0; d < 2; d++) {
+        if (lua_getfield(L, 2, comp[d]) != LUA_TTABLE || (size_t)luaL_len(L, -1) != n)
+            return bind_field_error(L, 2, "set_velocities", comp[d], expected);
+        v[d] = lua_newuserdatauv(L, (n ? n : 1) * sizeof(double), 0); /* freed by the GC */
+        for (size_t i = 0; i < n; i++) {
+            lua_rawgeti(L, -2, (lua_Integer)i + 1);
+            int isnum;
+            v[d][i] = lua_tonumberx(L, -1, &isnum);
+            if (!isnum || !isfinite(v[d][i]))
+                return luaL_error(L, "bad field '%s' in argument #1 to 'set_velocities' (%s "
+                                  "expected, entry %d is not)", comp[d], expected, (int)i + 1);
+            lua_pop(L, 1);
+        }
+    }
+    core_error err;
+    if (mpm_set_velocities(s, v[0], v[1], &err))
+        return bind_raise(L, "set_velocities", &err);
+    return 0;
+}
+
+static int l_info(lua_State *L)
+{
+    mpm_scene *s = check_scene(L, 1);
+    const mpm_scene_def *d = mpm_def(s);
+    lua_createtable(L, 0, 12);
+    lua_createtable(L, 2, 0);
+    for (int k = 0; k < 2; k++) {
+        lua_pushinteger(L, d->cells[k]);
+        lua_rawseti(L, -2, k + 1);
+    }
+    lua_setfield(L, -2, "cells");
+    push_pair(L, d->size);
+    lua_setfield(L, -2, "size");
+    push_pair(L, d->origin);
+    lua_setfield(L, -2, "origin");
+    push_pair(L, d->gravity);
+    lua_setfield(L, -2, "gravity");
+    double h[2];
+    mpm_cell_size(s, h);
+    push_pair(L, h);
+    lua_setfield(L, -2, "cell_size");
+    lua_pushinteger(L, (lua_Integer)mpm_point_count(s));
+    lua_setfield(L, -2, "points");
+    lua_pushinteger(L, (lua_Integer)mpm_grain_count(s));
+    lua_setfield(L, -2, "grains");
+    set_number(L, "time", mpm_time(s));
+    lua_pushinteger(L, mpm_steps_done(s));
+    lua_setfield(L, -2, "steps");
+    lua_pushstring(L, UPDATE_NAMES[d->update]);
+    lua_setfield(L, -2, "update");
+    set_number(L, "pic", d->pic);
+    lua_pushstring(L, mpm_contact(s) == MPM_CONTACT_NOSLIP ? "noslip" : "friction");
+    lua_setfield(L, -2, "contact");
+    return 1;
+}
+
+static int l_gc(lua_State *L)
+{
+    lscene *u = luaL_checkudata(L, 1, SCENE);
+    mpm_destroy(u->s);
+    u->s = NULL;
+    return 0;
+}
+
+static int l_tostring(lua_State *L)
+{
+    lscene *u = luaL_checkudata(L, 1, SCENE);
+    if (!u->s) {
+        lua_pushliteral(L, "mpm.scene (closed)");
+    } else {
+        const mpm_scene_def *d = mpm_def(u->s);
+        lua_pushfstring(L, "mpm.scene (%d x %d cells, %d grains, %d points, t = %f s)",
+                        d->cells[0], d->cells[1], (int)mpm_grain_count(u->s),
+                        (int)mpm_point_count(u->s), mpm_time(u->s));
+    }
+    return 1;
+}
+
+void bind_open_mpm(lua_State *L)
+{
+    static const bind_fn methods[] = {
+        {"add_disk", l_add_disk,
+         "m:add_disk{ center = {x, y}, radius = r, material = mat, points_per_cell = 2, "
+         "velocity = {vx, vy}, omega = 0 }",
+         "Fills a disk with n x n points per cell (points at the centres of the sub-cells inside "
+         "the disk; the paper uses n = 2 or 3) and returns the grain id. The disk must lie inside "
+         "the grid on axes that are not periodic. velocity and omega set a rigid initial motion "
+         "about the grain's centroid. material: an mpm.material."},
+        {"add_rect", l_add_rect,
+         "m:add_rect{ lo = {x0, y0}, hi = {x1, y1}, material = mat, points_per_cell = 2, "
+         "velocity = {vx, vy}, omega = 0 }",
+         "Fills a rectangle with points like add_disk (bars, blocks); returns the grain id."},
+        {"contact", l_contact, "m:contact{ model = 'noslip' }",
+         "The grain contact model. 'noslip': the single centre-of-mass velocity field of the "
+         "basic algorithm (Sec. 2), grains stick on contact. 'friction' (Eqs. 12-24, mu =) is "
+         "not implemented yet and is refused."},
+        {"timestep", l_timestep, "m:timestep{ cfl = 0.4 }",
+         "The CFL limit h / (c + max|v|) (h the smaller cell side, c = sqrt((K + 4G/3)/rho) the "
+         "largest P-wave speed), the automatic step cfl x limit, the wave speed and the fastest "
+         "point."},
+        {"run", l_run,
+         "m:run{ steps = N | time = T, dt = 'auto', cfl = 0.4, force = false, every =, "
+         "on_step = function(m) end, progress = nil }",
+         "Advances the scene (MUSL by default; update = 'usl' in mpm.scene for the paper's "
+         "step order, which is unstable at nearly empty nodes). dt = 'auto' takes cfl x h / (c + max|v|), "
+         "re-evaluated every step; a fixed dt above the CFL limit is refused unless force = "
+         "true. time = T lands exactly on T. on_step runs every `every` steps; returning false "
+         "stops the run. Ctrl-C stops between steps with the scene intact; NaN, an inverted "
+         "point or a point leaving the grid stop the run with an error naming the step, point "
+         "and grain. Returns {steps, time, dt, stopped}."},
+        {"measure", l_measure, "m:measure('energy'|'momentum')",
+         "energy: kinetic, elastic (Hencky stored energy), plastic (plastic work), potential "
+         "(gravity), total; per unit depth (J/m). momentum: linear = {px, py}, angular (about "
+         "the origin)."},
+        {"grain", l_grain, "m:grain(id)",
+         "mass, center (centre of mass), velocity, angular_momentum (about the centre of mass), "
+         "inertia, omega (= angular_momentum / inertia) and points of grain id."},
+        {"points", l_points, "m:points()",
+         "Arrays over the material points: x, y, vx, vy, mass, volume, grain, sxx, syy, sxy, szz "
+         "(Cauchy stress, tension positive), Fxx, Fxy, Fyx, Fyy, eps_p; and count."},
+        {"set_velocities", l_set_velocities, "m:set_velocities{ vx = {...}, vy = {...} }",
+         "Sets every point's velocity from arrays in point order (as m:points() lists them)."},
+        {"info", l_info, "m:info()",
+         "cells, size, origin, cell_size, gravity, points, grains, time, steps, update, pic, "
+         "contact."},
+        {NULL, NULL, NULL, NULL}};
+    static const luaL_Reg meta[] = {
+        {"__gc", l_gc}, {"__close", l_gc}, {"__tostring", l_tostring}, {NULL, NULL}};
+    bind_new_type(L, SCENE, methods, meta, "An MPM scene from mpm.scene{...}.");
+
+    luaL_newmetatable(L, MATERIAL);
+    bind_doc(L, -1, MATERIAL, MATERIAL,
+             "An MPM material from mpm.material{...}; read-only fields model, density, shear, "
+             "bulk, yield, hardening, young, poisson, wave_speed.");
+    lua_pushcfunction(L, material_index);
+    lua_setfield(L, -2, "__index");
+    lua_pushcfunction(L, material_tostring);
+    lua_setfield(L, -2, "__tostring");
+    lua_pop(L, 1);
+
+    static const bind_fn fns[] = {
+        {"scene", l_scene,
+         "mpm.scene{ cells = {nx, ny}, size = {Lx, Ly}, origin = {0, 0}, periodic = {false, "
+         "false}, gravity = {0, 0}, walls = 'noslip'|'slip'|'none'|{left =, right =, bottom =, "
+         "top =}, update = 'musl'|'usl', pic = 0 }",
+         "A new 2D (plane strain) MPM scene on a uniform grid of nx x ny cells. walls: the grid's "
+         "boundary nodes on axes that are not periodic — 'noslip' fixes them (default), 'slip' "
+         "fixes the normal velocity only, 'none' leaves them free (a point reaching the edge "
+         "stops the run). update: 'musl' (default: the strain rate from remapped, mass-weighted nodal velocities, stable at nearly empty nodes) or 'usl' (the paper's step order). pic: PIC "
+         "fraction of the point velocity update (0 = pure FLIP, Eq. 11)."},
+        {"material", l_material,
+         "mpm.material{ model = 'elastic'|'vonmises', density =, shear =, bulk =, yield =, "
+         "hardening = 0 }",
+         "An MPM material: Hencky (log-strain) hyperelastic, tau = K ln J I + 2 G dev ln V_e, "
+         "objective under large rotations and with a stored energy; 'vonmises' adds J2 "
+         "plasticity with linear isotropic hardening (q = yield + hardening eps_p, radial "
+         "return). SI units."},
+        {NULL, NULL, NULL, NULL}};
+    lua_newtable(L);
+    bind_register(L, -1, fns);
+    bind_doc(L, -1, "mpm", "mpm",
+             "Material points: deformable grains on a background grid (Bardenhagen et al. 1998).");
+    lua_setglobal(L, "mpm");
+}

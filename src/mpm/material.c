@@ -1,0 +1,128 @@
+/* MPM materials: Hencky (logarithmic-strain) hyperelasticity in plane strain and von Mises
+ * plasticity with linear isotropic hardening by radial return in principal log strains
+ * (Simo 1992). This is the constitutive part of step 3 of the paper's algorithm (Sec. 2). */
+#include <math.h>
+
+#include "mpm/mpm_internal.h"
+
+mpm_material mpm_default_material(void)
+{
+    return (mpm_material){.model = MPM_ELASTIC, .density = 3000, .shear = 2.5e6, .bulk = 10e6,
+                          .yield = 0, .hardening = 0};
+}
+
+core_status mpm_check_material(const mpm_material *m, core_error *err)
+{
+    if (m->model != MPM_ELASTIC && m->model != MPM_VONMISES)
+        return core_fail(err, CORE_ERR_ARG, "unknown material model %d", (int)m->model);
+    const double v[3] = {m->density, m->shear, m->bulk};
+    static const char *const names[3] = {"density", "shear modulus", "bulk modulus"};
+    for (int k = 0; k < 3; k++)
+        if (!(v[k] > 0) || !isfinite(v[k]))
+            return core_fail(err, CORE_ERR_ARG, "%s must be > 0, got %g", names[k], v[k]);
+    if (m->model == MPM_VONMISES) {
+        if (!(m->yield > 0) || !isfinite(m->yield))
+            return core_fail(err, CORE_ERR_ARG, "von Mises yield stress must be > 0, got %g",
+                             m->yield);
+        if (!(m->hardening >= 0) || !isfinite(m->hardening))
+            return core_fail(err, CORE_ERR_ARG, "hardening must be >= 0, got %g", m->hardening);
+    }
+    return CORE_OK;
+}
+
+double mpm_wave_speed(const mpm_material *m)
+{
+    return sqrt((m->bulk + 4.0 / 3.0 * m->shear) / m->density);
+}
+
+/* Principal directions of the in-plane block [a b; b c]: eigenvalues l1 >= l2, angle of the
+ * first eigenvector. */
+static void eig2(double a, double b, double c, double *l1, double *l2, double *cs, double *sn)
+{
+    double mean = 0.5 * (a + c), half = 0.5 * (a - c);
+    double r = sqrt(half * half + b * b);
+    *l1 = mean + r;
+    *l2 = mean - r;
+    double th = 0.5 * atan2(2 * b, a - c);
+    *cs = cos(th);
+    *sn = sin(th);
+}
+
+/* Principal log strains of b_e (eps_i = ln(lambda_i) / 2) and the principal directions. */
+static bool log_strains(const double be[4], double eps[3], double *cs, double *sn)
+{
+    double l1, l2;
+    eig2(be[0], be[1], be[2], &l1, &l2, cs, sn);
+    if (!(l2 > 0) || !(be[3] > 0))
+        return false;
+    eps[0] = 0.5 * log(l1);
+    eps[1] = 0.5 * log(l2);
+    eps[2] = 0.5 * log(be[3]);
+    return true;
+}
+
+double mpm_elastic_energy_density(const mpm_material *m, const double be[4])
+{
+    double eps[3], cs, sn;
+    if (!log_strains(be, eps, &cs, &sn))
+        return NAN;
+    double ev = eps[0] + eps[1] + eps[2], e2 = 0;
+    for (int i = 0; i < 3; i++) {
+        double e = eps[i] - ev / 3;
+        e2 += e * e;
+    }
+    return 0.5 * m->bulk * ev * ev + m->shear * e2;
+}
+
+bool mpm_material_update(const mpm_material *m, const double f[4], double be[4], double *eps_p,
+                         double J, double sigma[4])
+{
+    if (!(f[0] * f[3] - f[1] * f[2] > 0) || !(J > 0))
+        return false;
+    /* Trial b_e = f b_e f^T (in plane; plane strain keeps the zz stretch). */
+    const double b00 = be[0], b01 = be[1], b11 = be[2];
+    double t00 = f[0] * b00 + f[1] * b01, t01 = f[0] * b01 + f[1] * b11;
+    double t10 = f[2] * b00 + f[3] * b01, t11 = f[2] * b01 + f[3] * b11;
+    double tr[4] = {t00 * f[0] + t01 * f[1], t00 * f[2] + t01 * f[3], t10 * f[2] + t11 * f[3],
+                    be[3]};
+    double eps[3], cs, sn;
+    if (!log_strains(tr, eps, &cs, &sn))
+        return false;
+    const double K = m->bulk, G = m->shear;
+    double ev = eps[0] + eps[1] + eps[2], e[3], en = 0;
+    for (int i = 0; i < 3; i++) {
+        e[i] = eps[i] - ev / 3;
+        en += e[i] * e[i];
+    }
+    en = sqrt(en);
+    if (m->model == MPM_VONMISES && en > 0) {
+        /* Radial return: f = |s| - sqrt(2/3) (yield + H eps_p) with s = 2 G e. */
+        const double k23 = sqrt(2.0 / 3.0);
+        double ftrial = 2 * G * en - k23 * (m->yield + m->hardening * *eps_p);
+        if (ftrial > 0) {
+            double dgamma = ftrial / (2 * G + 2.0 / 3.0 * m->hardening);
+            double scale = 1 - dgamma / en;
+            for (int i = 0; i < 3; i++)
+                e[i] *= scale;
+            *eps_p += k23 * dgamma;
+        }
+    }
+    double tau[3];
+    for (int i = 0; i < 3; i++) {
+        eps[i] = e[i] + ev / 3;
+        tau[i] = K * ev + 2 * G * e[i];
+    }
+    /* Back to tensors: b_e = sum exp(2 eps_i) n_i n_i, tau likewise; sigma = tau / J. */
+    double l1 = exp(2 * eps[0]), l2 = exp(2 * eps[1]);
+    double c2 = cs * cs, s2 = sn * sn, csn = cs * sn;
+    be[0] = l1 * c2 + l2 * s2;
+    be[1] = (l1 - l2) * csn;
+    be[2] = l1 * s2 + l2 * c2;
+    be[3] = exp(2 * eps[2]);
+    double inv_j = 1 / J;
+    sigma[0] = (tau[0] * c2 + tau[1] * s2) * inv_j;
+    sigma[1] = (tau[0] * s2 + tau[1] * c2) * inv_j;
+    sigma[2] = (tau[0] - tau[1]) * csn * inv_j;
+    sigma[3] = tau[2] * inv_j;
+    return true;
+}

@@ -1,0 +1,191 @@
+/* grainlab MPM: the material point method in 2D (plane strain) on a uniform background grid.
+ * Physics: Bardenhagen, Brackbill & Sulsky (1998), Sec. 2: lumped mass (Eqs. 5-6), internal
+ * force (Eqs. 7-8), grid momentum (Eq. 9), point update (Eqs. 10-11), linear tensor-product
+ * shape functions. The single centre-of-mass velocity field is the "noslip" contact model; the
+ * frictional multi-field contact (Eqs. 12-24) is not implemented yet.
+ *
+ * Usage: fill an mpm_scene_def from mpm_default_scene_def(), create the scene, add materials and
+ * grains, then call mpm_run. Every call that can fail returns a core_status and explains itself
+ * in a core_error. Nothing here knows about Lua. */
+#ifndef GRAINLAB_MPM_H
+#define GRAINLAB_MPM_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "core/error.h"
+
+typedef struct mpm_scene mpm_scene;
+
+/* ---- scene --------------------------------------------------------------------------------- */
+typedef enum mpm_wall {
+    MPM_WALL_NOSLIP, /* boundary nodes fixed: zero velocity (default) */
+    MPM_WALL_SLIP,   /* zero normal velocity, free tangential motion */
+    MPM_WALL_NONE    /* no condition: a point reaching the edge stops the run */
+} mpm_wall;
+
+enum { MPM_LEFT, MPM_RIGHT, MPM_BOTTOM, MPM_TOP };
+
+typedef enum mpm_update {
+    /* Update stress last (the paper's step order, Sec. 2 steps 1-3): the velocity gradient comes
+     * from v_i^{n+1} of Eq. 9, which holds f_i / m_i and so blows up at nearly empty nodes when a
+     * grain crosses cells (measured: a spinning elastic disk, omega R = 1 m/s, 10 cells across,
+     * inverts a point at step 75). */
+    MPM_USL,
+    /* Modified USL (default): after Eq. 11 the new point momenta are mapped back to the grid
+     * (Eq. 5 with v_p^{n+1}) and the velocity gradient is taken from that field, a mass-weighted
+     * mean that stays bounded at any nodal mass. Positions and velocities are as in USL. */
+    MPM_MUSL
+} mpm_update;
+
+typedef struct mpm_scene_def {
+    int cells[2];         /* nx, ny >= 1 */
+    double origin[2];     /* lower-left corner, m */
+    double size[2];       /* Lx, Ly, m */
+    bool periodic[2];     /* a periodic axis has no walls and wraps points */
+    double gravity[2];    /* m/s^2 */
+    mpm_wall walls[4];    /* MPM_LEFT, MPM_RIGHT, MPM_BOTTOM, MPM_TOP (ignored on periodic axes) */
+    mpm_update update;
+    double pic;           /* PIC fraction of the velocity update in [0, 1]: 0 = pure FLIP (Eq. 11,
+                           * default), 1 = pure PIC (v_p = sum_i N_i v_i^{n+1}) */
+} mpm_scene_def;
+
+mpm_scene_def mpm_default_scene_def(void);
+core_status mpm_create(const mpm_scene_def *def, mpm_scene **out, core_error *err);
+void mpm_destroy(mpm_scene *s);
+const mpm_scene_def *mpm_def(const mpm_scene *s);
+/* Cell sizes hx, hy. */
+void mpm_cell_size(const mpm_scene *s, double h[2]);
+
+/* ---- materials ------------------------------------------------------------------------------
+ * Both models are Hencky (logarithmic-strain) hyperelastic in plane strain: Kirchhoff stress
+ * tau = K ln(J) I + 2 G dev(ln V_e), with V_e the elastic left stretch carried as b_e = V_e^2.
+ * It is objective under the large rotations of rolling and spinning grains (a small-strain rate
+ * form is not, and Jaumann-rate hypoelasticity creates or loses energy in closed cycles), it has
+ * a stored energy for the energy balance, and von Mises radial return is exact in log-strain
+ * space (Simo 1992) with the small-strain formula. */
+typedef enum mpm_model {
+    MPM_ELASTIC,
+    MPM_VONMISES  /* J2 plasticity, linear isotropic hardening: q = yield + hardening eps_p */
+} mpm_model;
+
+typedef struct mpm_material {
+    mpm_model model;
+    double density;    /* kg/m^3 */
+    double shear;      /* G, Pa */
+    double bulk;       /* K, Pa */
+    double yield;      /* von Mises yield stress (equivalent, q = sqrt(3/2)|s|), Pa */
+    double hardening;  /* H = d q / d eps_p, Pa (>= 0) */
+} mpm_material;
+
+mpm_material mpm_default_material(void); /* elastic, the paper's incline disk: 3000, 2.5 MPa, 10 MPa */
+/* Checks a material (positive density and moduli, yield > 0 for von Mises). */
+core_status mpm_check_material(const mpm_material *m, core_error *err);
+/* Returns the material index (>= 0) or -1 with err filled. */
+int mpm_add_material(mpm_scene *s, const mpm_material *m, core_error *err);
+/* The P-wave speed sqrt((K + 4G/3) / rho). */
+double mpm_wave_speed(const mpm_material *m);
+
+/* One constitutive update of a point (step 3 of Sec. 2): the incremental deformation gradient
+ * f = I + dt L (row-major xx, xy, yx, yy) updates b_e (xx, xy, yy, zz) and eps_p; J is the total
+ * det F after the step. Writes the Cauchy stress (xx, yy, xy, zz). Returns false when the step
+ * inverts the point (det f <= 0). Public so that C tests can drive a single point. */
+bool mpm_material_update(const mpm_material *m, const double f[4], double be[4], double *eps_p,
+                         double J, double sigma[4]);
+/* Stored (Hencky) energy per reference volume of b_e, J/m^3. */
+double mpm_elastic_energy_density(const mpm_material *m, const double be[4]);
+
+/* ---- grains ---------------------------------------------------------------------------------- */
+typedef enum mpm_shape { MPM_DISK, MPM_RECT } mpm_shape;
+
+typedef struct mpm_grain_def {
+    mpm_shape shape;
+    double center[2], radius; /* MPM_DISK */
+    double lo[2], hi[2];      /* MPM_RECT */
+    int material;
+    int points_per_cell;      /* n: the cell is split into n x n sub-cells, a point at the centre
+                               * of each sub-cell inside the shape (paper: n = 2 or 3) */
+    double velocity[2];       /* initial rigid motion: v = velocity + omega x (x - centroid) */
+    double omega;
+} mpm_grain_def;
+
+mpm_grain_def mpm_default_grain_def(void);
+/* Fills the shape with points; returns the grain index (>= 0) or -1 with err filled. The shape
+ * must lie inside the grid on axes that are not periodic. */
+long mpm_add_grain(mpm_scene *s, const mpm_grain_def *g, core_error *err);
+size_t mpm_grain_count(const mpm_scene *s);
+size_t mpm_point_count(const mpm_scene *s);
+
+/* ---- contact ------------------------------------------------------------------------------- */
+typedef enum mpm_contact_model {
+    MPM_CONTACT_NOSLIP,   /* the single centre-of-mass field (Sec. 2, the basic algorithm) */
+    MPM_CONTACT_FRICTION  /* Eqs. 12-24: not implemented yet (mpm_set_contact refuses it) */
+} mpm_contact_model;
+
+core_status mpm_set_contact(mpm_scene *s, mpm_contact_model model, core_error *err);
+mpm_contact_model mpm_contact(const mpm_scene *s);
+
+/* ---- points (bulk access, in point order) --------------------------------------------------- */
+typedef struct mpm_points {
+    const double *x, *y, *vx, *vy, *mass, *volume0;
+    const double *F[4];      /* total deformation gradient, xx, xy, yx, yy */
+    const double *sigma[4];  /* Cauchy stress xx, yy, xy, zz (tension positive) */
+    const double *eps_p;     /* equivalent plastic strain */
+    const int *grain, *material;
+} mpm_points;
+void mpm_get_points(const mpm_scene *s, mpm_points *p);
+/* Sets every point's velocity (arrays of mpm_point_count values, all finite). */
+core_status mpm_set_velocities(mpm_scene *s, const double *vx, const double *vy, core_error *err);
+
+/* ---- time stepping ----------------------------------------------------------------------- */
+typedef struct mpm_timestep {
+    double wave_speed;  /* largest P-wave speed of the materials in use */
+    double max_speed;   /* fastest point */
+    double limit;       /* CFL bound min(hx, hy) / (c + max|v|): no dt above it without force */
+    double dt_auto;     /* cfl * limit */
+} mpm_timestep;
+
+#define MPM_DEFAULT_CFL 0.4
+core_status mpm_timestep_info(const mpm_scene *s, double cfl, mpm_timestep *out, core_error *err);
+
+typedef struct mpm_run_def {
+    long steps;        /* at most this many steps (required >= 0) */
+    double time_end;   /* < 0: none; else stop once the scene time reaches it (the last step is
+                        * shortened to land on it) */
+    double dt;         /* > 0: fixed step; 0: automatic, cfl * limit re-evaluated every step */
+    double cfl;        /* for dt = 0, in (0, 1] */
+} mpm_run_def;
+
+mpm_run_def mpm_default_run_def(void);
+/* Advances the scene; *done = steps taken. Stops between steps on Ctrl-C (CORE_ERR_INTERRUPTED,
+ * scene intact) and on instability (CORE_ERR_UNSTABLE naming the step, the point and its grain:
+ * non-finite values, an inverted point, a point leaving the grid). */
+core_status mpm_run(mpm_scene *s, const mpm_run_def *run, long *done, core_error *err);
+double mpm_time(const mpm_scene *s);
+long mpm_steps_done(const mpm_scene *s);
+
+/* ---- measurements -------------------------------------------------------------------------- */
+typedef struct mpm_energy {
+    double kinetic;    /* sum 1/2 m v^2 (per unit depth: J/m) */
+    double elastic;    /* sum V0 W(b_e), Hencky energy */
+    double plastic;    /* sum V0 (yield eps_p + H eps_p^2 / 2): the plastic work */
+    double potential;  /* -sum m g . x */
+    double total;
+} mpm_energy;
+void mpm_measure_energy(const mpm_scene *s, mpm_energy *e);
+
+typedef struct mpm_grain_info {
+    double mass;
+    double center[2];          /* centre of mass (minimum image on periodic axes) */
+    double velocity[2];
+    double angular_momentum;   /* about the centre of mass, z component */
+    double inertia;            /* sum m |x - c|^2 */
+    double omega;              /* angular_momentum / inertia */
+    size_t points;
+} mpm_grain_info;
+core_status mpm_grain(const mpm_scene *s, size_t id, mpm_grain_info *out, core_error *err);
+
+/* Total linear momentum and angular momentum about the origin. */
+void mpm_measure_momentum(const mpm_scene *s, double p[2], double *lz);
+
+#endif

@@ -1,0 +1,367 @@
+/* MPM scenes: the grid, materials, grains filled with points, bulk access. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mpm/mpm_internal.h"
+
+mpm_scene_def mpm_default_scene_def(void)
+{
+    return (mpm_scene_def){.cells = {10, 10},
+                           .origin = {0, 0},
+                           .size = {1, 1},
+                           .periodic = {false, false},
+                           .gravity = {0, 0},
+                           .walls = {MPM_WALL_NOSLIP, MPM_WALL_NOSLIP, MPM_WALL_NOSLIP,
+                                     MPM_WALL_NOSLIP},
+                           .update = MPM_MUSL,
+                           .pic = 0};
+}
+
+static void *alloc_zero(size_t n, size_t size) { return calloc(n ? n : 1, size); }
+
+core_status mpm_create(const mpm_scene_def *def, mpm_scene **out, core_error *err)
+{
+    *out = NULL;
+    for (int d = 0; d < 2; d++) {
+        if (def->cells[d] < 1 || def->cells[d] > 1 << 20)
+            return core_fail(err, CORE_ERR_ARG, "cells[%d] must be in [1, 1048576], got %d", d + 1,
+                             def->cells[d]);
+        if (!(def->size[d] > 0) || !isfinite(def->size[d]))
+            return core_fail(err, CORE_ERR_ARG, "size[%d] must be > 0, got %g", d + 1, def->size[d]);
+        if (!isfinite(def->origin[d]) || !isfinite(def->gravity[d]))
+            return core_fail(err, CORE_ERR_ARG, "origin and gravity must be finite");
+        if (def->periodic[d] && def->cells[d] < 3)
+            return core_fail(err, CORE_ERR_ARG, "a periodic axis needs at least 3 cells, got %d",
+                             def->cells[d]);
+    }
+    if (!(def->pic >= 0 && def->pic <= 1))
+        return core_fail(err, CORE_ERR_ARG, "pic must be in [0, 1], got %g", def->pic);
+    mpm_scene *s = calloc(1, sizeof *s);
+    if (!s)
+        return core_fail(err, CORE_ERR_NOMEM, "out of memory for the scene");
+    s->def = *def;
+    s->hx = def->size[0] / def->cells[0];
+    s->hy = def->size[1] / def->cells[1];
+    s->inv_hx = 1 / s->hx;
+    s->inv_hy = 1 / s->hy;
+    s->nnx = def->cells[0] + (def->periodic[0] ? 0 : 1);
+    s->nny = def->cells[1] + (def->periodic[1] ? 0 : 1);
+    s->nnodes = (size_t)s->nnx * (size_t)s->nny;
+    double **fields[] = {&s->nm, &s->npx, &s->npy, &s->nfx, &s->nfy,
+                         &s->nvx, &s->nvy, &s->nax, &s->nay};
+    for (size_t k = 0; k < sizeof fields / sizeof *fields; k++)
+        if (!(*fields[k] = alloc_zero(s->nnodes, sizeof(double)))) {
+            mpm_destroy(s);
+            return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu grid nodes", s->nnodes);
+        }
+    if (!(s->nwall = alloc_zero(s->nnodes, 1))) {
+        mpm_destroy(s);
+        return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu grid nodes", s->nnodes);
+    }
+    /* Wall nodes: the boundary rows and columns of axes that are not periodic. */
+    for (int j = 0; j < s->nny; j++)
+        for (int i = 0; i < s->nnx; i++) {
+            unsigned char w = 0;
+            mpm_wall sides[2] = {MPM_WALL_NONE, MPM_WALL_NONE}; /* x side, y side */
+            if (!def->periodic[0] && i == 0)
+                sides[0] = def->walls[MPM_LEFT];
+            if (!def->periodic[0] && i == s->nnx - 1)
+                sides[0] = def->walls[MPM_RIGHT];
+            if (!def->periodic[1] && j == 0)
+                sides[1] = def->walls[MPM_BOTTOM];
+            if (!def->periodic[1] && j == s->nny - 1)
+                sides[1] = def->walls[MPM_TOP];
+            for (int a = 0; a < 2; a++) {
+                if (sides[a] == MPM_WALL_NOSLIP)
+                    w |= 3;
+                else if (sides[a] == MPM_WALL_SLIP)
+                    w |= (unsigned char)(1u << a);
+            }
+            s->nwall[(size_t)j * s->nnx + i] = w;
+        }
+    s->contact = MPM_CONTACT_NOSLIP;
+    *out = s;
+    return CORE_OK;
+}
+
+static double **point_doubles(mpm_scene *s, int k)
+{
+    double **list[] = {&s->x, &s->y, &s->vx, &s->vy, &s->m, &s->v0, &s->F[0], &s->F[1], &s->F[2],
+                       &s->F[3], &s->be[0], &s->be[1], &s->be[2], &s->be[3], &s->sig[0],
+                       &s->sig[1], &s->sig[2], &s->sig[3], &s->eps_p, NULL};
+    return list[k];
+}
+
+void mpm_destroy(mpm_scene *s)
+{
+    if (!s)
+        return;
+    double *fields[] = {s->nm, s->npx, s->npy, s->nfx, s->nfy, s->nvx, s->nvy, s->nax, s->nay,
+                        s->sw, s->sgx, s->sgy};
+    for (size_t k = 0; k < sizeof fields / sizeof *fields; k++)
+        free(fields[k]);
+    for (int k = 0; point_doubles(s, k); k++)
+        free(*point_doubles(s, k));
+    free(s->nwall);
+    free(s->grain);
+    free(s->mat);
+    free(s->sn);
+    free(s->mats);
+    free(s->gstart);
+    free(s->gcount);
+    free(s);
+}
+
+const mpm_scene_def *mpm_def(const mpm_scene *s) { return &s->def; }
+
+void mpm_cell_size(const mpm_scene *s, double h[2])
+{
+    h[0] = s->hx;
+    h[1] = s->hy;
+}
+
+int mpm_add_material(mpm_scene *s, const mpm_material *m, core_error *err)
+{
+    if (mpm_check_material(m, err))
+        return -1;
+    if (s->nmat == s->matcap) {
+        int cap = s->matcap ? 2 * s->matcap : 4;
+        mpm_material *p = realloc(s->mats, (size_t)cap * sizeof *p);
+        if (!p) {
+            core_fail(err, CORE_ERR_NOMEM, "out of memory for materials");
+            return -1;
+        }
+        s->mats = p;
+        s->matcap = cap;
+    }
+    s->mats[s->nmat] = *m;
+    return s->nmat++;
+}
+
+/* Grows the point arrays (and the stencil) to hold n points. Allocation happens here, when grains
+ * are added, never in the step loop. */
+static core_status reserve_points(mpm_scene *s, size_t n, core_error *err)
+{
+    if (n <= s->cap)
+        return CORE_OK;
+    size_t cap = s->cap ? s->cap : 1024;
+    while (cap < n)
+        cap *= 2;
+    for (int k = 0; point_doubles(s, k); k++) {
+        double **a = point_doubles(s, k);
+        double *p = realloc(*a, cap * sizeof(double));
+        if (!p)
+            return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu points", cap);
+        *a = p;
+    }
+    int **ints[] = {&s->grain, &s->mat};
+    for (int k = 0; k < 2; k++) {
+        int *p = realloc(*ints[k], cap * sizeof(int));
+        if (!p)
+            return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu points", cap);
+        *ints[k] = p;
+    }
+    int *sn = realloc(s->sn, cap * MPM_STENCIL * sizeof(int));
+    if (!sn)
+        return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu points", cap);
+    s->sn = sn;
+    double **st[] = {&s->sw, &s->sgx, &s->sgy};
+    for (int k = 0; k < 3; k++) {
+        double *p = realloc(*st[k], cap * MPM_STENCIL * sizeof(double));
+        if (!p)
+            return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu points", cap);
+        *st[k] = p;
+    }
+    s->cap = cap;
+    return CORE_OK;
+}
+
+mpm_grain_def mpm_default_grain_def(void)
+{
+    return (mpm_grain_def){.shape = MPM_DISK, .radius = 0, .material = 0, .points_per_cell = 2};
+}
+
+static bool inside(const mpm_grain_def *g, double x, double y)
+{
+    if (g->shape == MPM_DISK) {
+        double dx = x - g->center[0], dy = y - g->center[1];
+        return dx * dx + dy * dy <= g->radius * g->radius;
+    }
+    return x >= g->lo[0] && x <= g->hi[0] && y >= g->lo[1] && y <= g->hi[1];
+}
+
+long mpm_add_grain(mpm_scene *s, const mpm_grain_def *g, core_error *err)
+{
+    const mpm_scene_def *d = &s->def;
+    if (g->material < 0 || g->material >= s->nmat) {
+        core_fail(err, CORE_ERR_ARG, "material index %d is not in the scene", g->material);
+        return -1;
+    }
+    if (g->points_per_cell < 1 || g->points_per_cell > 64) {
+        core_fail(err, CORE_ERR_ARG, "points per cell must be in [1, 64], got %d",
+                  g->points_per_cell);
+        return -1;
+    }
+    double lo[2], hi[2];
+    if (g->shape == MPM_DISK) {
+        if (!(g->radius > 0) || !isfinite(g->radius)) {
+            core_fail(err, CORE_ERR_ARG, "radius must be > 0, got %g", g->radius);
+            return -1;
+        }
+        for (int a = 0; a < 2; a++) {
+            lo[a] = g->center[a] - g->radius;
+            hi[a] = g->center[a] + g->radius;
+        }
+    } else {
+        for (int a = 0; a < 2; a++) {
+            if (!(g->hi[a] > g->lo[a])) {
+                core_fail(err, CORE_ERR_ARG, "the rectangle's upper corner must be above the "
+                          "lower one on every axis");
+                return -1;
+            }
+            lo[a] = g->lo[a];
+            hi[a] = g->hi[a];
+        }
+    }
+    static const char *const axis[2] = {"x", "y"};
+    for (int a = 0; a < 2; a++) {
+        double glo = d->origin[a], ghi = d->origin[a] + d->size[a];
+        if (d->periodic[a] && hi[a] - lo[a] >= d->size[a]) {
+            core_fail(err, CORE_ERR_ARG, "the shape spans %g in %s, not less than the periodic "
+                      "length %g", hi[a] - lo[a], axis[a], d->size[a]);
+            return -1;
+        }
+        if (!d->periodic[a] && (lo[a] < glo || hi[a] > ghi)) {
+            core_fail(err, CORE_ERR_ARG, "the shape spans [%g, %g] in %s, outside the grid [%g, %g]",
+                      lo[a], hi[a], axis[a], glo, ghi);
+            return -1;
+        }
+    }
+    /* Points at the centres of n x n sub-cells of every grid cell, kept when inside the shape. */
+    const int n = g->points_per_cell;
+    const double dx = s->hx / n, dy = s->hy / n;
+    long i0 = (long)floor((lo[0] - d->origin[0]) / dx), i1 = (long)ceil((hi[0] - d->origin[0]) / dx);
+    long j0 = (long)floor((lo[1] - d->origin[1]) / dy), j1 = (long)ceil((hi[1] - d->origin[1]) / dy);
+    size_t count = 0;
+    double cx = 0, cy = 0;
+    for (long j = j0; j <= j1; j++)
+        for (long i = i0; i <= i1; i++) {
+            double x = d->origin[0] + (i + 0.5) * dx, y = d->origin[1] + (j + 0.5) * dy;
+            if (inside(g, x, y)) {
+                count++;
+                cx += x;
+                cy += y;
+            }
+        }
+    if (count == 0) {
+        core_fail(err, CORE_ERR_ARG, "the shape holds no point at %d points per cell (cell %g x %g): "
+                  "make it larger or use more points per cell", n, s->hx, s->hy);
+        return -1;
+    }
+    cx /= (double)count;
+    cy /= (double)count;
+    if (reserve_points(s, s->np + count, err))
+        return -1;
+    if (s->ngrains == s->gcap) {
+        size_t cap = s->gcap ? 2 * s->gcap : 16;
+        size_t *a = realloc(s->gstart, cap * sizeof *a);
+        if (!a) {
+            core_fail(err, CORE_ERR_NOMEM, "out of memory for grains");
+            return -1;
+        }
+        s->gstart = a;
+        size_t *b = realloc(s->gcount, cap * sizeof *b);
+        if (!b) {
+            core_fail(err, CORE_ERR_NOMEM, "out of memory for grains");
+            return -1;
+        }
+        s->gcount = b;
+        s->gcap = cap;
+    }
+    const mpm_material *mat = &s->mats[g->material];
+    const double vol = dx * dy, mass = mat->density * vol;
+    size_t p = s->np;
+    for (long j = j0; j <= j1; j++)
+        for (long i = i0; i <= i1; i++) {
+            double x = d->origin[0] + (i + 0.5) * dx, y = d->origin[1] + (j + 0.5) * dy;
+            if (!inside(g, x, y))
+                continue;
+            /* rigid initial motion about the point centroid */
+            s->vx[p] = g->velocity[0] - g->omega * (y - cy);
+            s->vy[p] = g->velocity[1] + g->omega * (x - cx);
+            for (int a = 0; a < 2; a++) {
+                double L = d->size[a], o = d->origin[a];
+                double *c = a ? &y : &x;
+                if (d->periodic[a])
+                    *c -= L * floor((*c - o) / L);
+            }
+            s->x[p] = x;
+            s->y[p] = y;
+            s->m[p] = mass;
+            s->v0[p] = vol;
+            s->F[0][p] = s->F[3][p] = 1;
+            s->F[1][p] = s->F[2][p] = 0;
+            s->be[0][p] = s->be[2][p] = s->be[3][p] = 1;
+            s->be[1][p] = 0;
+            for (int k = 0; k < 4; k++)
+                s->sig[k][p] = 0;
+            s->eps_p[p] = 0;
+            s->grain[p] = (int)s->ngrains;
+            s->mat[p] = g->material;
+            p++;
+        }
+    s->gstart[s->ngrains] = s->np;
+    s->gcount[s->ngrains] = count;
+    s->np = p;
+    /* Nodes lighter than 1e-12 of the lightest point take no acceleration (no division blow-up). */
+    if (s->m_min == 0 || 1e-12 * mass < s->m_min)
+        s->m_min = 1e-12 * mass;
+    return (long)s->ngrains++;
+}
+
+size_t mpm_grain_count(const mpm_scene *s) { return s->ngrains; }
+size_t mpm_point_count(const mpm_scene *s) { return s->np; }
+
+core_status mpm_set_contact(mpm_scene *s, mpm_contact_model model, core_error *err)
+{
+    if (model == MPM_CONTACT_FRICTION)
+        return core_fail(err, CORE_ERR_ARG, "contact model 'friction' (Eqs. 12-24) is not "
+                         "implemented yet; only 'noslip' (the single centre-of-mass field)");
+    if (model != MPM_CONTACT_NOSLIP)
+        return core_fail(err, CORE_ERR_ARG, "unknown contact model %d", (int)model);
+    s->contact = model;
+    return CORE_OK;
+}
+
+mpm_contact_model mpm_contact(const mpm_scene *s) { return s->contact; }
+
+void mpm_get_points(const mpm_scene *s, mpm_points *p)
+{
+    p->x = s->x;
+    p->y = s->y;
+    p->vx = s->vx;
+    p->vy = s->vy;
+    p->mass = s->m;
+    p->volume0 = s->v0;
+    for (int k = 0; k < 4; k++) {
+        p->F[k] = s->F[k];
+        p->sigma[k] = s->sig[k];
+    }
+    p->eps_p = s->eps_p;
+    p->grain = s->grain;
+    p->material = s->mat;
+}
+
+double mpm_time(const mpm_scene *s) { return s->time; }
+long mpm_steps_done(const mpm_scene *s) { return s->steps; }
+
+core_status mpm_set_velocities(mpm_scene *s, const double *vx, const double *vy, core_error *err)
+{
+    for (size_t p = 0; p < s->np; p++)
+        if (!isfinite(vx[p]) || !isfinite(vy[p]))
+            return core_fail(err, CORE_ERR_ARG, "velocity of point %zu is not finite", p + 1);
+    memcpy(s->vx, vx, s->np * sizeof(double));
+    memcpy(s->vy, vy, s->np * sizeof(double));
+    return CORE_OK;
+}

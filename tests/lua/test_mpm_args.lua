@@ -1,0 +1,93 @@
+-- The mpm binding's contract on bad input: every error names the call, the field and the value.
+local check = grainlab.check
+local mat = mpm.material{ density = 3000, shear = 2.5e6, bulk = 10e6 }
+local m = mpm.scene{ cells = { 10, 10 }, size = { 1, 1 } }
+
+-- materials: non-positive moduli, unknown model, plastic fields on an elastic material
+check.errors(function() mpm.material{ density = 3000, shear = 0, bulk = 1e6 } end,
+  "bad field 'shear' in argument #1 to 'material' (positive number expected, got 0)", "zero shear")
+check.errors(function() mpm.material{ density = 3000, shear = 1e6, bulk = -1 } end,
+  "bad field 'bulk' in argument #1 to 'material' (positive number expected, got -1)", "negative bulk")
+check.errors(function() mpm.material{ shear = 1e6, bulk = 1e6 } end,
+  "bad field 'density' in argument #1 to 'material' (positive number expected, got nil)", "missing density")
+check.errors(function() mpm.material{ model = "mohr", density = 1, shear = 1, bulk = 1 } end,
+  "bad field 'model' in argument #1 to 'material' (one of 'elastic', 'vonmises' expected, got 'mohr')", "unknown model")
+check.errors(function() mpm.material{ model = "vonmises", density = 1, shear = 1, bulk = 1 } end,
+  "bad field 'yield' in argument #1 to 'material' (positive number expected, got nil)", "von Mises needs a yield stress")
+check.errors(function() mpm.material{ density = 1, shear = 1, bulk = 1, yield = 5 } end,
+  "bad field 'yield' in argument #1 to 'material' (nothing for model 'elastic'", "yield on elastic")
+check.errors(function() mpm.material{ density = 1, shear = 1, bulk = 1, young = 5 } end,
+  "bad argument #1 to 'material' (unknown field 'young'", "unknown material field")
+local vm = mpm.material{ model = "vonmises", density = 1900, shear = 7.5e9, bulk = 11.4e9, yield = 0.3e9, hardening = 0.01e9 }
+check.eq(vm.model, "vonmises", "material fields readable")
+
+-- scenes
+check.errors(function() mpm.scene{ cells = { 0, 10 }, size = { 1, 1 } } end,
+  "bad field 'cells' in argument #1 to 'scene' (array of 2 integers", "zero cells")
+check.errors(function() mpm.scene{ cells = { 10, 10 }, size = { 1, -1 } } end,
+  "bad field 'size' in argument #1 to 'scene' (array of 2 positive numbers expected", "negative size")
+check.errors(function() mpm.scene{ cells = { 10, 10 }, size = { 1, 1 }, walls = "sticky" } end,
+  "bad field 'walls' in argument #1 to 'scene' (one of 'noslip', 'slip', 'none' expected, got 'sticky')", "unknown wall")
+check.errors(function() mpm.scene{ cells = { 10, 10 }, size = { 1, 1 }, walls = { left = "x" } } end,
+  "bad field 'walls.left' in argument #1 to 'scene'", "unknown wall side value")
+check.errors(function() mpm.scene{ cells = { 10, 10 }, size = { 1, 1 }, pic = 2 } end,
+  "bad field 'pic' in argument #1 to 'scene' (number in [0, 1] expected, got 2)", "pic above 1")
+check.errors(function() mpm.scene{ cells = { 10, 10 }, size = { 1, 1 }, gravty = { 0, -9.8 } } end,
+  "bad argument #1 to 'scene' (unknown field 'gravty'", "typo in a field")
+
+-- grains
+check.errors(function() m:add_disk{ center = { 0.5, 0.5 }, radius = 0.2, material = mat, points_per_cell = 0 } end,
+  "bad field 'points_per_cell' in argument #1 to 'add_disk' (integer in [1, 64] expected, got 0)", "points per cell < 1")
+check.errors(function() m:add_disk{ center = { 0.9, 0.5 }, radius = 0.2, material = mat } end,
+  "add_disk: the shape spans [0.7, 1.1] in x, outside the grid [0, 1]", "disk outside the grid")
+check.errors(function() m:add_disk{ center = { 0.5, 0.5 }, radius = -0.2, material = mat } end,
+  "bad field 'radius' in argument #1 to 'add_disk' (positive number expected, got -0.2)", "negative radius")
+check.errors(function() m:add_disk{ center = { 0.5, 0.5 }, radius = 0.2 } end,
+  "bad field 'material' in argument #1 to 'add_disk' (mpm.material expected, got nil)", "missing material")
+check.errors(function() m:add_disk{ center = { 0.5, 0.5 }, radius = 0.2, material = grainlab.material{ density = 1, young = 1 } } end,
+  "bad field 'material' in argument #1 to 'add_disk' (mpm.material expected, got table)", "DEM material")
+check.errors(function() m:add_disk{ center = { 0.5, 0.5 }, radius = 0.001, material = mat } end,
+  "add_disk: the shape holds no point", "disk smaller than the point spacing")
+check.errors(function() m:add_rect{ lo = { 0.5, 0.5 }, hi = { 0.4, 0.6 }, material = mat } end,
+  "add_rect: the rectangle's upper corner must be above the lower one", "inverted rectangle")
+check.errors(function() m:run{ steps = 1 } end, "run: the scene has no material points", "empty scene")
+check.eq(m:add_disk{ center = { 0.5, 0.5 }, radius = 0.2, material = mat }, 1, "first grain id")
+
+-- contact
+check.errors(function() m:contact{ model = "friction", mu = 0.3 } end,
+  "contact: contact model 'friction' (Eqs. 12-24) is not implemented yet", "friction refused")
+check.errors(function() m:contact{ model = "glue" } end,
+  "bad field 'model' in argument #1 to 'contact' (one of 'noslip', 'friction' expected, got 'glue')", "unknown contact")
+check.errors(function() m:contact{ model = "noslip", mu = 0.3 } end,
+  "bad field 'mu' in argument #1 to 'contact' (nothing for model 'noslip'", "mu without friction")
+m:contact{ model = "noslip" }
+
+-- time step
+local ts = m:timestep()
+check.near(ts.wave_speed, math.sqrt((10e6 + 4 / 3 * 2.5e6) / 3000), 1e-12, "P-wave speed")
+check.near(ts.dt_auto, 0.4 * ts.limit, 1e-12, "default cfl 0.4")
+local msg = check.errors(function() m:run{ steps = 1, dt = 2 * ts.limit } end,
+  "run: dt = ", "dt above the CFL limit")
+check.contains(msg, "exceeds the CFL limit", "the limit is in the message")
+check.errors(function() m:run{ steps = 1, cfl = 1.5 } end,
+  "bad field 'cfl' in argument #1 to 'run' (number in (0, 1] expected, got 1.5)", "cfl above 1")
+check.errors(function() m:run{ steps = 1, time = 1 } end, "run: give exactly one of steps and time", "steps and time")
+check.errors(function() m:run{ stpes = 1 } end, "bad argument #1 to 'run' (unknown field 'stpes'", "typo in run")
+check.errors(function() m:grain(2) end, "bad argument #1 to 'grain' (grain id in [1, 1] expected, got 2)", "unknown grain")
+check.errors(function() m:measure("stress") end, "bad argument #1 to 'measure' (invalid option 'stress')", "unknown measure")
+
+-- a point leaving the grid names the step and the grain
+local open = mpm.scene{ cells = { 10, 10 }, size = { 1, 1 }, walls = "none" }
+open:add_disk{ center = { 0.8, 0.5 }, radius = 0.1, material = mat, velocity = { 5, 0 } }
+msg = check.errors(function() open:run{ time = 0.1 } end, "run: point ", "leaving the grid")
+check.contains(msg, "of grain 1 left the grid at step ", "names the grain and the step")
+
+-- forced large dt blows up with an error naming the step and the grain
+local blow = mpm.scene{ cells = { 10, 10 }, size = { 1, 1 } }
+blow:add_disk{ center = { 0.5, 0.5 }, radius = 0.3, material = mat, velocity = { 1, 0 }, omega = 3 }
+msg = check.errors(function() blow:run{ steps = 200, dt = 20 * blow:timestep().limit, force = true } end,
+  "run: point ", "forced unstable step")
+check.contains(msg, "of grain 1 ", "blow-up names the grain")
+check.contains(msg, "at step ", "blow-up names the step")
+check.is_true(tostring(m):find("mpm.scene") ~= nil, "tostring")
+check.done()
