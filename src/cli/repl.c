@@ -44,11 +44,7 @@ static void on_line(char *line)
 
 static int read_tty(const char *prompt, char **out)
 {
-    struct sigaction sa = {0}, old;
-    sa.sa_handler = on_prompt_sigint; /* no SA_RESTART: select() must return */
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, &old);
-    prompt_sigint = 0;
+    prompt_sigint = 0; /* a Ctrl-C between statements only cancels itself */
     line_accepted = 0;
     accepted_line = NULL;
     rl_callback_handler_install(prompt, on_line);
@@ -76,7 +72,6 @@ static int read_tty(const char *prompt, char **out)
         }
         rl_callback_read_char();
     }
-    sigaction(SIGINT, &old, NULL);
     if (result == READ_LINE && !accepted_line)
         result = READ_EOF;
     *out = accepted_line;
@@ -293,6 +288,13 @@ static void close_readline(void)
 void repl_run(lua_State *L)
 {
     use_readline = isatty(STDIN_FILENO);
+    /* For the whole session a Ctrl-C only sets a flag (no SA_RESTART, so the prompt's select()
+     * returns): pressed between statements it must not end the session. cli_docall installs its
+     * own handler while Lua runs and restores this one. */
+    struct sigaction sa = {0}, old;
+    sa.sa_handler = on_prompt_sigint;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, &old);
     if (use_readline)
         setup_readline(L);
     for (;;) {
@@ -314,5 +316,6 @@ void repl_run(lua_State *L)
         fputc('\n', stdout);
         close_readline();
     }
+    sigaction(SIGINT, &old, NULL);
     fflush(stdout);
 }

@@ -192,6 +192,7 @@ static void test_ctrl_c(void **state)
     enter(&s, "print(counter > 1000 and 'counted' or 'no')");
     assert_true(expect(&s, "counted"));
     /* Ctrl-C at the prompt drops the line being typed and gives a fresh prompt. */
+    assert_true(wait_prompt(&s));
     type(&s, "this_would_be_an_error(");
     usleep(100 * 1000);
     type(&s, "\003");
