@@ -286,9 +286,15 @@ static int l_contact(lua_State *L)
     bind_check_table(L, 2, "contact");
     bind_check_fields(L, 2, "contact", fields);
     int model = bind_field_option(L, 2, "contact", "model", names, 0, BIND_REQUIRED);
-    if (model == MPM_CONTACT_NOSLIP && lua_getfield(L, 2, "mu") != LUA_TNIL)
-        return bind_field_error(L, 2, "contact", "mu", "nothing for model 'noslip'");
     core_error err;
+    if (model == MPM_CONTACT_FRICTION) {
+        double mu = bind_field_number(L, 2, "contact", "mu", 0, BIND_REQUIRED | BIND_NONNEG);
+        if (mpm_set_friction(s, mu, &err))
+            return bind_raise(L, "contact", &err);
+        return 0;
+    }
+    if (lua_getfield(L, 2, "mu") != LUA_TNIL)
+        return bind_field_error(L, 2, "contact", "mu", "nothing for model 'noslip'");
     if (mpm_set_contact(s, (mpm_contact_model)model, &err))
         return bind_raise(L, "contact", &err);
     return 0;
@@ -613,6 +619,7 @@ static int l_info(lua_State *L)
     set_number(L, "pic", d->pic);
     lua_pushstring(L, mpm_contact(s) == MPM_CONTACT_NOSLIP ? "noslip" : "friction");
     lua_setfield(L, -2, "contact");
+    set_number(L, "mu", mpm_friction(s));
     return 1;
 }
 
@@ -652,10 +659,18 @@ void bind_open_mpm(lua_State *L)
          "m:add_rect{ lo = {x0, y0}, hi = {x1, y1}, material = mat, points_per_cell = 2, "
          "velocity = {vx, vy}, omega = 0 }",
          "Fills a rectangle with points like add_disk (bars, blocks); returns the grain id."},
-        {"contact", l_contact, "m:contact{ model = 'noslip' }",
-         "The grain contact model. 'noslip': the single centre-of-mass velocity field of the "
-         "basic algorithm (Sec. 2), grains stick on contact. 'friction' (Eqs. 12-24, mu =) is "
-         "not implemented yet and is refused."},
+        {"contact", l_contact, "m:contact{ model = 'noslip' | 'friction', mu = 0.3 }",
+         "The grain contact model. 'noslip' (default): the single centre-of-mass velocity field "
+         "of the basic algorithm (Sec. 2); grains stick on contact. 'friction' (Sec. 3; mu >= 0 "
+         "required, 0 = frictionless): each grain also has its own nodal field, stored only at "
+         "the nodes its points touch; where grains share a node and a grain approaches the "
+         "centre-of-mass field (Eq. 12), its normal velocity is set to the centre-of-mass one "
+         "(Eq. 14) and its tangential slip is reduced by at most mu times that correction "
+         "(Coulomb, Eqs. 18-23), after the grid momentum update (not after P2G). Points move "
+         "with their own grain's field, so grains separate again; an isolated grain moves "
+         "exactly as with 'noslip'. Normals: the gradient of the grain's mass field with the "
+         "linear shape functions against that of the other grains (opposite normals, momentum "
+         "conserved; the paper's Eq. 24 uses quadratic B-splines)."},
         {"timestep", l_timestep, "m:timestep{ cfl = 0.4 }",
          "The CFL limit h / (c + max|v|) (h the smaller cell side, c = sqrt((K + 4G/3)/rho) the "
          "largest P-wave speed), the automatic step cfl x limit, the wave speed and the fastest "
@@ -684,7 +699,7 @@ void bind_open_mpm(lua_State *L)
          "Sets every point's velocity from arrays in point order (as m:points() lists them)."},
         {"info", l_info, "m:info()",
          "cells, size, origin, cell_size, gravity, points, grains, time, steps, update, pic, "
-         "contact."},
+         "contact, mu (0 for noslip)."},
         {NULL, NULL, NULL, NULL}};
     static const luaL_Reg meta[] = {
         {"__gc", l_gc}, {"__close", l_gc}, {"__tostring", l_tostring}, {NULL, NULL}};

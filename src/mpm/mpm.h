@@ -2,7 +2,7 @@
  * Physics: Bardenhagen, Brackbill & Sulsky (1998), Sec. 2: lumped mass (Eqs. 5-6), internal
  * force (Eqs. 7-8), grid momentum (Eq. 9), point update (Eqs. 10-11), linear tensor-product
  * shape functions. The single centre-of-mass velocity field is the "noslip" contact model; the
- * frictional multi-field contact (Eqs. 12-24) is not implemented yet.
+ * "friction" model adds per-grain nodal fields compared with it (Sec. 3, Eqs. 12-24).
  *
  * Usage: fill an mpm_scene_def from mpm_default_scene_def(), create the scene, add materials and
  * grains, then call mpm_run. Every call that can fail returns a core_status and explains itself
@@ -117,13 +117,34 @@ size_t mpm_grain_count(const mpm_scene *s);
 size_t mpm_point_count(const mpm_scene *s);
 
 /* ---- contact ------------------------------------------------------------------------------- */
+/* ---- contact --------------------------------------------------------------------------------
+ * "friction" (Sec. 3): every grain also carries its own nodal field v_i^g (mass Eq. 16, momentum
+ * and force over its own points), stored sparsely: one entry per (grain, node) pair the grain's
+ * points touch, rebuilt every step at a cost linear in the points. At a node touched by two or
+ * more grains, after the grid momentum update (Eq. 9), each grain's v_i^g is compared with the
+ * centre-of-mass v_i: if it approaches (Eq. 12, (v_i^g - v_i) . n_i^g > 0) its normal velocity is
+ * set to the centre-of-mass one (Eq. 14) and its tangential relative velocity is removed up to
+ * mu times the normal correction (Coulomb, Eqs. 18-23). The P2G velocities are not corrected;
+ * with MUSL the remapped grain fields are corrected again at the pairs found in contact at the
+ * momentum update (re-testing Eq. 12 there switches contact on and off every other step and
+ * creates energy). Each grain's points move with, and take their FLIP increment and strain rate
+ * from, their own grain's field at shared nodes and the centre-of-mass field elsewhere; an
+ * isolated grain therefore evolves exactly as with "noslip". Normal n_i^g: the gradient of the
+ * grain's mass field with the linear shape functions (sum_p m_p G_pi over the grain) taken
+ * against the gradient of everything else at the node, so two grains' normals are exactly
+ * opposite and momentum is conserved; the paper (Eq. 24) uses the grain's own
+ * quadratic-B-spline density gradient (not implemented). */
 typedef enum mpm_contact_model {
     MPM_CONTACT_NOSLIP,   /* the single centre-of-mass field (Sec. 2, the basic algorithm) */
-    MPM_CONTACT_FRICTION  /* Eqs. 12-24: not implemented yet (mpm_set_contact refuses it) */
+    MPM_CONTACT_FRICTION  /* per-grain fields with Coulomb friction (Eqs. 12-24) */
 } mpm_contact_model;
 
+/* Selects "noslip". MPM_CONTACT_FRICTION is refused here: it needs mu (mpm_set_friction). */
 core_status mpm_set_contact(mpm_scene *s, mpm_contact_model model, core_error *err);
+/* Selects "friction" with the Coulomb coefficient mu >= 0 (mu = 0: frictionless). */
+core_status mpm_set_friction(mpm_scene *s, double mu, core_error *err);
 mpm_contact_model mpm_contact(const mpm_scene *s);
+double mpm_friction(const mpm_scene *s); /* mu, 0 for noslip */
 
 /* ---- points (bulk access, in point order) --------------------------------------------------- */
 typedef struct mpm_points {

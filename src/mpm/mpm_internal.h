@@ -1,7 +1,7 @@
-/* The MPM scene's private layout: grid geometry, nodal arrays (allocated once at creation),
- * material points in structure-of-arrays, and the per-step stencil (each point's four nodes,
- * weights and weight gradients, computed once per step and reused by every transfer, so per-grain
- * nodal fields can later be accumulated sparsely from the same arrays). */
+/* The MPM scene's private layout: grid geometry, nodal arrays (allocated once), material points
+ * in structure-of-arrays, the per-step stencil (each point's four nodes, weights and weight
+ * gradients, computed once per step and reused by every transfer) and the sparse per-grain nodal
+ * fields of the frictional contact (one entry per (grain, node) pair a grain's points touch). */
 #ifndef GRAINLAB_MPM_INTERNAL_H
 #define GRAINLAB_MPM_INTERNAL_H
 
@@ -16,7 +16,8 @@ struct mpm_scene {
     int nnx, nny;           /* nodes per axis: cells + 1, or cells on a periodic axis */
     size_t nnodes;
 
-    /* nodal fields (nnodes each) */
+    /* nodal fields: nnodes centre-of-mass entries, then (contact "friction") one entry per
+     * (grain, node) pair at index nnodes + q, so the transfers index both the same way */
     double *nm;             /* lumped mass, Eq. 6 */
     double *npx, *npy;      /* momentum m_i v_i^n, Eq. 5 (reused for the MUSL remap) */
     double *nfx, *nfy;      /* internal + external force, Eq. 7 */
@@ -36,6 +37,21 @@ struct mpm_scene {
     int *sn;
     double *sw, *sgx, *sgy;
     double m_min;           /* nodes lighter than this take no acceleration */
+    /* sf: per stencil entry, the nodal-array index of the field the point moves with: sn for
+     * noslip; for friction the grain's pair at nodes shared by several grains, else sn */
+    int *sf;
+
+    /* frictional contact (Eqs. 12-24): sparse per-grain nodal fields, rebuilt every step */
+    double mu;
+    size_t paircap;         /* the nodal arrays hold nnodes + paircap entries */
+    size_t npairs;
+    int *pnode;             /* node of pair q */
+    unsigned char *pin;     /* pair q in contact this step (Eq. 12 at the momentum update) */
+    double *pnx, *pny;      /* sum_p m_p G_pi over the grain: its outward normal direction */
+    int *ngr;               /* grains touching node i (nnodes) */
+    double *tgx, *tgy;      /* sum_p m_p G_pi over all grains (nnodes) */
+    int *mark;              /* scratch (nnodes, -1): pair of node i for the grain being built */
+    int *sv;                /* MPM_STENCIL per point: the friction sf */
 
     mpm_material *mats;
     int nmat, matcap;
@@ -46,5 +62,9 @@ struct mpm_scene {
     double time;
     long steps;
 };
+
+/* Sizes the per-grain field arrays for the current points (called before a run with contact
+ * "friction"; no allocation happens inside the step loop). */
+core_status mpm_contact_reserve(mpm_scene *s, core_error *err);
 
 #endif

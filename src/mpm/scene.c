@@ -1,4 +1,5 @@
 /* MPM scenes: the grid, materials, grains filled with points, bulk access. */
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -104,6 +105,15 @@ void mpm_destroy(mpm_scene *s)
     for (int k = 0; point_doubles(s, k); k++)
         free(*point_doubles(s, k));
     free(s->nwall);
+    free(s->pnode);
+    free(s->pin);
+    free(s->tgx);
+    free(s->tgy);
+    free(s->pnx);
+    free(s->pny);
+    free(s->ngr);
+    free(s->mark);
+    free(s->sv);
     free(s->grain);
     free(s->mat);
     free(s->sn);
@@ -326,15 +336,69 @@ size_t mpm_point_count(const mpm_scene *s) { return s->np; }
 core_status mpm_set_contact(mpm_scene *s, mpm_contact_model model, core_error *err)
 {
     if (model == MPM_CONTACT_FRICTION)
-        return core_fail(err, CORE_ERR_ARG, "contact model 'friction' (Eqs. 12-24) is not "
-                         "implemented yet; only 'noslip' (the single centre-of-mass field)");
+        return core_fail(err, CORE_ERR_ARG, "contact model 'friction' needs a friction "
+                         "coefficient: use mpm_set_friction(scene, mu)");
     if (model != MPM_CONTACT_NOSLIP)
         return core_fail(err, CORE_ERR_ARG, "unknown contact model %d", (int)model);
     s->contact = model;
     return CORE_OK;
 }
 
+core_status mpm_set_friction(mpm_scene *s, double mu, core_error *err)
+{
+    if (!(mu >= 0) || !isfinite(mu))
+        return core_fail(err, CORE_ERR_ARG, "mu must be a finite number >= 0, got %g", mu);
+    s->contact = MPM_CONTACT_FRICTION;
+    s->mu = mu;
+    return CORE_OK;
+}
+
 mpm_contact_model mpm_contact(const mpm_scene *s) { return s->contact; }
+double mpm_friction(const mpm_scene *s) { return s->contact == MPM_CONTACT_FRICTION ? s->mu : 0; }
+
+/* realloc that keeps *a on failure. */
+#define GROW(a, n)                                                                                \
+    do {                                                                                          \
+        void *grown_ = realloc((a), ((n) ? (n) : 1) * sizeof *(a));                               \
+        if (!grown_)                                                                              \
+            return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu contact field entries", \
+                             (size_t)(n));                                                       \
+        (a) = grown_;                                                                             \
+    } while (0)
+
+core_status mpm_contact_reserve(mpm_scene *s, core_error *err)
+{
+    const size_t need = MPM_STENCIL * s->np, nn = s->nnodes;
+    if (need + nn > (size_t)INT_MAX)
+        return core_fail(err, CORE_ERR_NOMEM, "%zu points are too many for the contact fields",
+                         s->np);
+    if (!s->mark) {
+        GROW(s->ngr, nn);
+        GROW(s->tgx, nn);
+        GROW(s->tgy, nn);
+        GROW(s->mark, nn);
+        for (size_t i = 0; i < nn; i++)
+            s->mark[i] = -1;
+    }
+    if (need <= s->paircap && s->sv)
+        return CORE_OK;
+    GROW(s->nm, nn + need);
+    GROW(s->npx, nn + need);
+    GROW(s->npy, nn + need);
+    GROW(s->nfx, nn + need);
+    GROW(s->nfy, nn + need);
+    GROW(s->nvx, nn + need);
+    GROW(s->nvy, nn + need);
+    GROW(s->nax, nn + need);
+    GROW(s->nay, nn + need);
+    GROW(s->pnode, need);
+    GROW(s->pin, need);
+    GROW(s->pnx, need);
+    GROW(s->pny, need);
+    GROW(s->sv, need);
+    s->paircap = need;
+    return CORE_OK;
+}
 
 void mpm_get_points(const mpm_scene *s, mpm_points *p)
 {

@@ -54,8 +54,9 @@ check.errors(function() m:run{ steps = 1 } end, "run: the scene has no material 
 check.eq(m:add_disk{ center = { 0.5, 0.5 }, radius = 0.2, material = mat }, 1, "first grain id")
 
 -- contact
-check.errors(function() m:contact{ model = "friction", mu = 0.3 } end,
-  "contact: contact model 'friction' (Eqs. 12-24) is not implemented yet", "friction refused")
+m:contact{ model = "friction", mu = 0.3 } -- accepted (tests/lua/test_mpm_friction.lua checks it)
+check.eq(m:info().mu, 0.3, "friction accepted with its mu")
+m:contact{ model = "noslip" }
 check.errors(function() m:contact{ model = "glue" } end,
   "bad field 'model' in argument #1 to 'contact' (one of 'noslip', 'friction' expected, got 'glue')", "unknown contact")
 check.errors(function() m:contact{ model = "noslip", mu = 0.3 } end,
