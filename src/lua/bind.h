@@ -66,6 +66,24 @@ int bind_field_error(lua_State *L, int arg, const char *call, const char *field,
 /* Writes a short description of the value at idx: "-0.1", "'xyz'", "nil", "table". */
 void bind_describe(lua_State *L, int idx, char *buf, size_t size);
 
+/* ---- running and bulk results ------------------------------------------------------------ */
+typedef struct bind_run {
+    const char *label; /* progress label, e.g. "dem run" */
+    long steps;        /* at most this many steps (LUA_MAXINTEGER: until advance stops short) */
+    long expect;       /* the expected number, for progress and the default `every` */
+    /* Advances up to n steps, setting *done to those taken (fewer: the run reached its end). */
+    core_status (*advance)(void *ctx, long n, long *done, core_error *err);
+    void *ctx;
+} bind_run;
+
+/* Reads `every`, `on_step` and `progress` from the options table at arg and advances in chunks
+ * of `every` steps, calling on_step(scene) after each; kernel errors are raised named after call.
+ * Returns 1 when on_step returned false. */
+int bind_run_chunks(lua_State *L, int scene, int arg, const char *call, const bind_run *r);
+
+/* Sets field `name` of the table on top to an array of the n values. */
+void bind_push_array(lua_State *L, const double *a, size_t n, const char *name);
+
 /* ---- documentation for help() ------------------------------------------------------------ */
 typedef struct bind_fn {
     const char *name;

@@ -413,6 +413,20 @@ static int l_timestep(lua_State *L)
 static const char *const INTEGRATOR_NAMES[] = {"velocity_verlet", "position_verlet", "gear",
                                                "two_timescales", NULL};
 
+typedef struct dem_advance_ctx {
+    dem_scene *s;
+    dem_run_def *run;
+} dem_advance_ctx;
+
+static core_status dem_advance(void *ctx, long n, long *done, core_error *err)
+{
+    dem_advance_ctx *c = ctx;
+    c->run->steps = n;
+    c->run->progress = NULL;
+    *done = n;
+    return dem_run(c->s, c->run, err);
+}
+
 static int l_run(lua_State *L)
 {
     static const char *const fields[] = {"steps", "time", "dt", "force", "impact_velocity",
@@ -462,54 +476,11 @@ static int l_run(lua_State *L)
         return luaL_error(L, "run: give exactly one of steps and time");
     if (time >= 0)
         steps = (long)ceil(time / run.dt - 1e-9);
-    long every = (long)bind_field_integer(L, 2, "run", "every", 0, 1, LUA_MAXINTEGER, 0);
-    int has_cb = lua_getfield(L, 2, "on_step") != LUA_TNIL;
-    if (has_cb && lua_type(L, -1) != LUA_TFUNCTION)
-        return bind_field_error(L, 2, "run", "on_step", "function");
-    int cb = lua_gettop(L);
-    if (has_cb && every == 0)
-        every = steps > 100 ? steps / 100 : 1;
-    if (every == 0)
-        every = steps ? steps : 1;
-    int want_progress = bind_field_boolean(L, 2, "run", "progress", -1);
-    progress prog;
-    prog.active = 0;
-    if (want_progress == 1 || (want_progress == -1 && steps >= 1000 &&
-                               progress_default_style() != PROGRESS_QUIET)) {
-        progress_begin(&prog, "dem run", (double)steps, "steps");
-        if (want_progress == -1 && prog.style != PROGRESS_BAR)
-            prog.active = 0; /* unasked, lines would flood logs: only a bar on a terminal */
-    }
     double t0 = dem_time(s);
-    long s0 = dem_steps_done(s), f0 = dem_force_evaluations(s), done = 0;
-    int stopped = 0;
-    while (done < steps && !stopped) {
-        long chunk = steps - done < every ? steps - done : every;
-        run.steps = chunk;
-        run.progress = NULL;
-        core_status st = dem_run(s, &run, &err);
-        done += chunk;
-        if (prog.active)
-            progress_update(&prog, (double)done);
-        if (st != CORE_OK) {
-            if (prog.active)
-                progress_end(&prog);
-            return bind_raise(L, "run", &err);
-        }
-        if (has_cb) {
-            lua_pushvalue(L, cb);
-            lua_pushvalue(L, 1);
-            if (lua_pcall(L, 1, 1, 0) != LUA_OK) {
-                if (prog.active)
-                    progress_end(&prog);
-                return lua_error(L);
-            }
-            stopped = lua_type(L, -1) == LUA_TBOOLEAN && !lua_toboolean(L, -1);
-            lua_pop(L, 1);
-        }
-    }
-    if (prog.active)
-        progress_end(&prog);
+    long s0 = dem_steps_done(s), f0 = dem_force_evaluations(s);
+    dem_advance_ctx ctx = {s, &run};
+    bind_run r = {"dem run", steps, steps, dem_advance, &ctx};
+    int stopped = bind_run_chunks(L, 1, 2, "run", &r);
     lua_createtable(L, 0, 5);
     lua_pushinteger(L, dem_steps_done(s) - s0);
     lua_setfield(L, -2, "steps");
@@ -695,15 +666,6 @@ static int l_measure(lua_State *L)
     }
 }
 
-static void push_array(lua_State *L, const double *a, size_t n, const char *name)
-{
-    lua_createtable(L, (int)n, 0);
-    for (size_t i = 0; i < n; i++) {
-        lua_pushnumber(L, a[i]);
-        lua_rawseti(L, -2, (lua_Integer)i + 1);
-    }
-    lua_setfield(L, -2, name);
-}
 
 static int l_particles(lua_State *L)
 {
@@ -714,16 +676,16 @@ static int l_particles(lua_State *L)
     static const char *const ws[3] = {"wx", "wy", "wz"};
     lua_createtable(L, 0, 10);
     for (int d = 0; d < D; d++) {
-        push_array(L, dem_positions(s, d), n, xs[d]);
-        push_array(L, dem_velocities(s, d), n, vs[d]);
+        bind_push_array(L, dem_positions(s, d), n, xs[d]);
+        bind_push_array(L, dem_velocities(s, d), n, vs[d]);
     }
     if (D == 2 && dem_angular_velocities(s, 2))
-        push_array(L, dem_angular_velocities(s, 2), n, "omega");
+        bind_push_array(L, dem_angular_velocities(s, 2), n, "omega");
     for (int d = 0; D == 3 && d < 3; d++)
         if (dem_angular_velocities(s, d))
-            push_array(L, dem_angular_velocities(s, d), n, ws[d]);
-    push_array(L, dem_radii(s), n, "radius");
-    push_array(L, dem_masses(s), n, "mass");
+            bind_push_array(L, dem_angular_velocities(s, d), n, ws[d]);
+    bind_push_array(L, dem_radii(s), n, "radius");
+    bind_push_array(L, dem_masses(s), n, "mass");
     lua_pushinteger(L, (lua_Integer)n);
     lua_setfield(L, -2, "count");
     return 1;

@@ -332,6 +332,18 @@ static int l_timestep(lua_State *L)
     return 1;
 }
 
+typedef struct mpm_advance_ctx {
+    mpm_scene *s;
+    mpm_run_def *run;
+} mpm_advance_ctx;
+
+static core_status mpm_advance(void *ctx, long n, long *done, core_error *err)
+{
+    mpm_advance_ctx *c = ctx;
+    c->run->steps = n;
+    return mpm_run(c->s, c->run, done, err);
+}
+
 static int l_run(lua_State *L)
 {
     static const char *const fields[] = {"steps", "time", "dt", "cfl", "force", "every", "on_step",
@@ -380,55 +392,10 @@ static int l_run(lua_State *L)
         expect = (long)ceil(time / (run.dt > 0 ? run.dt : ts.dt_auto) - 1e-9);
         steps = LUA_MAXINTEGER;
     }
-    long every = (long)bind_field_integer(L, 2, "run", "every", 0, 1, LUA_MAXINTEGER, 0);
-    int has_cb = lua_getfield(L, 2, "on_step") != LUA_TNIL;
-    if (has_cb && lua_type(L, -1) != LUA_TFUNCTION)
-        return bind_field_error(L, 2, "run", "on_step", "function");
-    int cb = lua_gettop(L);
-    if (has_cb && every == 0)
-        every = expect > 100 ? expect / 100 : 1;
-    if (every == 0)
-        every = steps;
-    int want_progress = bind_field_boolean(L, 2, "run", "progress", -1);
-    progress prog;
-    prog.active = 0;
-    if (want_progress == 1 || (want_progress == -1 && expect >= 1000 &&
-                               progress_default_style() != PROGRESS_QUIET)) {
-        progress_begin(&prog, "mpm run", (double)expect, "steps");
-        if (want_progress == -1 && prog.style != PROGRESS_BAR)
-            prog.active = 0;
-    }
-    long s0 = mpm_steps_done(s), done = 0;
-    int stopped = 0;
-    while (done < steps && !stopped) {
-        run.steps = steps - done < every ? steps - done : every;
-        long chunk;
-        core_status st = mpm_run(s, &run, &chunk, &err);
-        done += chunk;
-        if (prog.active)
-            progress_update(&prog, (double)done);
-        if (st != CORE_OK) {
-            if (prog.active)
-                progress_end(&prog);
-            return bind_raise(L, "run", &err);
-        }
-        if (chunk < run.steps)
-            stopped = 2; /* reached the end time */
-        if (has_cb && chunk > 0) {
-            lua_pushvalue(L, cb);
-            lua_pushvalue(L, 1);
-            if (lua_pcall(L, 1, 1, 0) != LUA_OK) {
-                if (prog.active)
-                    progress_end(&prog);
-                return lua_error(L);
-            }
-            if (lua_type(L, -1) == LUA_TBOOLEAN && !lua_toboolean(L, -1))
-                stopped = 1;
-            lua_pop(L, 1);
-        }
-    }
-    if (prog.active)
-        progress_end(&prog);
+    long s0 = mpm_steps_done(s);
+    mpm_advance_ctx ctx = {s, &run};
+    bind_run r = {"mpm run", steps, expect, mpm_advance, &ctx};
+    int stopped = bind_run_chunks(L, 1, 2, "run", &r);
     lua_createtable(L, 0, 4);
     lua_pushinteger(L, mpm_steps_done(s) - s0);
     lua_setfield(L, -2, "steps");
@@ -436,7 +403,7 @@ static int l_run(lua_State *L)
     lua_setfield(L, -2, "time");
     lua_pushnumber(L, run.dt > 0 ? run.dt : ts.dt_auto);
     lua_setfield(L, -2, "dt");
-    lua_pushboolean(L, stopped == 1);
+    lua_pushboolean(L, stopped);
     lua_setfield(L, -2, "stopped");
     return 1;
 }
@@ -507,15 +474,6 @@ static int l_grain(lua_State *L)
     return 1;
 }
 
-static void push_array(lua_State *L, const double *a, size_t n, const char *name)
-{
-    lua_createtable(L, (int)n, 0);
-    for (size_t i = 0; i < n; i++) {
-        lua_pushnumber(L, a[i]);
-        lua_rawseti(L, -2, (lua_Integer)i + 1);
-    }
-    lua_setfield(L, -2, name);
-}
 
 static int l_points(lua_State *L)
 {
@@ -524,18 +482,18 @@ static int l_points(lua_State *L)
     mpm_points p;
     mpm_get_points(s, &p);
     lua_createtable(L, 0, 16);
-    push_array(L, p.x, n, "x");
-    push_array(L, p.y, n, "y");
-    push_array(L, p.vx, n, "vx");
-    push_array(L, p.vy, n, "vy");
-    push_array(L, p.mass, n, "mass");
+    bind_push_array(L, p.x, n, "x");
+    bind_push_array(L, p.y, n, "y");
+    bind_push_array(L, p.vx, n, "vx");
+    bind_push_array(L, p.vy, n, "vy");
+    bind_push_array(L, p.mass, n, "mass");
     static const char *const sig[4] = {"sxx", "syy", "sxy", "szz"};
     static const char *const F[4] = {"Fxx", "Fxy", "Fyx", "Fyy"};
     for (int k = 0; k < 4; k++) {
-        push_array(L, p.sigma[k], n, sig[k]);
-        push_array(L, p.F[k], n, F[k]);
+        bind_push_array(L, p.sigma[k], n, sig[k]);
+        bind_push_array(L, p.F[k], n, F[k]);
     }
-    push_array(L, p.eps_p, n, "eps_p");
+    bind_push_array(L, p.eps_p, n, "eps_p");
     lua_createtable(L, (int)n, 0);
     for (size_t i = 0; i < n; i++) {
         lua_pushinteger(L, p.grain[i] + 1);
