@@ -4,6 +4,7 @@
  * and completion, and lets Ctrl-C at the prompt drop the line instead of ending the session. */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
+#include <fcntl.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -29,10 +30,27 @@ static volatile sig_atomic_t prompt_sigint;
 static char *accepted_line;
 static int line_accepted;
 
+/* The self-pipe: the handler also writes a byte, and the prompt's select() watches the pipe with
+ * standard input, so a Ctrl-C arriving just before select() still wakes it. */
+static int sigint_pipe[2] = {-1, -1};
+
 static void on_prompt_sigint(int sig)
 {
     (void)sig;
     prompt_sigint = 1;
+    if (sigint_pipe[1] >= 0) {
+        int saved = errno;
+        ssize_t w = write(sigint_pipe[1], "i", 1);
+        (void)w;
+        errno = saved;
+    }
+}
+
+static void drain_sigint_pipe(void)
+{
+    char buf[64];
+    while (sigint_pipe[0] >= 0 && read(sigint_pipe[0], buf, sizeof buf) > 0) {
+    }
 }
 
 static void on_line(char *line)
@@ -44,6 +62,7 @@ static void on_line(char *line)
 
 static int read_tty(const char *prompt, char **out)
 {
+    drain_sigint_pipe();
     prompt_sigint = 0; /* a Ctrl-C between statements only cancels itself */
     line_accepted = 0;
     accepted_line = NULL;
@@ -53,8 +72,14 @@ static int read_tty(const char *prompt, char **out)
         fd_set fds;
         FD_ZERO(&fds);
         FD_SET(STDIN_FILENO, &fds);
-        int n = select(STDIN_FILENO + 1, &fds, NULL, NULL, NULL);
+        int maxfd = STDIN_FILENO;
+        if (sigint_pipe[0] >= 0) {
+            FD_SET(sigint_pipe[0], &fds);
+            maxfd = sigint_pipe[0] > maxfd ? sigint_pipe[0] : maxfd;
+        }
+        int n = prompt_sigint ? -1 : select(maxfd + 1, &fds, NULL, NULL, NULL);
         if (prompt_sigint) {
+            drain_sigint_pipe();
             rl_free_line_state();
             rl_callback_sigcleanup();
             rl_callback_handler_remove();
@@ -70,7 +95,8 @@ static int read_tty(const char *prompt, char **out)
             result = READ_EOF;
             break;
         }
-        rl_callback_read_char();
+        if (FD_ISSET(STDIN_FILENO, &fds))
+            rl_callback_read_char();
     }
     if (result == READ_LINE && !accepted_line)
         result = READ_EOF;
@@ -295,6 +321,10 @@ void repl_run(lua_State *L)
     sa.sa_handler = on_prompt_sigint;
     sigemptyset(&sa.sa_mask);
     sigaction(SIGINT, &sa, &old);
+    if (use_readline && pipe(sigint_pipe) == 0) {
+        for (int k = 0; k < 2; k++)
+            fcntl(sigint_pipe[k], F_SETFL, fcntl(sigint_pipe[k], F_GETFL) | O_NONBLOCK);
+    }
     if (use_readline)
         setup_readline(L);
     for (;;) {
@@ -317,5 +347,10 @@ void repl_run(lua_State *L)
         close_readline();
     }
     sigaction(SIGINT, &old, NULL);
+    for (int k = 0; k < 2; k++)
+        if (sigint_pipe[k] >= 0) {
+            close(sigint_pipe[k]);
+            sigint_pipe[k] = -1;
+        }
     fflush(stdout);
 }
