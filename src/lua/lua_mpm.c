@@ -23,6 +23,21 @@ static mpm_scene *check_scene(lua_State *L, int idx)
     return u->s;
 }
 
+static void set_number(lua_State *L, const char *k, double v)
+{
+    lua_pushnumber(L, v);
+    lua_setfield(L, -2, k);
+}
+
+static void push_pair(lua_State *L, const double v[2])
+{
+    lua_createtable(L, 2, 0);
+    for (int d = 0; d < 2; d++) {
+        lua_pushnumber(L, v[d]);
+        lua_rawseti(L, -2, d + 1);
+    }
+}
+
 /* ---- mpm.material{...} ------------------------------------------------------------------------ */
 static const char *const MODEL_NAMES[] = {"elastic", "vonmises", NULL};
 
@@ -102,7 +117,9 @@ static int material_tostring(lua_State *L)
 }
 
 /* ---- mpm.scene{...} --------------------------------------------------------------------------- */
-static const char *const WALL_NAMES[] = {"noslip", "slip", "none", NULL};
+static const char *const WALL_NAMES[] = {"noslip", "slip", "none", "friction", NULL};
+static const char *const SHAPE_NAMES[] = {"linear", "bspline", NULL};
+static const char *const NORMAL_NAMES[] = {"averaged", "own", "linear", NULL};
 static const char *const UPDATE_NAMES[] = {"usl", "musl", NULL};
 
 static void read_pair(lua_State *L, int arg, const char *field, const char *expected, int *is_int,
@@ -132,24 +149,90 @@ static void read_pair(lua_State *L, int arg, const char *field, const char *expe
     lua_pop(L, 1);
 }
 
+/* One wall: a name, or {kind = name, mu = , velocity = {vx, vy}} (a table at the stack top). */
+static void read_wall(lua_State *L, const char *field, mpm_wall *kind, double *mu, double v[2])
+{
+    static const char *const fields[] = {"kind", "mu", "velocity", NULL};
+    const char *expected = "'noslip', 'slip', 'none' or {kind = 'noslip'|'slip'|'friction', "
+                           "mu =, velocity = {vx, vy}}";
+    int w = -1;
+    if (lua_type(L, -1) == LUA_TSTRING) {
+        for (int i = 0; WALL_NAMES[i]; i++)
+            if (strcmp(lua_tostring(L, -1), WALL_NAMES[i]) == 0)
+                w = i;
+        if (w == MPM_WALL_FRICTION)
+            bind_field_error(L, 1, "scene", field, "{kind = 'friction', mu = ...} (a friction "
+                             "wall needs mu)");
+        if (w < 0)
+            bind_field_error(L, 1, "scene", field, expected);
+        *kind = (mpm_wall)w;
+        return;
+    }
+    if (lua_type(L, -1) != LUA_TTABLE)
+        bind_field_error(L, 1, "scene", field, expected);
+    int t = lua_gettop(L);
+    bind_check_fields(L, t, "scene", fields);
+    char sub[48];
+    snprintf(sub, sizeof sub, "%s.kind", field);
+    w = -1;
+    if (lua_getfield(L, t, "kind") == LUA_TSTRING)
+        for (int i = 0; WALL_NAMES[i]; i++)
+            if (strcmp(lua_tostring(L, -1), WALL_NAMES[i]) == 0)
+                w = i;
+    if (w < 0)
+        bind_field_error(L, 1, "scene", sub, "one of 'noslip', 'slip', 'none', 'friction'");
+    lua_pop(L, 1);
+    *kind = (mpm_wall)w;
+    snprintf(sub, sizeof sub, "%s.mu", field);
+    int tm = lua_getfield(L, t, "mu");
+    if (tm != LUA_TNIL || *kind == MPM_WALL_FRICTION) {
+        if (tm != LUA_TNUMBER || !(lua_tonumber(L, -1) >= 0) || !isfinite(lua_tonumber(L, -1)))
+            bind_field_error(L, 1, "scene", sub, "non-negative number");
+        *mu = lua_tonumber(L, -1);
+    }
+    lua_pop(L, 1);
+    snprintf(sub, sizeof sub, "%s.velocity", field);
+    if (lua_getfield(L, t, "velocity") != LUA_TNIL) {
+        int ok = lua_type(L, -1) == LUA_TTABLE && luaL_len(L, -1) == 2;
+        for (int k = 0; ok && k < 2; k++) {
+            lua_rawgeti(L, -1, k + 1);
+            v[k] = lua_tonumberx(L, -1, &ok);
+            ok = ok && isfinite(v[k]);
+            lua_pop(L, 1);
+        }
+        if (!ok)
+            bind_field_error(L, 1, "scene", sub, "array of 2 finite numbers");
+    }
+    lua_pop(L, 1);
+}
+
 static void read_walls(lua_State *L, mpm_scene_def *def)
 {
     static const char *const sides[] = {"left", "right", "bottom", "top", NULL};
-    const char *expected = "'noslip', 'slip', 'none' or a table {left =, right =, bottom =, top =}";
+    const char *expected = "a wall or a table {left =, right =, bottom =, top =} of walls";
     int t = lua_getfield(L, 1, "walls");
     if (t == LUA_TNIL) {
         lua_pop(L, 1);
         return;
     }
-    if (t == LUA_TSTRING) {
+    if (t == LUA_TSTRING || (t == LUA_TTABLE && lua_getfield(L, -1, "kind") != LUA_TNIL)) {
+        if (t == LUA_TTABLE)
+            lua_pop(L, 1);
+        mpm_wall w = MPM_WALL_NOSLIP;
+        double mu = 0, v[2] = {0, 0};
+        read_wall(L, "walls", &w, &mu, v);
+        for (int k = 0; k < 4; k++) {
+            def->walls[k] = w;
+            def->wall_mu[k] = mu;
+            def->wall_velocity[k][0] = v[0];
+            def->wall_velocity[k][1] = v[1];
+        }
         lua_pop(L, 1);
-        int w = bind_field_option(L, 1, "scene", "walls", WALL_NAMES, 0, 0);
-        for (int k = 0; k < 4; k++)
-            def->walls[k] = (mpm_wall)w;
         return;
     }
     if (t != LUA_TTABLE)
         bind_field_error(L, 1, "scene", "walls", expected);
+    lua_pop(L, 1); /* the nil kind */
     int tab = lua_gettop(L);
     bind_check_fields(L, tab, "scene", sides);
     for (int k = 0; k < 4; k++) {
@@ -157,17 +240,9 @@ static void read_walls(lua_State *L, mpm_scene_def *def)
             lua_pop(L, 1);
             continue;
         }
-        int w = -1;
-        if (lua_type(L, -1) == LUA_TSTRING)
-            for (int i = 0; WALL_NAMES[i]; i++)
-                if (strcmp(lua_tostring(L, -1), WALL_NAMES[i]) == 0)
-                    w = i;
-        if (w < 0) {
-            char field[32];
-            snprintf(field, sizeof field, "walls.%s", sides[k]);
-            bind_field_error(L, 1, "scene", field, "one of 'noslip', 'slip', 'none'");
-        }
-        def->walls[k] = (mpm_wall)w;
+        char field[32];
+        snprintf(field, sizeof field, "walls.%s", sides[k]);
+        read_wall(L, field, &def->walls[k], &def->wall_mu[k], def->wall_velocity[k]);
         lua_pop(L, 1);
     }
     lua_pop(L, 1);
@@ -176,7 +251,7 @@ static void read_walls(lua_State *L, mpm_scene_def *def)
 static int l_scene(lua_State *L)
 {
     static const char *const fields[] = {"cells", "size", "origin", "periodic", "gravity", "walls",
-                                         "update", "pic", NULL};
+                                         "update", "pic", "shape", "wall_gap", NULL};
     bind_check_table(L, 1, "scene");
     bind_check_fields(L, 1, "scene", fields);
     mpm_scene_def def = mpm_default_scene_def();
@@ -200,6 +275,9 @@ static int l_scene(lua_State *L)
     read_walls(L, &def);
     def.update = (mpm_update)bind_field_option(L, 1, "scene", "update", UPDATE_NAMES, MPM_MUSL, 0);
     def.pic = bind_field_number(L, 1, "scene", "pic", 0, BIND_NONNEG);
+    def.wall_gap = bind_field_number(L, 1, "scene", "wall_gap", def.wall_gap, BIND_NONNEG);
+    def.shape = (mpm_shape_fn)bind_field_option(L, 1, "scene", "shape", SHAPE_NAMES,
+                                                MPM_SHAPE_LINEAR, 0);
     if (def.pic > 1) {
         lua_getfield(L, 1, "pic");
         return bind_field_error(L, 1, "scene", "pic", "number in [0, 1]");
@@ -247,9 +325,9 @@ static int material_of(lua_State *L, int scene, int arg, const char *call)
 static int add_grain(lua_State *L, const char *call, mpm_shape shape)
 {
     static const char *const disk_fields[] = {"center", "radius", "material", "points_per_cell",
-                                              "velocity", "omega", NULL};
+                                              "velocity", "omega", "clip", "hydrostatic", NULL};
     static const char *const rect_fields[] = {"lo", "hi", "material", "points_per_cell",
-                                              "velocity", "omega", NULL};
+                                              "velocity", "omega", "clip", "hydrostatic", NULL};
     mpm_scene *s = check_scene(L, 1);
     bind_check_table(L, 2, call);
     bind_check_fields(L, 2, call, shape == MPM_DISK ? disk_fields : rect_fields);
@@ -265,10 +343,14 @@ static int add_grain(lua_State *L, const char *call, mpm_shape shape)
     g.points_per_cell = (int)bind_field_integer(L, 2, call, "points_per_cell", 2, 1, 64, 0);
     bind_field_vector(L, 2, call, "velocity", 2, g.velocity, 0);
     g.omega = bind_field_number(L, 2, call, "omega", 0, 0);
+    g.clip = bind_field_boolean(L, 2, call, "clip", 0);
+    int hydro = bind_field_boolean(L, 2, call, "hydrostatic", 0);
     g.material = material_of(L, 1, 2, call);
     core_error err;
     long id = mpm_add_grain(s, &g, &err);
     if (id < 0)
+        return bind_raise(L, call, &err);
+    if (hydro && mpm_hydrostatic(s, (size_t)id, &err))
         return bind_raise(L, call, &err);
     lua_pushinteger(L, id + 1);
     return 1;
@@ -280,13 +362,25 @@ static int l_add_rect(lua_State *L) { return add_grain(L, "add_rect", MPM_RECT);
 /* ---- contact --------------------------------------------------------------------------------- */
 static int l_contact(lua_State *L)
 {
-    static const char *const fields[] = {"model", "mu", NULL};
+    static const char *const fields[] = {"model", "mu", "normals", "separation", "strain_cap",
+                                         NULL};
     static const char *const names[] = {"noslip", "friction", NULL};
     mpm_scene *s = check_scene(L, 1);
     bind_check_table(L, 2, "contact");
     bind_check_fields(L, 2, "contact", fields);
     int model = bind_field_option(L, 2, "contact", "model", names, 0, BIND_REQUIRED);
     core_error err;
+    mpm_contact_options o = mpm_default_contact_options();
+    o.normals = (mpm_normals)bind_field_option(L, 2, "contact", "normals", NORMAL_NAMES,
+                                               o.normals, 0);
+    o.separation = bind_field_number(L, 2, "contact", "separation", o.separation, BIND_NONNEG);
+    if (o.separation > 1) {
+        lua_getfield(L, 2, "separation");
+        return bind_field_error(L, 2, "contact", "separation", "number in [0, 1]");
+    }
+    o.strain_cap = bind_field_number(L, 2, "contact", "strain_cap", o.strain_cap, BIND_NONNEG);
+    if (mpm_set_contact_options(s, &o, &err))
+        return bind_raise(L, "contact", &err);
     if (model == MPM_CONTACT_FRICTION) {
         double mu = bind_field_number(L, 2, "contact", "mu", 0, BIND_REQUIRED | BIND_NONNEG);
         if (mpm_set_friction(s, mu, &err))
@@ -298,6 +392,84 @@ static int l_contact(lua_State *L)
     if (mpm_set_contact(s, (mpm_contact_model)model, &err))
         return bind_raise(L, "contact", &err);
     return 0;
+}
+
+/* m:prescribe(grain, {vx, vy}) */
+static int l_prescribe(lua_State *L)
+{
+    mpm_scene *s = check_scene(L, 1);
+    lua_Integer id = luaL_checkinteger(L, 2);
+    if (id < 1 || (size_t)id > mpm_grain_count(s))
+        return luaL_error(L, "bad argument #1 to 'prescribe' (grain id in [1, %d] expected, got "
+                          "%d)", (int)mpm_grain_count(s), (int)id);
+    double v[2];
+    if (lua_type(L, 3) != LUA_TTABLE)
+        return luaL_error(L, "bad argument #2 to 'prescribe' (velocity {vx, vy} expected, got "
+                          "%s)", luaL_typename(L, 3));
+    for (int k = 0; k < 2; k++) {
+        lua_rawgeti(L, 3, k + 1);
+        int ok;
+        v[k] = lua_tonumberx(L, -1, &ok);
+        if (!ok || !isfinite(v[k]))
+            return luaL_error(L, "bad argument #2 to 'prescribe' (velocity {vx, vy} of finite "
+                              "numbers expected)");
+        lua_pop(L, 1);
+    }
+    core_error err;
+    if (mpm_prescribe(s, (size_t)(id - 1), v, &err))
+        return bind_raise(L, "prescribe", &err);
+    return 0;
+}
+
+/* m:plane{ point = {x, y}, normal = {nx, ny}, kind = 'friction', mu = 0.5, velocity = {0, 0} } */
+static int l_plane(lua_State *L)
+{
+    static const char *const fields[] = {"point", "normal", "kind", "mu", "velocity", NULL};
+    static const char *const kinds[] = {"noslip", "slip", "friction", NULL};
+    static const mpm_wall kind_of[] = {MPM_WALL_NOSLIP, MPM_WALL_SLIP, MPM_WALL_FRICTION};
+    mpm_scene *s = check_scene(L, 1);
+    bind_check_table(L, 2, "plane");
+    bind_check_fields(L, 2, "plane", fields);
+    mpm_plane_def d = {{0, 0}, {0, 1}, MPM_WALL_FRICTION, 0, {0, 0}};
+    bind_field_vector(L, 2, "plane", "point", 2, d.point, BIND_REQUIRED);
+    bind_field_vector(L, 2, "plane", "normal", 2, d.normal, BIND_REQUIRED);
+    d.kind = kind_of[bind_field_option(L, 2, "plane", "kind", kinds, 2, 0)];
+    d.mu = bind_field_number(L, 2, "plane", "mu", 0,
+                             BIND_NONNEG | (d.kind == MPM_WALL_FRICTION ? BIND_REQUIRED : 0));
+    bind_field_vector(L, 2, "plane", "velocity", 2, d.velocity, 0);
+    if (hypot(d.normal[0], d.normal[1]) == 0) {
+        lua_getfield(L, 2, "normal");
+        return bind_field_error(L, 2, "plane", "normal", "non-zero vector");
+    }
+    core_error err;
+    if (mpm_add_plane(s, &d, &err))
+        return bind_raise(L, "plane", &err);
+    return 0;
+}
+
+/* m:field(name) -> {nx =, ny =, values = {...} (row-major, nan in empty cells), ...} */
+static int l_field(lua_State *L)
+{
+    static const char *const names[] = {"vx", "vy", "speed", "ux", "uy", "displacement", "sxx",
+                                        "syy", "sxy", "pressure", "psd", "eps_p", "grain", "mass",
+                                        NULL};
+    mpm_scene *s = check_scene(L, 1);
+    int kind = luaL_checkoption(L, 2, NULL, names);
+    const mpm_scene_def *d = mpm_def(s);
+    size_t n = (size_t)d->cells[0] * (size_t)d->cells[1];
+    double *v = lua_newuserdatauv(L, n * sizeof *v, 0);
+    mpm_field(s, (mpm_field_kind)kind, v);
+    lua_createtable(L, 0, 5);
+    bind_push_array(L, v, n, "values");
+    lua_pushinteger(L, d->cells[0]);
+    lua_setfield(L, -2, "nx");
+    lua_pushinteger(L, d->cells[1]);
+    lua_setfield(L, -2, "ny");
+    push_pair(L, d->origin);
+    lua_setfield(L, -2, "origin");
+    push_pair(L, d->size);
+    lua_setfield(L, -2, "size");
+    return 1;
 }
 
 /* ---- time stepping ------------------------------------------------------------------------- */
@@ -409,26 +581,31 @@ static int l_run(lua_State *L)
 }
 
 /* ---- measurements ---------------------------------------------------------------------------- */
-static void set_number(lua_State *L, const char *k, double v)
-{
-    lua_pushnumber(L, v);
-    lua_setfield(L, -2, k);
-}
-
-static void push_pair(lua_State *L, const double v[2])
-{
-    lua_createtable(L, 2, 0);
-    for (int d = 0; d < 2; d++) {
-        lua_pushnumber(L, v[d]);
-        lua_rawseti(L, -2, d + 1);
-    }
-}
-
 static int l_measure(lua_State *L)
 {
-    static const char *const what_names[] = {"energy", "momentum", NULL};
+    static const char *const what_names[] = {"energy", "momentum", "columns", "shear", NULL};
     mpm_scene *s = check_scene(L, 1);
     int what = luaL_checkoption(L, 2, NULL, what_names);
+    if (what == 2) {
+        const int nx = mpm_def(s)->cells[0];
+        double *c = lua_newuserdatauv(L, (size_t)nx * sizeof *c, 0);
+        mpm_column_uy(s, c);
+        lua_createtable(L, 0, 2);
+        bind_push_array(L, c, (size_t)nx, "uy");
+        double h[2];
+        mpm_cell_size(s, h);
+        lua_createtable(L, nx, 0);
+        for (int i = 0; i < nx; i++) {
+            lua_pushnumber(L, mpm_def(s)->origin[0] + (i + 0.5) * h[0]);
+            lua_rawseti(L, -2, i + 1);
+        }
+        lua_setfield(L, -2, "x");
+        return 1;
+    }
+    if (what == 3) {
+        lua_pushnumber(L, mpm_shear_strain(s));
+        return 1;
+    }
     if (what == 0) {
         mpm_energy e;
         mpm_measure_energy(s, &e);
@@ -494,6 +671,8 @@ static int l_points(lua_State *L)
         bind_push_array(L, p.F[k], n, F[k]);
     }
     bind_push_array(L, p.eps_p, n, "eps_p");
+    bind_push_array(L, p.ux, n, "ux");
+    bind_push_array(L, p.uy, n, "uy");
     lua_createtable(L, (int)n, 0);
     for (size_t i = 0; i < n; i++) {
         lua_pushinteger(L, p.grain[i] + 1);
@@ -578,6 +757,13 @@ static int l_info(lua_State *L)
     lua_pushstring(L, mpm_contact(s) == MPM_CONTACT_NOSLIP ? "noslip" : "friction");
     lua_setfield(L, -2, "contact");
     set_number(L, "mu", mpm_friction(s));
+    lua_pushstring(L, SHAPE_NAMES[d->shape]);
+    lua_setfield(L, -2, "shape");
+    mpm_contact_options o = mpm_get_contact_options(s);
+    lua_pushstring(L, NORMAL_NAMES[o.normals]);
+    lua_setfield(L, -2, "normals");
+    set_number(L, "separation", o.separation);
+    set_number(L, "strain_cap", o.strain_cap);
     return 1;
 }
 
@@ -616,8 +802,30 @@ void bind_open_mpm(lua_State *L)
         {"add_rect", l_add_rect,
          "m:add_rect{ lo = {x0, y0}, hi = {x1, y1}, material = mat, points_per_cell = 2, "
          "velocity = {vx, vy}, omega = 0 }",
-         "Fills a rectangle with points like add_disk (bars, blocks); returns the grain id."},
-        {"contact", l_contact, "m:contact{ model = 'noslip' | 'friction', mu = 0.3 }",
+         "Fills a rectangle with points like add_disk (bars, blocks); returns the grain id. "
+         "Both take clip = true (keep only the points inside the grid: grains cut by an edge) "
+         "and hydrostatic = true (initial static pressure with grad p = rho g, p = 0 at the "
+         "grain's top, the paper's incline)."},
+        {"prescribe", l_prescribe, "m:prescribe(grain, {vx, vy})",
+         "The grain moves rigidly at {vx, vy} from now on: every node its points touch takes "
+         "that velocity, so its neighbours meet a moving rigid body through the contact rule "
+         "(the shear test's edge grains)."},
+        {"plane", l_plane,
+         "m:plane{ point = {x, y}, normal = {nx, ny}, kind = 'friction'|'slip'|'noslip', mu =, "
+         "velocity = {0, 0} }",
+         "A rigid half-space not aligned with the grid (at most 4): the nodes behind the plane "
+         "(normal points out of the body, into the material) take the wall rule with the "
+         "plane's exact normal; the nodes form a staircase along it."},
+        {"field", l_field,
+         "m:field('vx'|'vy'|'speed'|'ux'|'uy'|'displacement'|'sxx'|'syy'|'sxy'|'pressure'|'psd'|"
+         "'eps_p'|'grain'|'mass')",
+         "A cell field: the mass-weighted mean over the points in each cell (nan in empty "
+         "cells; 'mass' sums). psd is the principal stress difference sigma_1 - sigma_2. "
+         "Returns {nx, ny, origin, size, values} (row-major, x fastest), ready for "
+         "render.field."},
+        {"contact", l_contact,
+         "m:contact{ model = 'noslip' | 'friction', mu = 0.3, normals = 'averaged'|'own'|'linear', "
+         "separation = 0, strain_cap = 0 }",
          "The grain contact model. 'noslip' (default): the single centre-of-mass velocity field "
          "of the basic algorithm (Sec. 2); grains stick on contact. 'friction' (Sec. 3; mu >= 0 "
          "required, 0 = frictionless): each grain also has its own nodal field, stored only at "
@@ -626,9 +834,14 @@ void bind_open_mpm(lua_State *L)
          "(Eq. 14) and its tangential slip is reduced by at most mu times that correction "
          "(Coulomb, Eqs. 18-23), after the grid momentum update (not after P2G). Points move "
          "with their own grain's field, so grains separate again; an isolated grain moves "
-         "exactly as with 'noslip'. Normals: the gradient of the grain's mass field with the "
-         "linear shape functions against that of the other grains (opposite normals, momentum "
-         "conserved; the paper's Eq. 24 uses quadratic B-splines)."},
+         "exactly as with 'noslip'. normals: 'averaged' (default) the quadratic-B-spline "
+         "gradient of the grain's mass field against that of everything else (opposite normals, "
+         "momentum conserved), 'own' the grain's own B-spline density gradient (Eq. 24), "
+         "'linear' as 'averaged' with linear-shape gradients. separation: a shared node is a "
+         "contact only when the grains' nodal volumes fill this fraction of the cell (against "
+         "contact at a distance; 0 = off). strain_cap: corrections limited to |dv| dt / h <= "
+         "cap (0 = off). With three or more grains at a node, the momentum the corrections "
+         "change is given back as a common velocity shift of the corrected grains."},
         {"timestep", l_timestep, "m:timestep{ cfl = 0.4 }",
          "The CFL limit h / (c + max|v|) (h the smaller cell side, c = sqrt((K + 4G/3)/rho) the "
          "largest P-wave speed), the automatic step cfl x limit, the wave speed and the fastest "
@@ -643,21 +856,24 @@ void bind_open_mpm(lua_State *L)
          "stops the run. Ctrl-C stops between steps with the scene intact; NaN, an inverted "
          "point or a point leaving the grid stop the run with an error naming the step, point "
          "and grain. Returns {steps, time, dt, stopped}."},
-        {"measure", l_measure, "m:measure('energy'|'momentum')",
+        {"measure", l_measure, "m:measure('energy'|'momentum'|'columns'|'shear')",
          "energy: kinetic, elastic (Hencky stored energy), plastic (plastic work), potential "
          "(gravity), total; per unit depth (J/m). momentum: linear = {px, py}, angular (about "
-         "the origin)."},
+         "the origin). columns: {x, uy}, the mass-weighted mean vertical displacement per "
+         "column of cells (the paper's Fig. 8). shear: the material's average shear strain, "
+         "the mass-weighted least-squares slope d u_y / d x of the displacements."},
         {"grain", l_grain, "m:grain(id)",
          "mass, center (centre of mass), velocity, angular_momentum (about the centre of mass), "
          "inertia, omega (= angular_momentum / inertia) and points of grain id."},
         {"points", l_points, "m:points()",
-         "Arrays over the material points: x, y, vx, vy, mass, volume, grain, sxx, syy, sxy, szz "
-         "(Cauchy stress, tension positive), Fxx, Fxy, Fyx, Fyy, eps_p; and count."},
+         "Arrays over the material points: x, y, vx, vy, ux, uy (displacement), mass, volume, "
+         "grain, sxx, syy, sxy, szz (Cauchy stress, tension positive), Fxx, Fxy, Fyx, Fyy, "
+         "eps_p; and count."},
         {"set_velocities", l_set_velocities, "m:set_velocities{ vx = {...}, vy = {...} }",
          "Sets every point's velocity from arrays in point order (as m:points() lists them)."},
         {"info", l_info, "m:info()",
          "cells, size, origin, cell_size, gravity, points, grains, time, steps, update, pic, "
-         "contact, mu (0 for noslip)."},
+         "contact, mu (0 for noslip), shape, normals, separation, strain_cap."},
         {NULL, NULL, NULL, NULL}};
     static const luaL_Reg meta[] = {
         {"__gc", l_gc}, {"__close", l_gc}, {"__tostring", l_tostring}, {NULL, NULL}};
@@ -676,12 +892,16 @@ void bind_open_mpm(lua_State *L)
     static const bind_fn fns[] = {
         {"scene", l_scene,
          "mpm.scene{ cells = {nx, ny}, size = {Lx, Ly}, origin = {0, 0}, periodic = {false, "
-         "false}, gravity = {0, 0}, walls = 'noslip'|'slip'|'none'|{left =, right =, bottom =, "
-         "top =}, update = 'musl'|'usl', pic = 0 }",
+         "false}, gravity = {0, 0}, walls = 'noslip'|'slip'|'none'|{kind =, mu =, velocity =}|"
+         "{left =, right =, bottom =, top =}, update = 'musl'|'usl', pic = 0, "
+         "shape = 'linear'|'bspline' }",
          "A new 2D (plane strain) MPM scene on a uniform grid of nx x ny cells. walls: the grid's "
          "boundary nodes on axes that are not periodic — 'noslip' fixes them (default), 'slip' "
          "fixes the normal velocity only, 'none' leaves them free (a point reaching the edge "
-         "stops the run). update: 'musl' (default: the strain rate from remapped, mass-weighted nodal velocities, stable at nearly empty nodes) or 'usl' (the paper's step order). pic: PIC "
+         "stops the run); {kind = 'friction', mu = 0.5} applies the grain contact rule against "
+         "a rigid wall (Coulomb, only material moving into it); velocity = {vx, vy} moves a "
+         "wall. shape: 'linear' (the paper's, 4 nodes per point) or 'bspline' (quadratic, 9 "
+         "nodes, smooth across cell edges; a ghost node layer beyond each wall). update: 'musl' (default: the strain rate from remapped, mass-weighted nodal velocities, stable at nearly empty nodes) or 'usl' (the paper's step order). pic: PIC "
          "fraction of the point velocity update (0 = pure FLIP, Eq. 11)."},
         {"material", l_material,
          "mpm.material{ model = 'elastic'|'vonmises', density =, shear =, bulk =, yield =, "

@@ -1,5 +1,6 @@
 /* MPM measurements: energies, momentum, per-grain centre of mass and spin. */
 #include <math.h>
+#include <stdlib.h>
 
 #include "mpm/mpm_internal.h"
 
@@ -88,4 +89,99 @@ core_status mpm_grain(const mpm_scene *s, size_t id, mpm_grain_info *out, core_e
     out->omega = I > 0 ? L / I : 0;
     out->points = n;
     return CORE_OK;
+}
+
+static double field_value(const mpm_scene *s, mpm_field_kind kind, size_t p)
+{
+    const double sxx = s->sig[0][p], syy = s->sig[1][p], sxy = s->sig[2][p];
+    switch (kind) {
+    case MPM_FIELD_VX: return s->vx[p];
+    case MPM_FIELD_VY: return s->vy[p];
+    case MPM_FIELD_SPEED: return hypot(s->vx[p], s->vy[p]);
+    case MPM_FIELD_UX: return s->ux[p];
+    case MPM_FIELD_UY: return s->uy[p];
+    case MPM_FIELD_UMAG: return hypot(s->ux[p], s->uy[p]);
+    case MPM_FIELD_SXX: return sxx;
+    case MPM_FIELD_SYY: return syy;
+    case MPM_FIELD_SXY: return sxy;
+    case MPM_FIELD_PRESSURE: return -(sxx + syy) / 2;
+    case MPM_FIELD_PSD: return 2 * hypot(0.5 * (sxx - syy), sxy);
+    case MPM_FIELD_EPS_P: return s->eps_p[p];
+    case MPM_FIELD_GRAIN: return s->grain[p] + 1;
+    case MPM_FIELD_MASS: return 1;
+    }
+    return 0;
+}
+
+/* The cell holding a point (points on the upper edge belong to the last cell). */
+static size_t cell_of(const mpm_scene *s, size_t p)
+{
+    const int nx = s->def.cells[0], ny = s->def.cells[1];
+    int i = (int)floor((s->x[p] - s->def.origin[0]) * s->inv_hx);
+    int j = (int)floor((s->y[p] - s->def.origin[1]) * s->inv_hy);
+    i = i < 0 ? 0 : (i >= nx ? nx - 1 : i);
+    j = j < 0 ? 0 : (j >= ny ? ny - 1 : j);
+    return (size_t)j * (size_t)nx + (size_t)i;
+}
+
+void mpm_field(const mpm_scene *s, mpm_field_kind kind, double *out)
+{
+    const size_t nc = (size_t)s->def.cells[0] * (size_t)s->def.cells[1];
+    double *mass = calloc(nc, sizeof *mass);
+    for (size_t c = 0; c < nc; c++)
+        out[c] = 0;
+    if (!mass) { /* measurements never fail: fall back to unweighted NAN-free zeros */
+        return;
+    }
+    for (size_t p = 0; p < s->np; p++) {
+        size_t c = cell_of(s, p);
+        mass[c] += s->m[p];
+        out[c] += kind == MPM_FIELD_MASS ? s->m[p] : s->m[p] * field_value(s, kind, p);
+    }
+    for (size_t c = 0; c < nc; c++) {
+        if (kind == MPM_FIELD_MASS)
+            continue;
+        out[c] = mass[c] > 0 ? out[c] / mass[c] : NAN;
+    }
+    free(mass);
+}
+
+void mpm_column_uy(const mpm_scene *s, double *out)
+{
+    const int nx = s->def.cells[0];
+    double *mass = calloc((size_t)nx, sizeof *mass);
+    for (int i = 0; i < nx; i++)
+        out[i] = 0;
+    if (!mass)
+        return;
+    for (size_t p = 0; p < s->np; p++) {
+        size_t c = cell_of(s, p) % (size_t)nx;
+        mass[c] += s->m[p];
+        out[c] += s->m[p] * s->uy[p];
+    }
+    for (int i = 0; i < nx; i++)
+        out[i] = mass[i] > 0 ? out[i] / mass[i] : NAN;
+    free(mass);
+}
+
+double mpm_shear_strain(const mpm_scene *s)
+{
+    double M = 0, mx = 0, mu = 0;
+    for (size_t p = 0; p < s->np; p++) {
+        double x0 = s->x[p] - s->ux[p]; /* reference position (x is not wrapped in shear) */
+        M += s->m[p];
+        mx += s->m[p] * x0;
+        mu += s->m[p] * s->uy[p];
+    }
+    if (!(M > 0))
+        return 0;
+    mx /= M;
+    mu /= M;
+    double cxu = 0, cxx = 0;
+    for (size_t p = 0; p < s->np; p++) {
+        double dx = s->x[p] - s->ux[p] - mx;
+        cxu += s->m[p] * dx * (s->uy[p] - mu);
+        cxx += s->m[p] * dx * dx;
+    }
+    return cxx > 0 ? cxu / cxx : 0;
 }

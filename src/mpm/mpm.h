@@ -18,11 +18,21 @@
 typedef struct mpm_scene mpm_scene;
 
 /* ---- scene --------------------------------------------------------------------------------- */
+/* A rigid wall acts on the grid nodes on and beyond it, on the centre-of-mass field and on every
+ * grain's own field, relative to the wall's velocity. */
 typedef enum mpm_wall {
-    MPM_WALL_NOSLIP, /* boundary nodes fixed: zero velocity (default) */
-    MPM_WALL_SLIP,   /* zero normal velocity, free tangential motion */
-    MPM_WALL_NONE    /* no condition: a point reaching the edge stops the run */
+    MPM_WALL_NOSLIP,  /* the wall's velocity (default; zero for a fixed wall) */
+    MPM_WALL_SLIP,    /* the wall's normal velocity, free tangential motion, pulling as well */
+    MPM_WALL_NONE,    /* no condition: a point reaching the edge stops the run */
+    MPM_WALL_FRICTION /* the grain contact rule against a rigid body (Eqs. 12-23): material moving
+                       * into the wall takes its normal velocity and loses tangential velocity up
+                       * to mu times that correction; material moving away is free */
 } mpm_wall;
+
+/* Shape functions of the transfers. Linear: the paper's tensor-product hat functions, 4 nodes per
+ * point; the gradient jumps when a point crosses a cell edge ("cell-crossing noise").
+ * Quadratic B-spline: 9 nodes per point, C1 gradients, one ghost node layer beyond each wall. */
+typedef enum mpm_shape_fn { MPM_SHAPE_LINEAR, MPM_SHAPE_BSPLINE } mpm_shape_fn;
 
 enum { MPM_LEFT, MPM_RIGHT, MPM_BOTTOM, MPM_TOP };
 
@@ -45,6 +55,14 @@ typedef struct mpm_scene_def {
     bool periodic[2];     /* a periodic axis has no walls and wraps points */
     double gravity[2];    /* m/s^2 */
     mpm_wall walls[4];    /* MPM_LEFT, MPM_RIGHT, MPM_BOTTOM, MPM_TOP (ignored on periodic axes) */
+    double wall_mu[4];    /* Coulomb coefficient of a MPM_WALL_FRICTION wall */
+    double wall_velocity[4][2]; /* a moving wall's velocity (tangential part for friction/slip) */
+    mpm_shape_fn shape;
+    /* Gap test of friction walls and planes against contact "at a distance": a node takes the
+     * wall rule only when the centroid of its material (weighted by the shape functions) lies
+     * within wall_gap cells of where a gap-free layer of material would put it; 0 = off (every
+     * node behind the wall is in contact whenever material moves into it). */
+    double wall_gap;
     mpm_update update;
     double pic;           /* PIC fraction of the velocity update in [0, 1]: 0 = pure FLIP (Eq. 11,
                            * default), 1 = pure PIC (v_p = sum_i N_i v_i^{n+1}) */
@@ -107,6 +125,7 @@ typedef struct mpm_grain_def {
                                * of each sub-cell inside the shape (paper: n = 2 or 3) */
     double velocity[2];       /* initial rigid motion: v = velocity + omega x (x - centroid) */
     double omega;
+    bool clip;                /* keep only the points inside the grid (grains cut by an edge) */
 } mpm_grain_def;
 
 mpm_grain_def mpm_default_grain_def(void);
@@ -115,6 +134,29 @@ mpm_grain_def mpm_default_grain_def(void);
 long mpm_add_grain(mpm_scene *s, const mpm_grain_def *g, core_error *err);
 size_t mpm_grain_count(const mpm_scene *s);
 size_t mpm_point_count(const mpm_scene *s);
+
+/* Initial stress of a grain at rest under the scene's gravity: the static pressure with
+ * grad p = rho g (the paper's incline), p = 0 at the grain's highest point against g. Sets each
+ * point's deformation and elastic stretch to the isotropic in-plane compression that gives
+ * sigma_xx = sigma_yy = -p in the grain's material law. */
+core_status mpm_hydrostatic(mpm_scene *s, size_t grain, core_error *err);
+
+/* A grain with prescribed velocity moves rigidly at v: every node its points touch takes v (the
+ * centre-of-mass field, and its own field with friction), so neighbours meet a rigid body that
+ * drives them through the contact rule. Used by the shear test for the edge grains. */
+core_status mpm_prescribe(mpm_scene *s, size_t grain, const double v[2], core_error *err);
+
+/* A rigid half-space ("plane") with any normal, for walls not aligned with the grid: the nodes
+ * with (x_i - point) . normal <= 0 belong to it (a staircase on the grid) and take the wall rule
+ * with the plane's exact normal. normal points out of the body into the material. */
+typedef struct mpm_plane_def {
+    double point[2], normal[2];
+    mpm_wall kind;       /* noslip, slip or friction */
+    double mu;
+    double velocity[2];
+} mpm_plane_def;
+#define MPM_MAX_PLANES 4
+core_status mpm_add_plane(mpm_scene *s, const mpm_plane_def *p, core_error *err);
 
 /* ---- contact ------------------------------------------------------------------------------- */
 /* ---- contact --------------------------------------------------------------------------------
@@ -143,6 +185,32 @@ typedef enum mpm_contact_model {
 core_status mpm_set_contact(mpm_scene *s, mpm_contact_model model, core_error *err);
 /* Selects "friction" with the Coulomb coefficient mu >= 0 (mu = 0: frictionless). */
 core_status mpm_set_friction(mpm_scene *s, double mu, core_error *err);
+
+/* Grain normals n_i^g at a shared node. */
+typedef enum mpm_normals {
+    /* 2 g - g_all with quadratic-B-spline gradients g of the grains' mass fields (default): the
+     * grain's gradient against that of everything else, so two grains' normals are exactly
+     * opposite and the corrections conserve momentum */
+    MPM_NORMALS_AVERAGED,
+    /* Eq. 24: each grain's own quadratic-B-spline density gradient */
+    MPM_NORMALS_OWN,
+    /* 2 g - g_all with the gradients of the linear shape functions */
+    MPM_NORMALS_LINEAR
+} mpm_normals;
+
+typedef struct mpm_contact_options {
+    mpm_normals normals;
+    /* Separation check against contact "at a distance": a shared node counts as a contact only
+     * when the grains' nodal volumes sum_g sum_p N_ip V_p fill at least this fraction of the
+     * node's volume (0 = off; a node inside a gap-free region holds about one cell volume). */
+    double separation;
+    /* Cap on the contact-imposed strain: a correction dv at a node is scaled so that
+     * |dv| dt / h <= strain_cap (0 = off). */
+    double strain_cap;
+} mpm_contact_options;
+mpm_contact_options mpm_default_contact_options(void);
+core_status mpm_set_contact_options(mpm_scene *s, const mpm_contact_options *o, core_error *err);
+mpm_contact_options mpm_get_contact_options(const mpm_scene *s);
 mpm_contact_model mpm_contact(const mpm_scene *s);
 double mpm_friction(const mpm_scene *s); /* mu, 0 for noslip */
 
@@ -152,6 +220,7 @@ typedef struct mpm_points {
     const double *F[4];      /* total deformation gradient, xx, xy, yx, yy */
     const double *sigma[4];  /* Cauchy stress xx, yy, xy, zz (tension positive) */
     const double *eps_p;     /* equivalent plastic strain */
+    const double *ux, *uy;   /* displacement since the grain was added (not wrapped) */
     const int *grain, *material;
 } mpm_points;
 void mpm_get_points(const mpm_scene *s, mpm_points *p);
@@ -205,6 +274,21 @@ typedef struct mpm_grain_info {
     size_t points;
 } mpm_grain_info;
 core_status mpm_grain(const mpm_scene *s, size_t id, mpm_grain_info *out, core_error *err);
+
+/* Cell fields: the mass-weighted mean of a point quantity over the points in each cell (row-major,
+ * nx * ny values; NAN in empty cells), and the mass per cell. */
+typedef enum mpm_field_kind {
+    MPM_FIELD_VX, MPM_FIELD_VY, MPM_FIELD_SPEED, MPM_FIELD_UX, MPM_FIELD_UY, MPM_FIELD_UMAG,
+    MPM_FIELD_SXX, MPM_FIELD_SYY, MPM_FIELD_SXY, MPM_FIELD_PRESSURE,
+    MPM_FIELD_PSD,   /* principal stress difference sigma_1 - sigma_2 (in-plane) */
+    MPM_FIELD_EPS_P, MPM_FIELD_GRAIN, MPM_FIELD_MASS
+} mpm_field_kind;
+void mpm_field(const mpm_scene *s, mpm_field_kind kind, double *out);
+/* Mass-weighted mean vertical displacement per column of cells (nx values; NAN if empty). */
+void mpm_column_uy(const mpm_scene *s, double *out);
+/* Average shear strain of the material: the least-squares slope d u_y / d x over all points,
+ * mass-weighted (exact for a uniform simple shear u_y = gamma x). */
+double mpm_shear_strain(const mpm_scene *s);
 
 /* Total linear momentum and angular momentum about the origin. */
 void mpm_measure_momentum(const mpm_scene *s, double p[2], double *lz);

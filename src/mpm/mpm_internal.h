@@ -7,13 +7,22 @@
 
 #include "mpm/mpm.h"
 
-/* Linear tensor-product shape functions: four nodes per point. */
-#define MPM_STENCIL 4
+/* Nodes per point: 4 for linear shape functions, 9 for quadratic B-splines (s->ns). */
+#define MPM_STENCIL 9
+
+/* A rigid wall as the nodes see it: n points into the wall (out of the material). The grid's
+ * edges are planes 0-3 (MPM_LEFT...), user planes follow. */
+typedef struct mpm_plane {
+    mpm_wall kind;
+    double n[2], v[2], mu, point[2];
+} mpm_plane;
 
 struct mpm_scene {
     mpm_scene_def def;
     double hx, hy, inv_hx, inv_hy;
-    int nnx, nny;           /* nodes per axis: cells + 1, or cells on a periodic axis */
+    int nnx, nny;           /* nodes per axis: cells + 1 + 2 gl, or cells on a periodic axis */
+    int gl[2];              /* ghost node layers beyond each wall: 1 for B-splines, else 0 */
+    int ns;                 /* nodes per point: 4 (linear) or 9 (B-spline) */
     size_t nnodes;
 
     /* nodal fields: nnodes centre-of-mass entries, then (contact "friction") one entry per
@@ -23,7 +32,26 @@ struct mpm_scene {
     double *nfx, *nfy;      /* internal + external force, Eq. 7 */
     double *nvx, *nvy;      /* v_i^n */
     double *nax, *nay;      /* v_i^{n+1} */
-    unsigned char *nwall;   /* bit 0: x fixed, bit 1: y fixed */
+    unsigned char *nwall;   /* bit k: node belongs to plane k */
+    unsigned char *nwin;    /* bit k: friction plane k in contact at this node this step */
+    mpm_plane planes[4 + MPM_MAX_PLANES];
+    int nplanes;
+    /* The gap test of friction planes (def.wall_gap > 0): first moments of the nodal mass about
+     * the node, sum_p N_ip m_p (x_p - x_i) (nnodes each, NULL without friction planes), and per
+     * friction plane the distance from the plane of the centroid a full half-space of material
+     * would give each node (NULL for other planes). */
+    double *nmx, *nmy;
+    double *dref[4 + MPM_MAX_PLANES];
+    /* How far a point may sit beyond a grid edge with a wall before the run stops: a quarter
+     * cell (a wall's contact engages within a small gap, and material may overshoot it by a
+     * fraction of a cell; the shape functions extend there), 0 at edges without a wall. */
+    double slack[2][2];
+
+    /* prescribed-velocity grains (allocated when the first is prescribed) */
+    int *gpres;             /* per grain: index into pv, or -1 */
+    double (*pv)[2];
+    int npres;
+    int *nforce;            /* per node: 1 + index into pv of the grain forcing it, or 0 */
 
     /* material points */
     size_t np, cap;
@@ -32,6 +60,7 @@ struct mpm_scene {
     double *be[4];          /* elastic left Cauchy-Green: xx, xy, yy, zz */
     double *sig[4];         /* Cauchy stress: xx, yy, xy, zz */
     double *eps_p;
+    double *ux, *uy;        /* displacement */
     int *grain, *mat;
     /* stencil, MPM_STENCIL per point */
     int *sn;
@@ -46,12 +75,18 @@ struct mpm_scene {
     size_t paircap;         /* the nodal arrays hold nnodes + paircap entries */
     size_t npairs;
     int *pnode;             /* node of pair q */
+    int *pgrain;            /* grain of pair q */
     unsigned char *pin;     /* pair q in contact this step (Eq. 12 at the momentum update) */
+    unsigned char *pwin;    /* pair q: bit k, friction plane k in contact (as nwin) */
+    double *pvol;           /* sum_p N_ip V_p over the grain (the separation check) */
+    double *tvol;           /* the same over all grains (nnodes) */
+    double *ndp;            /* scratch (3 nnodes): momentum change of the corrections at a node */
+    mpm_contact_options opt;
     double *pnx, *pny;      /* sum_p m_p G_pi over the grain: its outward normal direction */
     int *ngr;               /* grains touching node i (nnodes) */
     double *tgx, *tgy;      /* sum_p m_p G_pi over all grains (nnodes) */
     int *mark;              /* scratch (nnodes, -1): pair of node i for the grain being built */
-    int *sv;                /* MPM_STENCIL per point: the friction sf */
+    int *sv;                /* ns per point: the friction sf */
 
     mpm_material *mats;
     int nmat, matcap;

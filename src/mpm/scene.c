@@ -16,10 +16,66 @@ mpm_scene_def mpm_default_scene_def(void)
                            .walls = {MPM_WALL_NOSLIP, MPM_WALL_NOSLIP, MPM_WALL_NOSLIP,
                                      MPM_WALL_NOSLIP},
                            .update = MPM_MUSL,
+                           .shape = MPM_SHAPE_LINEAR,
+                           .wall_gap = 0.02,
                            .pic = 0};
 }
 
 static void *alloc_zero(size_t n, size_t size) { return calloc(n ? n : 1, size); }
+
+/* 1D shape function of the scene's kind at offset t (in cells) from its node. */
+static double shape1(const mpm_scene *s, double t)
+{
+    t = fabs(t);
+    if (s->ns == 9)
+        return t < 0.5 ? 0.75 - t * t : (t < 1.5 ? 0.5 * (1.5 - t) * (1.5 - t) : 0);
+    return t < 1 ? 1 - t : 0;
+}
+
+/* For friction plane k: at every node of the plane, the shape-weighted mean distance from the
+ * plane of material filling the whole half-space in front of it, by midpoint quadrature over the
+ * node's support (64 x 64 samples). The gap test compares the nodal material's centroid with
+ * it. */
+static core_status plane_reference(mpm_scene *s, int k, core_error *err)
+{
+    const mpm_plane *pl = &s->planes[k];
+    if (pl->kind != MPM_WALL_FRICTION || !(s->def.wall_gap > 0))
+        return CORE_OK;
+    if (!s->nmx) {
+        s->nmx = alloc_zero(s->nnodes, sizeof(double));
+        s->nmy = alloc_zero(s->nnodes, sizeof(double));
+    }
+    if (!(s->dref[k] = alloc_zero(s->nnodes, sizeof(double))) || !s->nmx || !s->nmy)
+        return core_fail(err, CORE_ERR_NOMEM, "out of memory for the wall gap test");
+    const double reach = s->ns == 9 ? 1.5 : 1.0;
+    const int M = 64;
+    for (int j = 0; j < s->nny; j++)
+        for (int i = 0; i < s->nnx; i++) {
+            const size_t node = (size_t)j * s->nnx + i;
+            if (!(s->nwall[node] & (1u << k)))
+                continue;
+            const double xi = s->def.origin[0] + (i - s->gl[0]) * s->hx;
+            const double yi = s->def.origin[1] + (j - s->gl[1]) * s->hy;
+            double w = 0, wd = 0;
+            for (int b = 0; b < M; b++) {
+                const double ty = -reach + (b + 0.5) * 2 * reach / M;
+                const double wy = shape1(s, ty);
+                for (int a = 0; a < M; a++) {
+                    const double tx = -reach + (a + 0.5) * 2 * reach / M;
+                    /* distance out of the body: -(x - point) . n */
+                    const double d = -((xi + tx * s->hx - pl->point[0]) * pl->n[0] +
+                                       (yi + ty * s->hy - pl->point[1]) * pl->n[1]);
+                    if (d <= 0)
+                        continue;
+                    const double ww = shape1(s, tx) * wy;
+                    w += ww;
+                    wd += ww * d;
+                }
+            }
+            s->dref[k][node] = w > 0 ? wd / w : 0;
+        }
+    return CORE_OK;
+}
 
 core_status mpm_create(const mpm_scene_def *def, mpm_scene **out, core_error *err)
 {
@@ -36,6 +92,20 @@ core_status mpm_create(const mpm_scene_def *def, mpm_scene **out, core_error *er
             return core_fail(err, CORE_ERR_ARG, "a periodic axis needs at least 3 cells, got %d",
                              def->cells[d]);
     }
+    for (int k = 0; k < 4; k++) {
+        if (!(def->wall_mu[k] >= 0) || !isfinite(def->wall_mu[k]))
+            return core_fail(err, CORE_ERR_ARG, "wall friction must be finite and >= 0, got %g",
+                             def->wall_mu[k]);
+        if (!isfinite(def->wall_velocity[k][0]) || !isfinite(def->wall_velocity[k][1]))
+            return core_fail(err, CORE_ERR_ARG, "wall velocities must be finite");
+        if ((unsigned)def->walls[k] > MPM_WALL_FRICTION)
+            return core_fail(err, CORE_ERR_ARG, "unknown wall kind %d", (int)def->walls[k]);
+    }
+    if (!(def->wall_gap >= 0) || !isfinite(def->wall_gap))
+        return core_fail(err, CORE_ERR_ARG, "wall_gap must be finite and >= 0, got %g",
+                         def->wall_gap);
+    if (def->shape != MPM_SHAPE_LINEAR && def->shape != MPM_SHAPE_BSPLINE)
+        return core_fail(err, CORE_ERR_ARG, "unknown shape functions %d", (int)def->shape);
     if (!(def->pic >= 0 && def->pic <= 1))
         return core_fail(err, CORE_ERR_ARG, "pic must be in [0, 1], got %g", def->pic);
     mpm_scene *s = calloc(1, sizeof *s);
@@ -46,8 +116,11 @@ core_status mpm_create(const mpm_scene_def *def, mpm_scene **out, core_error *er
     s->hy = def->size[1] / def->cells[1];
     s->inv_hx = 1 / s->hx;
     s->inv_hy = 1 / s->hy;
-    s->nnx = def->cells[0] + (def->periodic[0] ? 0 : 1);
-    s->nny = def->cells[1] + (def->periodic[1] ? 0 : 1);
+    s->ns = def->shape == MPM_SHAPE_BSPLINE ? 9 : 4;
+    for (int a = 0; a < 2; a++)
+        s->gl[a] = def->shape == MPM_SHAPE_BSPLINE && !def->periodic[a] ? 1 : 0;
+    s->nnx = def->cells[0] + (def->periodic[0] ? 0 : 1 + 2 * s->gl[0]);
+    s->nny = def->cells[1] + (def->periodic[1] ? 0 : 1 + 2 * s->gl[1]);
     s->nnodes = (size_t)s->nnx * (size_t)s->nny;
     double **fields[] = {&s->nm, &s->npx, &s->npy, &s->nfx, &s->nfy,
                          &s->nvx, &s->nvy, &s->nax, &s->nay};
@@ -56,31 +129,52 @@ core_status mpm_create(const mpm_scene_def *def, mpm_scene **out, core_error *er
             mpm_destroy(s);
             return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu grid nodes", s->nnodes);
         }
-    if (!(s->nwall = alloc_zero(s->nnodes, 1))) {
+    if (!(s->nwall = alloc_zero(s->nnodes, 1)) || !(s->nwin = alloc_zero(s->nnodes, 1))) {
         mpm_destroy(s);
         return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu grid nodes", s->nnodes);
     }
-    /* Wall nodes: the boundary rows and columns of axes that are not periodic. */
+    /* The grid's edges as planes 0-3 (n into the wall); their nodes are the boundary rows and
+     * columns and the ghost layers beyond them, on axes that are not periodic. */
+    static const double normals[4][2] = {{-1, 0}, {1, 0}, {0, -1}, {0, 1}};
+    for (int k = 0; k < 4; k++) {
+        mpm_plane *pl = &s->planes[k];
+        pl->kind = def->periodic[k / 2] ? MPM_WALL_NONE : def->walls[k];
+        pl->n[0] = normals[k][0];
+        pl->n[1] = normals[k][1];
+        pl->v[0] = def->wall_velocity[k][0];
+        pl->v[1] = def->wall_velocity[k][1];
+        pl->mu = def->wall_mu[k];
+    }
+    s->nplanes = 4;
     for (int j = 0; j < s->nny; j++)
         for (int i = 0; i < s->nnx; i++) {
             unsigned char w = 0;
-            mpm_wall sides[2] = {MPM_WALL_NONE, MPM_WALL_NONE}; /* x side, y side */
-            if (!def->periodic[0] && i == 0)
-                sides[0] = def->walls[MPM_LEFT];
-            if (!def->periodic[0] && i == s->nnx - 1)
-                sides[0] = def->walls[MPM_RIGHT];
-            if (!def->periodic[1] && j == 0)
-                sides[1] = def->walls[MPM_BOTTOM];
-            if (!def->periodic[1] && j == s->nny - 1)
-                sides[1] = def->walls[MPM_TOP];
-            for (int a = 0; a < 2; a++) {
-                if (sides[a] == MPM_WALL_NOSLIP)
-                    w |= 3;
-                else if (sides[a] == MPM_WALL_SLIP)
-                    w |= (unsigned char)(1u << a);
-            }
+            int gi = i - s->gl[0], gj = j - s->gl[1];
+            if (!def->periodic[0] && gi <= 0 && s->planes[MPM_LEFT].kind != MPM_WALL_NONE)
+                w |= 1u << MPM_LEFT;
+            if (!def->periodic[0] && gi >= def->cells[0] &&
+                s->planes[MPM_RIGHT].kind != MPM_WALL_NONE)
+                w |= 1u << MPM_RIGHT;
+            if (!def->periodic[1] && gj <= 0 && s->planes[MPM_BOTTOM].kind != MPM_WALL_NONE)
+                w |= 1u << MPM_BOTTOM;
+            if (!def->periodic[1] && gj >= def->cells[1] && s->planes[MPM_TOP].kind != MPM_WALL_NONE)
+                w |= 1u << MPM_TOP;
             s->nwall[(size_t)j * s->nnx + i] = w;
         }
+    s->opt = mpm_default_contact_options();
+    for (int k = 0; k < 4; k++)
+        s->slack[k / 2][k % 2] = s->planes[k].kind == MPM_WALL_NONE ? 0
+                                 : 0.25 * (k / 2 ? s->hy : s->hx);
+    for (int k = 0; k < 4; k++) {
+        /* the grid edge's plane passes through the edge */
+        s->planes[k].point[0] = def->origin[0] + (k == MPM_RIGHT ? def->size[0] : 0);
+        s->planes[k].point[1] = def->origin[1] + (k == MPM_TOP ? def->size[1] : 0);
+        core_status st = plane_reference(s, k, err);
+        if (st) {
+            mpm_destroy(s);
+            return st;
+        }
+    }
     s->contact = MPM_CONTACT_NOSLIP;
     *out = s;
     return CORE_OK;
@@ -90,7 +184,7 @@ static double **point_doubles(mpm_scene *s, int k)
 {
     double **list[] = {&s->x, &s->y, &s->vx, &s->vy, &s->m, &s->v0, &s->F[0], &s->F[1], &s->F[2],
                        &s->F[3], &s->be[0], &s->be[1], &s->be[2], &s->be[3], &s->sig[0],
-                       &s->sig[1], &s->sig[2], &s->sig[3], &s->eps_p, NULL};
+                       &s->sig[1], &s->sig[2], &s->sig[3], &s->eps_p, &s->ux, &s->uy, NULL};
     return list[k];
 }
 
@@ -105,7 +199,20 @@ void mpm_destroy(mpm_scene *s)
     for (int k = 0; point_doubles(s, k); k++)
         free(*point_doubles(s, k));
     free(s->nwall);
+    free(s->nwin);
+    free(s->nmx);
+    free(s->nmy);
+    for (int k = 0; k < 4 + MPM_MAX_PLANES; k++)
+        free(s->dref[k]);
+    free(s->gpres);
+    free(s->pv);
+    free(s->nforce);
+    free(s->pwin);
+    free(s->pvol);
+    free(s->tvol);
+    free(s->ndp);
     free(s->pnode);
+    free(s->pgrain);
     free(s->pin);
     free(s->tgx);
     free(s->tgy);
@@ -189,7 +296,8 @@ static core_status reserve_points(mpm_scene *s, size_t n, core_error *err)
 
 mpm_grain_def mpm_default_grain_def(void)
 {
-    return (mpm_grain_def){.shape = MPM_DISK, .radius = 0, .material = 0, .points_per_cell = 2};
+    return (mpm_grain_def){.shape = MPM_DISK, .radius = 0, .material = 0, .points_per_cell = 2,
+                           .clip = false};
 }
 
 static bool inside(const mpm_grain_def *g, double x, double y)
@@ -242,7 +350,7 @@ long mpm_add_grain(mpm_scene *s, const mpm_grain_def *g, core_error *err)
                       "length %g", hi[a] - lo[a], axis[a], d->size[a]);
             return -1;
         }
-        if (!d->periodic[a] && (lo[a] < glo || hi[a] > ghi)) {
+        if (!d->periodic[a] && !g->clip && (lo[a] < glo || hi[a] > ghi)) {
             core_fail(err, CORE_ERR_ARG, "the shape spans [%g, %g] in %s, outside the grid [%g, %g]",
                       lo[a], hi[a], axis[a], glo, ghi);
             return -1;
@@ -253,6 +361,17 @@ long mpm_add_grain(mpm_scene *s, const mpm_grain_def *g, core_error *err)
     const double dx = s->hx / n, dy = s->hy / n;
     long i0 = (long)floor((lo[0] - d->origin[0]) / dx), i1 = (long)ceil((hi[0] - d->origin[0]) / dx);
     long j0 = (long)floor((lo[1] - d->origin[1]) / dy), j1 = (long)ceil((hi[1] - d->origin[1]) / dy);
+    if (g->clip) { /* sub-cells inside the grid only, on axes that are not periodic */
+        const long n0[2] = {(long)n * d->cells[0] - 1, (long)n * d->cells[1] - 1};
+        if (!d->periodic[0]) {
+            i0 = i0 < 0 ? 0 : i0;
+            i1 = i1 > n0[0] ? n0[0] : i1;
+        }
+        if (!d->periodic[1]) {
+            j0 = j0 < 0 ? 0 : j0;
+            j1 = j1 > n0[1] ? n0[1] : j1;
+        }
+    }
     size_t count = 0;
     double cx = 0, cy = 0;
     for (long j = j0; j <= j1; j++)
@@ -287,8 +406,18 @@ long mpm_add_grain(mpm_scene *s, const mpm_grain_def *g, core_error *err)
             return -1;
         }
         s->gcount = b;
+        if (s->gpres) {
+            int *c = realloc(s->gpres, cap * sizeof *c);
+            if (!c) {
+                core_fail(err, CORE_ERR_NOMEM, "out of memory for grains");
+                return -1;
+            }
+            s->gpres = c;
+        }
         s->gcap = cap;
     }
+    if (s->gpres)
+        s->gpres[s->ngrains] = -1;
     const mpm_material *mat = &s->mats[g->material];
     const double vol = dx * dy, mass = mat->density * vol;
     size_t p = s->np;
@@ -317,6 +446,7 @@ long mpm_add_grain(mpm_scene *s, const mpm_grain_def *g, core_error *err)
             for (int k = 0; k < 4; k++)
                 s->sig[k][p] = 0;
             s->eps_p[p] = 0;
+            s->ux[p] = s->uy[p] = 0;
             s->grain[p] = (int)s->ngrains;
             s->mat[p] = g->material;
             p++;
@@ -368,7 +498,7 @@ double mpm_friction(const mpm_scene *s) { return s->contact == MPM_CONTACT_FRICT
 
 core_status mpm_contact_reserve(mpm_scene *s, core_error *err)
 {
-    const size_t need = MPM_STENCIL * s->np, nn = s->nnodes;
+    const size_t need = (size_t)s->ns * s->np, nn = s->nnodes;
     if (need + nn > (size_t)INT_MAX)
         return core_fail(err, CORE_ERR_NOMEM, "%zu points are too many for the contact fields",
                          s->np);
@@ -377,6 +507,9 @@ core_status mpm_contact_reserve(mpm_scene *s, core_error *err)
         GROW(s->tgx, nn);
         GROW(s->tgy, nn);
         GROW(s->mark, nn);
+        GROW(s->tvol, nn);
+        const size_t nn3 = 3 * nn;
+        GROW(s->ndp, nn3);
         for (size_t i = 0; i < nn; i++)
             s->mark[i] = -1;
     }
@@ -392,7 +525,10 @@ core_status mpm_contact_reserve(mpm_scene *s, core_error *err)
     GROW(s->nax, nn + need);
     GROW(s->nay, nn + need);
     GROW(s->pnode, need);
+    GROW(s->pgrain, need);
     GROW(s->pin, need);
+    GROW(s->pwin, need);
+    GROW(s->pvol, need);
     GROW(s->pnx, need);
     GROW(s->pny, need);
     GROW(s->sv, need);
@@ -413,6 +549,8 @@ void mpm_get_points(const mpm_scene *s, mpm_points *p)
         p->sigma[k] = s->sig[k];
     }
     p->eps_p = s->eps_p;
+    p->ux = s->ux;
+    p->uy = s->uy;
     p->grain = s->grain;
     p->material = s->mat;
 }
@@ -427,5 +565,132 @@ core_status mpm_set_velocities(mpm_scene *s, const double *vx, const double *vy,
             return core_fail(err, CORE_ERR_ARG, "velocity of point %zu is not finite", p + 1);
     memcpy(s->vx, vx, s->np * sizeof(double));
     memcpy(s->vy, vy, s->np * sizeof(double));
+    return CORE_OK;
+}
+
+mpm_contact_options mpm_default_contact_options(void)
+{
+    return (mpm_contact_options){.normals = MPM_NORMALS_AVERAGED, .separation = 0,
+                                 .strain_cap = 0};
+}
+
+core_status mpm_set_contact_options(mpm_scene *s, const mpm_contact_options *o, core_error *err)
+{
+    if ((unsigned)o->normals > MPM_NORMALS_LINEAR)
+        return core_fail(err, CORE_ERR_ARG, "unknown normals %d", (int)o->normals);
+    if (!(o->separation >= 0 && o->separation <= 1))
+        return core_fail(err, CORE_ERR_ARG, "separation must be in [0, 1], got %g", o->separation);
+    if (!(o->strain_cap >= 0) || !isfinite(o->strain_cap))
+        return core_fail(err, CORE_ERR_ARG, "strain_cap must be finite and >= 0, got %g",
+                         o->strain_cap);
+    s->opt = *o;
+    return CORE_OK;
+}
+
+mpm_contact_options mpm_get_contact_options(const mpm_scene *s) { return s->opt; }
+
+core_status mpm_prescribe(mpm_scene *s, size_t grain, const double v[2], core_error *err)
+{
+    if (grain >= s->ngrains)
+        return core_fail(err, CORE_ERR_ARG, "grain %zu does not exist (the scene has %zu)",
+                         grain + 1, s->ngrains);
+    if (!isfinite(v[0]) || !isfinite(v[1]))
+        return core_fail(err, CORE_ERR_ARG, "the prescribed velocity must be finite");
+    if (!s->gpres) {
+        if (!(s->gpres = malloc((s->gcap ? s->gcap : 1) * sizeof *s->gpres)) ||
+            !(s->nforce = calloc(s->nnodes, sizeof *s->nforce)))
+            return core_fail(err, CORE_ERR_NOMEM, "out of memory for prescribed grains");
+        for (size_t g = 0; g < s->ngrains; g++)
+            s->gpres[g] = -1;
+    }
+    int k = s->gpres[grain];
+    if (k < 0) {
+        double(*pv)[2] = realloc(s->pv, (size_t)(s->npres + 1) * sizeof *pv);
+        if (!pv)
+            return core_fail(err, CORE_ERR_NOMEM, "out of memory for prescribed grains");
+        s->pv = pv;
+        k = s->gpres[grain] = s->npres++;
+    }
+    s->pv[k][0] = v[0];
+    s->pv[k][1] = v[1];
+    for (size_t p = s->gstart[grain]; p < s->gstart[grain] + s->gcount[grain]; p++) {
+        s->vx[p] = v[0];
+        s->vy[p] = v[1];
+    }
+    return CORE_OK;
+}
+
+core_status mpm_add_plane(mpm_scene *s, const mpm_plane_def *d, core_error *err)
+{
+    if (s->nplanes >= 4 + MPM_MAX_PLANES)
+        return core_fail(err, CORE_ERR_ARG, "at most %d planes", MPM_MAX_PLANES);
+    double len = hypot(d->normal[0], d->normal[1]);
+    if (!(len > 0) || !isfinite(len))
+        return core_fail(err, CORE_ERR_ARG, "the plane's normal must be a non-zero finite vector");
+    if (d->kind != MPM_WALL_NOSLIP && d->kind != MPM_WALL_SLIP && d->kind != MPM_WALL_FRICTION)
+        return core_fail(err, CORE_ERR_ARG, "a plane is noslip, slip or friction");
+    if (!(d->mu >= 0) || !isfinite(d->mu))
+        return core_fail(err, CORE_ERR_ARG, "the plane's mu must be finite and >= 0, got %g", d->mu);
+    for (int a = 0; a < 2; a++)
+        if (!isfinite(d->point[a]) || !isfinite(d->velocity[a]))
+            return core_fail(err, CORE_ERR_ARG, "the plane's point and velocity must be finite");
+    const int k = s->nplanes++;
+    mpm_plane *pl = &s->planes[k];
+    pl->kind = d->kind;
+    pl->mu = d->mu;
+    for (int a = 0; a < 2; a++) {
+        pl->n[a] = -d->normal[a] / len;
+        pl->v[a] = d->velocity[a];
+        pl->point[a] = d->point[a];
+    }
+    for (int j = 0; j < s->nny; j++)
+        for (int i = 0; i < s->nnx; i++) {
+            double x = s->def.origin[0] + (i - s->gl[0]) * s->hx;
+            double y = s->def.origin[1] + (j - s->gl[1]) * s->hy;
+            /* inside the body: (x - point) . normal_out <= 0, i.e. . n >= 0 */
+            if ((x - pl->point[0]) * pl->n[0] + (y - pl->point[1]) * pl->n[1] >= 0)
+                s->nwall[(size_t)j * s->nnx + i] |= (unsigned char)(1u << k);
+        }
+    return plane_reference(s, k, err);
+}
+
+core_status mpm_hydrostatic(mpm_scene *s, size_t grain, core_error *err)
+{
+    if (grain >= s->ngrains)
+        return core_fail(err, CORE_ERR_ARG, "grain %zu does not exist (the scene has %zu)",
+                         grain + 1, s->ngrains);
+    const double gx = s->def.gravity[0], gy = s->def.gravity[1];
+    const size_t p0 = s->gstart[grain], p1 = p0 + s->gcount[grain];
+    double top = INFINITY;
+    for (size_t p = p0; p < p1; p++)
+        top = fmin(top, gx * s->x[p] + gy * s->y[p]);
+    for (size_t p = p0; p < p1; p++) {
+        const mpm_material *m = &s->mats[s->mat[p]];
+        const double pres = m->density * (gx * s->x[p] + gy * s->y[p] - top);
+        /* In-plane isotropic stretch lambda (F = lambda I in plane, 1 out of plane): the Hencky
+         * law gives sigma_xx = sigma_yy = (2K + 2G/3) ln(lambda) / lambda^2; solve for -pres by
+         * Newton from lambda = 1. */
+        const double c = 2 * m->bulk + 2 * m->shear / 3;
+        double l = 0; /* ln lambda */
+        for (int it = 0; it < 50; it++) {
+            double f = c * l * exp(-2 * l) + pres, df = c * exp(-2 * l) * (1 - 2 * l);
+            double dl = f / df;
+            l -= dl;
+            if (fabs(dl) < 1e-15)
+                break;
+        }
+        const double lam = exp(l);
+        double f[4] = {lam, 0, 0, lam}, be[4] = {1, 0, 1, 1}, eps = 0, sig[4];
+        if (!mpm_material_update(m, f, be, &eps, lam * lam, sig))
+            return core_fail(err, CORE_ERR_ARG, "the hydrostatic pressure %g Pa inverts a point",
+                             pres);
+        s->F[0][p] = s->F[3][p] = lam;
+        s->F[1][p] = s->F[2][p] = 0;
+        for (int k = 0; k < 4; k++) {
+            s->be[k][p] = be[k];
+            s->sig[k][p] = sig[k];
+        }
+        s->eps_p[p] = eps;
+    }
     return CORE_OK;
 }

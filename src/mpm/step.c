@@ -45,16 +45,58 @@ core_status mpm_timestep_info(const mpm_scene *s, double cfl, mpm_timestep *out,
     return CORE_OK;
 }
 
-/* Each point's four nodes, weights N_i(x_p) and gradients G_pi (Eq. 8), linear tensor-product
- * shape functions. Points are inside the grid here (checked at the end of every step). */
+/* Node index of grid node gi on axis a (ghost layers and periodic wrap), or -1 outside. */
+static inline int node_of(const mpm_scene *s, int a, int gi)
+{
+    const int n = s->def.cells[a];
+    if (s->def.periodic[a])
+        return gi < 0 ? gi + n : (gi >= n ? gi - n : gi);
+    const int I = gi + s->gl[a], nn = a ? s->nny : s->nnx;
+    return I >= 0 && I < nn ? I : -1;
+}
+
+/* Quadratic B-spline weights and derivatives (per grid unit) of the three nodes base, base+1,
+ * base+2 around a point at grid coordinate xi. */
+static inline int bspline(double xi, double w[3], double d[3])
+{
+    const int b = (int)floor(xi - 0.5);
+    const double t = xi - b; /* in [0.5, 1.5) */
+    w[0] = 0.5 * (1.5 - t) * (1.5 - t);
+    w[1] = 0.75 - (t - 1) * (t - 1);
+    w[2] = 0.5 * (t - 0.5) * (t - 0.5);
+    d[0] = t - 1.5;
+    d[1] = -2 * (t - 1);
+    d[2] = t - 0.5;
+    return b;
+}
+
+/* Each point's nodes, weights N_i(x_p) and gradients G_pi (Eq. 8): linear tensor-product shape
+ * functions (4 nodes) or quadratic B-splines (9). Points are inside the grid here (checked at the
+ * end of every step). */
 static void stencil(mpm_scene *s)
 {
     const double ox = s->def.origin[0], oy = s->def.origin[1];
-    const int nx = s->def.cells[0], ny = s->def.cells[1], nnx = s->nnx;
-    const bool px = s->def.periodic[0], py = s->def.periodic[1];
+    const int nx = s->def.cells[0], ny = s->def.cells[1], nnx = s->nnx, ns = s->ns;
     const double ihx = s->inv_hx, ihy = s->inv_hy;
     for (size_t p = 0; p < s->np; p++) {
-        double xi = (s->x[p] - ox) * ihx, eta = (s->y[p] - oy) * ihy;
+        const double xi = (s->x[p] - ox) * ihx, eta = (s->y[p] - oy) * ihy;
+        int *n = &s->sn[ns * p];
+        double *w = &s->sw[ns * p], *gx = &s->sgx[ns * p], *gy = &s->sgy[ns * p];
+        if (ns == 9) {
+            double wx[3], dx[3], wy[3], dy[3];
+            const int bi = bspline(xi, wx, dx), bj = bspline(eta, wy, dy);
+            int k = 0;
+            for (int b = 0; b < 3; b++) {
+                const int J = node_of(s, 1, bj + b);
+                for (int a = 0; a < 3; a++, k++) {
+                    n[k] = J * nnx + node_of(s, 0, bi + a);
+                    w[k] = wx[a] * wy[b];
+                    gx[k] = dx[a] * wy[b] * ihx;
+                    gy[k] = wx[a] * dy[b] * ihy;
+                }
+            }
+            continue;
+        }
         int i = (int)floor(xi), j = (int)floor(eta);
         if (i > nx - 1)
             i = nx - 1; /* a point exactly on the upper edge */
@@ -64,18 +106,12 @@ static void stencil(mpm_scene *s)
             j = ny - 1;
         if (j < 0)
             j = 0;
-        double fx = xi - i, fy = eta - j;
-        int i1 = i + 1, j1 = j + 1;
-        if (px && i1 == nx)
-            i1 = 0;
-        if (py && j1 == ny)
-            j1 = 0;
-        int *n = &s->sn[MPM_STENCIL * p];
-        double *w = &s->sw[MPM_STENCIL * p], *gx = &s->sgx[MPM_STENCIL * p],
-               *gy = &s->sgy[MPM_STENCIL * p];
-        n[0] = j * nnx + i;
-        n[1] = j * nnx + i1;
-        n[2] = j1 * nnx + i;
+        const double fx = xi - i, fy = eta - j;
+        const int i0 = node_of(s, 0, i), i1 = node_of(s, 0, i + 1);
+        const int j0 = node_of(s, 1, j), j1 = node_of(s, 1, j + 1);
+        n[0] = j0 * nnx + i0;
+        n[1] = j0 * nnx + i1;
+        n[2] = j1 * nnx + i0;
         n[3] = j1 * nnx + i1;
         w[0] = (1 - fx) * (1 - fy);
         w[1] = fx * (1 - fy);
@@ -92,6 +128,45 @@ static void stencil(mpm_scene *s)
     }
 }
 
+/* The nodes a prescribed grain's points touch take its velocity (nforce = 1 + its index). */
+static void mark_forced(mpm_scene *s)
+{
+    if (!s->npres)
+        return;
+    memset(s->nforce, 0, s->nnodes * sizeof *s->nforce);
+    const int ns = s->ns;
+    for (size_t g = 0; g < s->ngrains; g++) {
+        if (s->gpres[g] < 0)
+            continue;
+        for (size_t p = s->gstart[g]; p < s->gstart[g] + s->gcount[g]; p++)
+            for (int k = 0; k < ns; k++)
+                s->nforce[s->sn[ns * p + k]] = 1 + s->gpres[g];
+    }
+}
+
+/* First moments of the nodal mass about each node, sum_p N_ip m_p (x_p - x_i) (minimum image on
+ * periodic axes), for the gap test of friction walls. */
+static void moments(mpm_scene *s)
+{
+    memset(s->nmx, 0, s->nnodes * sizeof(double));
+    memset(s->nmy, 0, s->nnodes * sizeof(double));
+    const int ns = s->ns, nnx = s->nnx;
+    const double ox = s->def.origin[0] - s->gl[0] * s->hx, oy = s->def.origin[1] - s->gl[1] * s->hy;
+    const double Lx = s->def.size[0], Ly = s->def.size[1];
+    for (size_t p = 0; p < s->np; p++)
+        for (int k = 0; k < ns; k++) {
+            const int i = s->sn[ns * p + k];
+            double dx = s->x[p] - (ox + (i % nnx) * s->hx), dy = s->y[p] - (oy + (i / nnx) * s->hy);
+            if (s->def.periodic[0])
+                dx -= Lx * floor(dx / Lx + 0.5);
+            if (s->def.periodic[1])
+                dy -= Ly * floor(dy / Ly + 0.5);
+            const double wm = s->sw[ns * p + k] * s->m[p];
+            s->nmx[i] += wm * dx;
+            s->nmy[i] += wm * dy;
+        }
+}
+
 /* Step 1: lumped mass (Eq. 6), momentum (Eq. 5), internal force (Eq. 7, m_p / rho_p = V_p) and
  * gravity m_i g. */
 static void to_grid(mpm_scene *s)
@@ -103,14 +178,14 @@ static void to_grid(mpm_scene *s)
     memset(s->nfx, 0, nn * sizeof(double));
     memset(s->nfy, 0, nn * sizeof(double));
     const double gx0 = s->def.gravity[0], gy0 = s->def.gravity[1];
+    const int ns = s->ns;
     for (size_t p = 0; p < s->np; p++) {
         const double m = s->m[p], px = m * s->vx[p], py = m * s->vy[p];
         const double V = s->v0[p] * (s->F[0][p] * s->F[3][p] - s->F[1][p] * s->F[2][p]);
         const double sxx = V * s->sig[0][p], syy = V * s->sig[1][p], sxy = V * s->sig[2][p];
-        const int *n = &s->sn[MPM_STENCIL * p];
-        const double *w = &s->sw[MPM_STENCIL * p], *gx = &s->sgx[MPM_STENCIL * p],
-                     *gy = &s->sgy[MPM_STENCIL * p];
-        for (int k = 0; k < MPM_STENCIL; k++) {
+        const int *n = &s->sn[ns * p];
+        const double *w = &s->sw[ns * p], *gx = &s->sgx[ns * p], *gy = &s->sgy[ns * p];
+        for (int k = 0; k < ns; k++) {
             const int i = n[k];
             s->nm[i] += w[k] * m;
             s->npx[i] += w[k] * px;
@@ -119,24 +194,103 @@ static void to_grid(mpm_scene *s)
             s->nfy[i] += w[k] * m * gy0 - (sxy * gx[k] + syy * gy[k]);
         }
     }
+    if (s->nmx)
+        moments(s);
 }
 
-/* Wall conditions on the centre-of-mass nodes and on the grain fields (entries nnodes + q). */
-static void apply_walls(const mpm_scene *s, double *vx, double *vy)
+/* The wall rule of plane pl on one nodal velocity, relative to the wall's velocity. For a
+ * friction wall, decide sets *flag to Eq. 12 (the material moves into the wall); without decide
+ * the flag of the momentum update is reused (as for grain contact, see remap). */
+static inline void wall_rule(const mpm_plane *pl, double *vx, double *vy, unsigned char *flags,
+                             unsigned char bit, bool decide, bool near)
+{
+    double rx = *vx - pl->v[0], ry = *vy - pl->v[1];
+    const double vn = rx * pl->n[0] + ry * pl->n[1];
+    switch (pl->kind) {
+    case MPM_WALL_NOSLIP:
+        rx = ry = 0;
+        break;
+    case MPM_WALL_SLIP:
+        rx -= vn * pl->n[0];
+        ry -= vn * pl->n[1];
+        break;
+    case MPM_WALL_FRICTION: {
+        if (decide)
+            *flags = (unsigned char)(vn > 0 && near ? *flags | bit : *flags & ~bit);
+        if (!(*flags & bit))
+            return;
+        rx -= vn * pl->n[0];
+        ry -= vn * pl->n[1];
+        const double t = hypot(rx, ry);
+        if (t > 0) {
+            const double c = fmin(pl->mu * fabs(vn), t) / t;
+            rx -= c * rx;
+            ry -= c * ry;
+        }
+        break;
+    }
+    case MPM_WALL_NONE:
+        return;
+    }
+    *vx = pl->v[0] + rx;
+    *vy = pl->v[1] + ry;
+}
+
+/* The gap test of friction plane k at node i: the centroid of the node's material (weighted by
+ * the shape functions) is within wall_gap cells of where a gap-free layer would put it. */
+static inline bool near_plane(const mpm_scene *s, int k, size_t i)
+{
+    if (!s->dref[k])
+        return true;
+    const mpm_plane *pl = &s->planes[k];
+    const int I = (int)(i % (size_t)s->nnx), J = (int)(i / (size_t)s->nnx);
+    const double inv = s->nm[i] > 0 ? 1 / s->nm[i] : 0;
+    const double cx = s->def.origin[0] + (I - s->gl[0]) * s->hx + s->nmx[i] * inv;
+    const double cy = s->def.origin[1] + (J - s->gl[1]) * s->hy + s->nmy[i] * inv;
+    const double d = -((cx - pl->point[0]) * pl->n[0] + (cy - pl->point[1]) * pl->n[1]);
+    const double h = s->hx < s->hy ? s->hx : s->hy;
+    return d <= s->dref[k][i] + s->def.wall_gap * h;
+}
+
+/* Wall and plane conditions on the centre-of-mass nodes, then the velocity of prescribed grains
+ * at the nodes they touch. */
+static void apply_walls(mpm_scene *s, double *vx, double *vy, bool decide)
 {
     for (size_t i = 0; i < s->nnodes; i++) {
-        unsigned char w = s->nwall[i];
-        if (w & 1)
-            vx[i] = 0;
-        if (w & 2)
-            vy[i] = 0;
+        const unsigned char w = s->nwall[i];
+        if (w)
+            for (int k = 0; k < s->nplanes; k++)
+                if (w & (1u << k))
+                    wall_rule(&s->planes[k], &vx[i], &vy[i], &s->nwin[i],
+                              (unsigned char)(1u << k), decide, !decide || near_plane(s, k, i));
+        if (s->npres && s->nforce[i]) {
+            vx[i] = s->pv[s->nforce[i] - 1][0];
+            vy[i] = s->pv[s->nforce[i] - 1][1];
+        }
     }
+}
+
+/* The same for the grain fields at shared nodes (entries nnodes + q); a prescribed grain's own
+ * field takes its velocity everywhere. */
+static void apply_walls_pairs(mpm_scene *s, double *vx, double *vy, bool decide)
+{
+    const size_t nn = s->nnodes;
     for (size_t q = 0; q < s->npairs; q++) {
-        unsigned char w = s->nwall[s->pnode[q]];
-        if (w & 1)
-            vx[s->nnodes + q] = 0;
-        if (w & 2)
-            vy[s->nnodes + q] = 0;
+        const int i = s->pnode[q];
+        if (s->ngr[i] < 2)
+            continue;
+        const size_t e = nn + q;
+        const unsigned char w = s->nwall[i];
+        if (w)
+            for (int k = 0; k < s->nplanes; k++)
+                if (w & (1u << k))
+                    wall_rule(&s->planes[k], &vx[e], &vy[e], &s->pwin[q],
+                              (unsigned char)(1u << k), decide, !decide || near_plane(s, k, i));
+        const int k = s->npres ? s->gpres[s->pgrain[q]] : -1;
+        if (k >= 0) {
+            vx[e] = s->pv[k][0];
+            vy[e] = s->pv[k][1];
+        }
     }
 }
 
@@ -144,18 +298,24 @@ static void apply_walls(const mpm_scene *s, double *vx, double *vy)
  * that a grain's points touch, found grain by grain (points are stored grain by grain) with a
  * per-node scratch mark that is reset after each grain: the cost is linear in the points, and no
  * grains x nodes array exists. Entry nnodes + q of the nodal arrays holds the grain's mass
- * (Eq. 16), momentum (Eq. 5) and force (Eq. 7) over its own points; pnx, pny hold sum_p m_p G_pi,
- * the gradient of the grain's mass field at the node taken with the linear shape functions
- * (Eq. 24 uses the gradient of a quadratic-B-spline density instead; both point out of the
- * grain). A point moves with its grain's field at nodes shared by two or more grains and with
- * the centre-of-mass node elsewhere, so an isolated grain evolves exactly as with noslip. */
+ * (Eq. 16), momentum (Eq. 5) and force (Eq. 7) over its own points, and its nodal volume
+ * sum_p N_ip V_p. pnx, pny hold sum_p m_p grad N_i(x_p) over the grain, minus the gradient of
+ * its mass field at the node (it points out of the grain), and tgx, tgy the same over all grains;
+ * with normals from quadratic B-splines (Eq. 24) and linear transfers, a second pass adds the
+ * B-spline gradients of each grain's points to the pairs it already has (the 9-node support). A
+ * point moves with its grain's field at nodes shared by two or more grains and with the
+ * centre-of-mass node elsewhere, so an isolated grain evolves exactly as with noslip. */
 static void grain_fields(mpm_scene *s)
 {
     const size_t nn = s->nnodes;
+    const int ns = s->ns;
     const double gx0 = s->def.gravity[0], gy0 = s->def.gravity[1];
+    const bool spline_normals = s->opt.normals != MPM_NORMALS_LINEAR && ns != 9;
+    const double ox = s->def.origin[0], oy = s->def.origin[1];
     memset(s->ngr, 0, nn * sizeof(int));
     memset(s->tgx, 0, nn * sizeof(double));
     memset(s->tgy, 0, nn * sizeof(double));
+    memset(s->tvol, 0, nn * sizeof(double));
     size_t q = 0;
     for (size_t g = 0; g < s->ngrains; g++) {
         const size_t p0 = s->gstart[g], p1 = p0 + s->gcount[g], q0 = q;
@@ -163,20 +323,20 @@ static void grain_fields(mpm_scene *s)
             const double m = s->m[p], px = m * s->vx[p], py = m * s->vy[p];
             const double V = s->v0[p] * (s->F[0][p] * s->F[3][p] - s->F[1][p] * s->F[2][p]);
             const double sxx = V * s->sig[0][p], syy = V * s->sig[1][p], sxy = V * s->sig[2][p];
-            const int *n = &s->sn[MPM_STENCIL * p];
-            const double *w = &s->sw[MPM_STENCIL * p], *gx = &s->sgx[MPM_STENCIL * p],
-                         *gy = &s->sgy[MPM_STENCIL * p];
-            for (int k = 0; k < MPM_STENCIL; k++) {
+            const int *n = &s->sn[ns * p];
+            const double *w = &s->sw[ns * p], *gx = &s->sgx[ns * p], *gy = &s->sgy[ns * p];
+            for (int k = 0; k < ns; k++) {
                 const int i = n[k];
                 int r = s->mark[i];
                 if (r < 0) {
                     r = (int)q++;
                     s->mark[i] = r;
                     s->pnode[r] = i;
+                    s->pgrain[r] = (int)g;
                     s->ngr[i]++;
                     const size_t e = nn + (size_t)r;
                     s->nm[e] = s->npx[e] = s->npy[e] = s->nfx[e] = s->nfy[e] = 0;
-                    s->pnx[r] = s->pny[r] = 0;
+                    s->pnx[r] = s->pny[r] = s->pvol[r] = 0;
                 }
                 const size_t e = nn + (size_t)r;
                 s->nm[e] += w[k] * m;
@@ -184,18 +344,49 @@ static void grain_fields(mpm_scene *s)
                 s->npy[e] += w[k] * py;
                 s->nfx[e] += w[k] * m * gx0 - (sxx * gx[k] + sxy * gy[k]);
                 s->nfy[e] += w[k] * m * gy0 - (sxy * gx[k] + syy * gy[k]);
-                s->pnx[r] += m * gx[k];
-                s->pny[r] += m * gy[k];
-                s->tgx[i] += m * gx[k];
-                s->tgy[i] += m * gy[k];
-                s->sv[MPM_STENCIL * p + k] = (int)e;
+                s->pvol[r] += w[k] * V;
+                s->tvol[i] += w[k] * V;
+                if (!spline_normals) {
+                    s->pnx[r] += m * gx[k];
+                    s->pny[r] += m * gy[k];
+                    s->tgx[i] += m * gx[k];
+                    s->tgy[i] += m * gy[k];
+                }
+                s->sv[ns * p + k] = (int)e;
             }
         }
+        if (spline_normals)
+            for (size_t p = p0; p < p1; p++) {
+                double wx[3], dx[3], wy[3], dy[3];
+                const int bi = bspline((s->x[p] - ox) * s->inv_hx, wx, dx);
+                const int bj = bspline((s->y[p] - oy) * s->inv_hy, wy, dy);
+                const double m = s->m[p];
+                for (int b = 0; b < 3; b++) {
+                    const int J = node_of(s, 1, bj + b);
+                    if (J < 0)
+                        continue;
+                    for (int a = 0; a < 3; a++) {
+                        const int I = node_of(s, 0, bi + a);
+                        if (I < 0)
+                            continue;
+                        const int i = J * s->nnx + I;
+                        const double ggx = m * dx[a] * wy[b] * s->inv_hx;
+                        const double ggy = m * wx[a] * dy[b] * s->inv_hy;
+                        s->tgx[i] += ggx;
+                        s->tgy[i] += ggy;
+                        const int r = s->mark[i];
+                        if (r >= 0) {
+                            s->pnx[r] += ggx;
+                            s->pny[r] += ggy;
+                        }
+                    }
+                }
+            }
         for (size_t r = q0; r < q; r++)
             s->mark[s->pnode[r]] = -1;
     }
     s->npairs = q;
-    for (size_t e = 0; e < MPM_STENCIL * s->np; e++)
+    for (size_t e = 0; e < (size_t)ns * s->np; e++)
         if (s->ngr[s->sn[e]] < 2)
             s->sv[e] = s->sn[e];
 }
@@ -220,55 +411,93 @@ static void grid_update(mpm_scene *s, double dt)
             s->nvx[i] = s->nvy[i] = s->nax[i] = s->nay[i] = 0;
         }
     }
-    apply_walls(s, s->nax, s->nay);
+    apply_walls(s, s->nax, s->nay, true);
 }
 
 /* The contact rule at nodes shared by two or more grains: each grain's velocity (vx, vy at entry
  * nnodes + q) against the centre-of-mass velocity at its node. With decide, Eq. 12 (the grain
- * overtakes the centre-of-mass field along its normal) marks the pair in contact for this step;
- * without, the marks of the momentum update are reused (see remap). Marked pairs get the normal
- * correction (Eq. 14) and Coulomb friction (Eqs. 18-23). */
-static void contact_correct(mpm_scene *s, double *vx, double *vy, bool decide)
+ * overtakes the centre-of-mass field along its normal) and the separation check mark the pair in
+ * contact for this step; without, the marks of the momentum update are reused (see remap).
+ * Marked pairs get the normal correction (Eq. 14) and Coulomb friction (Eqs. 18-23), capped by
+ * the strain cap; then the momentum the corrections changed at a node (non-zero with three or
+ * more grains, or with the cap) is taken back evenly from the corrected grains there, a common
+ * velocity shift that leaves their relative motion as the rule made it. */
+static void contact_correct(mpm_scene *s, double *vx, double *vy, bool decide, double dt)
 {
     const size_t nn = s->nnodes;
     const double mu = s->mu;
+    const mpm_normals normals = s->opt.normals;
+    const double sep = s->opt.separation * s->hx * s->hy;
+    const double cap = s->opt.strain_cap * (s->hx < s->hy ? s->hx : s->hy) / dt;
+    double *dp = s->ndp; /* per node: momentum change x, y, and the corrected grains' mass */
+    bool any = false;
     for (size_t q = 0; q < s->npairs; q++) {
         const int i = s->pnode[q];
         const size_t e = nn + q;
-        /* The grain's mass gradient against that of everything else at the node,
-         * g - (g_all - g) = 2 g - g_all: at a node of two grains their normals are then exactly
-         * opposite and the corrections conserve momentum (the grain's own gradient alone loses
-         * 5% of the momentum when a disk hits one at rest head-on). */
-        const double gx = 2 * s->pnx[q] - s->tgx[i], gy = 2 * s->pny[q] - s->tgy[i];
-        const double len = hypot(gx, gy);
         if (decide)
             s->pin[q] = 0;
-        if (s->ngr[i] < 2 || !(len > 0) || !(s->nm[e] > 0))
+        if (s->ngr[i] < 2 || !(s->nm[e] > 0))
+            continue;
+        double gx = s->pnx[q], gy = s->pny[q];
+        if (normals != MPM_NORMALS_OWN) {
+            /* The grain's mass gradient against that of everything else at the node,
+             * g - (g_all - g) = 2 g - g_all: at a node of two grains their normals are then
+             * exactly opposite and the corrections conserve momentum. */
+            gx = 2 * gx - s->tgx[i];
+            gy = 2 * gy - s->tgy[i];
+        }
+        const double len = hypot(gx, gy);
+        if (!(len > 0))
             continue;
         const double nx = gx / len, ny = gy / len;
         const double dvx = vx[e] - vx[i], dvy = vy[e] - vy[i];
         const double dn = dvx * nx + dvy * ny;
         if (decide)
-            s->pin[q] = dn > 0; /* Eq. 12 */
+            s->pin[q] = dn > 0 && !(sep > 0 && s->tvol[i] < sep); /* Eq. 12, separation */
         if (!s->pin[q])
             continue;
         const double tx = dvx - dn * nx, ty = dvy - dn * ny, t = hypot(tx, ty);
-        /* Eq. 14: the normal velocity becomes the centre-of-mass one (the force of Eq. 15) */
-        vx[e] -= dn * nx;
-        vy[e] -= dn * ny;
-        /* Eqs. 18-23: sticking would remove the whole relative tangential velocity t (Eq. 18);
+        /* Eq. 14: the normal velocity becomes the centre-of-mass one (the force of Eq. 15);
+         * Eqs. 18-23: sticking would remove the whole relative tangential velocity t (Eq. 18);
          * Coulomb caps the removal at mu times the normal correction |dn|, i.e.
          * mu' = min(mu, t / dn) (Eq. 21) along -t / |t| (Eqs. 20, 22), which is Eq. 23. */
+        double cx = -dn * nx, cy = -dn * ny;
         if (t > 0) {
             const double c = fmin(mu * fabs(dn), t) / t;
-            vx[e] -= c * tx;
-            vy[e] -= c * ty;
+            cx -= c * tx;
+            cy -= c * ty;
         }
+        if (cap > 0) {
+            const double c = hypot(cx, cy);
+            if (c > cap) {
+                cx *= cap / c;
+                cy *= cap / c;
+            }
+        }
+        vx[e] += cx;
+        vy[e] += cy;
+        if (!any) {
+            memset(dp, 0, 3 * nn * sizeof(double));
+            any = true;
+        }
+        dp[i] += s->nm[e] * cx;
+        dp[nn + i] += s->nm[e] * cy;
+        dp[2 * nn + i] += s->nm[e];
+    }
+    if (!any)
+        return;
+    for (size_t q = 0; q < s->npairs; q++) {
+        const int i = s->pnode[q];
+        if (!s->pin[q] || s->nwall[i] || (s->npres && s->nforce[i]))
+            continue;
+        const double M = dp[2 * nn + i];
+        vx[nn + q] -= dp[i] / M;
+        vy[nn + q] -= dp[nn + i] / M;
     }
 }
 
 /* Step 2 for the grain fields at shared nodes: v_i^g and the updated v_i^g (Eqs. 5 and 9 over the
- * grain's points, with the centre-of-mass field's mass threshold and walls), then the contact
+ * grain's points, with the centre-of-mass field's mass threshold), the walls, then the contact
  * rule. Applied after the momentum update (the paper's order) and not to the P2G velocities
  * (measured on the 0.5 m/s head-on collision: correcting v_i^g after P2G as well changed the
  * rebound speed by 1.5% and did not remove the energy error that the consistent marks below
@@ -292,24 +521,22 @@ static void contact_update(mpm_scene *s, double dt)
         s->nvy[e] = s->npy[e] * inv;
         s->nax[e] = s->nvx[e] + k * s->nfx[e];
         s->nay[e] = s->nvy[e] + k * s->nfy[e];
-        const unsigned char w = s->nwall[i];
-        if (w & 1)
-            s->nax[e] = 0;
-        if (w & 2)
-            s->nay[e] = 0;
     }
-    contact_correct(s, s->nax, s->nay, true);
+    apply_walls_pairs(s, s->nax, s->nay, true);
+    contact_correct(s, s->nax, s->nay, true, dt);
 }
 
-/* Step 3: positions (Eq. 10) and velocities (Eq. 11, blended with PIC). */
+/* Step 3: positions (Eq. 10) and velocities (Eq. 11, blended with PIC); a prescribed grain's
+ * points keep its velocity exactly. */
 static void to_points(mpm_scene *s, double dt)
 {
     const double pic = s->def.pic, flip = 1 - pic;
+    const int ns = s->ns;
     for (size_t p = 0; p < s->np; p++) {
-        const int *n = &s->sf[MPM_STENCIL * p];
-        const double *w = &s->sw[MPM_STENCIL * p];
+        const int *n = &s->sf[ns * p];
+        const double *w = &s->sw[ns * p];
         double dvx = 0, dvy = 0, ax = 0, ay = 0;
-        for (int k = 0; k < MPM_STENCIL; k++) {
+        for (int k = 0; k < ns; k++) {
             const int i = n[k];
             ax += w[k] * s->nax[i];
             ay += w[k] * s->nay[i];
@@ -318,23 +545,36 @@ static void to_points(mpm_scene *s, double dt)
         }
         s->x[p] += dt * ax;
         s->y[p] += dt * ay;
+        s->ux[p] += dt * ax;
+        s->uy[p] += dt * ay;
         s->vx[p] = flip * (s->vx[p] + dvx) + pic * ax;
         s->vy[p] = flip * (s->vy[p] + dvy) + pic * ay;
     }
+    if (s->npres)
+        for (size_t g = 0; g < s->ngrains; g++) {
+            const int k = s->gpres[g];
+            if (k < 0)
+                continue;
+            for (size_t p = s->gstart[g]; p < s->gstart[g] + s->gcount[g]; p++) {
+                s->vx[p] = s->pv[k][0];
+                s->vy[p] = s->pv[k][1];
+            }
+        }
 }
 
 /* MUSL: the updated point momenta mapped back (Eq. 5 with v_p^{n+1}) give the nodal velocities
  * the strain increment is taken from; with friction each grain's own field at shared nodes. */
-static void remap(mpm_scene *s)
+static void remap(mpm_scene *s, double dt)
 {
     const size_t nn = s->nnodes + s->npairs;
+    const int ns = s->ns;
     memset(s->npx, 0, nn * sizeof(double));
     memset(s->npy, 0, nn * sizeof(double));
     for (size_t p = 0; p < s->np; p++) {
         const double px = s->m[p] * s->vx[p], py = s->m[p] * s->vy[p];
-        const int *n = &s->sf[MPM_STENCIL * p];
-        const double *w = &s->sw[MPM_STENCIL * p];
-        for (int k = 0; k < MPM_STENCIL; k++) {
+        const int *n = &s->sf[ns * p];
+        const double *w = &s->sw[ns * p];
+        for (int k = 0; k < ns; k++) {
             s->npx[n[k]] += w[k] * px;
             s->npy[n[k]] += w[k] * py;
         }
@@ -351,15 +591,19 @@ static void remap(mpm_scene *s)
         s->nax[i] = m > 0 ? s->npx[i] / m : 0;
         s->nay[i] = m > 0 ? s->npy[i] / m : 0;
     }
-    apply_walls(s, s->nax, s->nay);
-    /* The point velocities carry the grid-update correction only in part (each point gets a
-     * weighted share), so the remapped grain fields still approach at contacts and are corrected
-     * again, at the pairs that Eq. 12 put in contact at the momentum update. Both choices were
-     * measured on two elastic disks (R = 4 cells) meeting head-on at 0.5 m/s each, noslip
-     * ending with (kinetic + elastic) / initial kinetic = 1.01: no remap correction: 1.64;
-     * remap correction re-deciding Eq. 12 on the remapped field (contact switching on and off
-     * every other step): 1.58; the marks of the momentum update: 1.03. */
-    contact_correct(s, s->nax, s->nay, false);
+    apply_walls(s, s->nax, s->nay, false);
+    if (s->npairs) {
+        apply_walls_pairs(s, s->nax, s->nay, false);
+        /* The point velocities carry the grid-update correction only in part (each point gets a
+         * weighted share), so the remapped grain fields still approach at contacts and are
+         * corrected again, at the pairs that Eq. 12 put in contact at the momentum update. Both
+         * choices were measured on two elastic disks (R = 4 cells) meeting head-on at 0.5 m/s
+         * each, noslip ending with (kinetic + elastic) / initial kinetic = 1.01: no remap
+         * correction: 1.64; remap correction re-deciding Eq. 12 on the remapped field (contact
+         * switching on and off every other step): 1.58; the marks of the momentum update:
+         * 1.03. */
+        contact_correct(s, s->nax, s->nay, false, dt);
+    }
 }
 
 /* Step 3, continued: velocity gradient L = sum_i v_i G_pi, F <- (I + dt L) F, stress update.
@@ -367,11 +611,12 @@ static void remap(mpm_scene *s)
 static size_t constitutive(mpm_scene *s, double dt)
 {
     size_t bad = (size_t)-1;
+    const int ns = s->ns;
     for (size_t p = 0; p < s->np; p++) {
-        const int *n = &s->sf[MPM_STENCIL * p];
-        const double *gx = &s->sgx[MPM_STENCIL * p], *gy = &s->sgy[MPM_STENCIL * p];
+        const int *n = &s->sf[ns * p];
+        const double *gx = &s->sgx[ns * p], *gy = &s->sgy[ns * p];
         double L[4] = {0, 0, 0, 0};
-        for (int k = 0; k < MPM_STENCIL; k++) {
+        for (int k = 0; k < ns; k++) {
             const int i = n[k];
             L[0] += s->nax[i] * gx[k];
             L[1] += s->nax[i] * gy[k];
@@ -427,7 +672,7 @@ static core_status check_points(mpm_scene *s, core_error *err)
                     *c[a] -= L * floor((*c[a] - o) / L);
                 if (*c[a] >= o + L) /* rounding of a value just below o */
                     *c[a] = o;
-            } else if (*c[a] < o || *c[a] > o + L) {
+            } else if (*c[a] < o - s->slack[a][0] || *c[a] > o + L + s->slack[a][1]) {
                 return unstable(s, p, "left the grid",
                                 "an edge without a wall (walls = 'none'), or a time step too "
                                 "large for the speed", err);
@@ -473,6 +718,7 @@ core_status mpm_run(mpm_scene *s, const mpm_run_def *run, long *done, core_error
         if (run->time_end >= 0 && s->time + dt > run->time_end)
             dt = run->time_end - s->time;
         stencil(s);
+        mark_forced(s);
         to_grid(s);
         if (friction)
             grain_fields(s);
@@ -481,7 +727,7 @@ core_status mpm_run(mpm_scene *s, const mpm_run_def *run, long *done, core_error
             contact_update(s, dt);
         to_points(s, dt);
         if (s->def.update == MPM_MUSL)
-            remap(s);
+            remap(s, dt);
         size_t bad = constitutive(s, dt);
         if (bad != (size_t)-1)
             return unstable(s, bad, "was inverted (det F <= 0)",

@@ -27,13 +27,46 @@ check.errors(function() mpm.scene{ cells = { 0, 10 }, size = { 1, 1 } } end,
 check.errors(function() mpm.scene{ cells = { 10, 10 }, size = { 1, -1 } } end,
   "bad field 'size' in argument #1 to 'scene' (array of 2 positive numbers expected", "negative size")
 check.errors(function() mpm.scene{ cells = { 10, 10 }, size = { 1, 1 }, walls = "sticky" } end,
-  "bad field 'walls' in argument #1 to 'scene' (one of 'noslip', 'slip', 'none' expected, got 'sticky')", "unknown wall")
+  "bad field 'walls' in argument #1 to 'scene' ('noslip', 'slip', 'none' or {kind = 'noslip'|'slip'|'friction', mu =, velocity = {vx, vy}} expected, got 'sticky')", "unknown wall")
+check.errors(function() mpm.scene{ cells = { 10, 10 }, size = { 1, 1 }, walls = "friction" } end,
+  "bad field 'walls' in argument #1 to 'scene' ({kind = 'friction', mu = ...} (a friction wall needs mu) expected, got 'friction')", "friction wall without mu")
+check.errors(function() mpm.scene{ cells = { 10, 10 }, size = { 1, 1 }, walls = { bottom = { kind = "friction" } } } end,
+  "bad field 'walls.bottom.mu' in argument #1 to 'scene' (non-negative number expected, got nil)", "friction wall table without mu")
+check.errors(function() mpm.scene{ cells = { 10, 10 }, size = { 1, 1 }, walls = { bottom = { kind = "friction", mu = -1 } } } end,
+  "bad field 'walls.bottom.mu' in argument #1 to 'scene' (non-negative number expected, got -1)", "negative wall mu")
+check.errors(function() mpm.scene{ cells = { 10, 10 }, size = { 1, 1 }, shape = "cubic" } end,
+  "bad field 'shape' in argument #1 to 'scene' (one of 'linear', 'bspline' expected, got 'cubic')", "unknown shape functions")
 check.errors(function() mpm.scene{ cells = { 10, 10 }, size = { 1, 1 }, walls = { left = "x" } } end,
   "bad field 'walls.left' in argument #1 to 'scene'", "unknown wall side value")
 check.errors(function() mpm.scene{ cells = { 10, 10 }, size = { 1, 1 }, pic = 2 } end,
   "bad field 'pic' in argument #1 to 'scene' (number in [0, 1] expected, got 2)", "pic above 1")
 check.errors(function() mpm.scene{ cells = { 10, 10 }, size = { 1, 1 }, gravty = { 0, -9.8 } } end,
   "bad argument #1 to 'scene' (unknown field 'gravty'", "typo in a field")
+
+-- planes, prescribed grains, contact options, fields
+do
+  local p = mpm.scene{ cells = { 10, 10 }, size = { 1, 1 } }
+  check.errors(function() p:plane{ point = { 0, 0.2 }, normal = { 0, 0 }, mu = 0.3 } end,
+    "bad field 'normal' in argument #1 to 'plane' (non-zero vector expected", "plane with a zero normal")
+  check.errors(function() p:plane{ point = { 0, 0.2 }, normal = { 0, 1 } } end,
+    "bad field 'mu' in argument #1 to 'plane' (non-negative number expected, got nil)", "friction plane without mu")
+  check.errors(function() p:prescribe(1, { 0, 1 }) end,
+    "bad argument #1 to 'prescribe' (grain id in [1, 0] expected, got 1)", "prescribe a missing grain")
+  local g = p:add_disk{ center = { 0.5, 0.5 }, radius = 0.2, material = mpm.material{ density = 1, shear = 1, bulk = 1 } }
+  check.errors(function() p:prescribe(g, { 0, 0 / 0 }) end,
+    "bad argument #2 to 'prescribe' (velocity {vx, vy} of finite numbers expected)", "prescribe NaN")
+  check.errors(function() p:contact{ model = "friction", mu = 0.3, separation = 1.5 } end,
+    "bad field 'separation' in argument #1 to 'contact' (number in [0, 1] expected, got 1.5)", "separation above 1")
+  check.errors(function() p:contact{ model = "friction", mu = 0.3, normals = "mine" } end,
+    "bad field 'normals' in argument #1 to 'contact' (one of 'averaged', 'own', 'linear' expected, got 'mine')", "unknown normals")
+  check.errors(function() p:field("temperature") end, "bad argument #1 to 'field' (invalid option 'temperature')", "unknown field")
+  check.errors(function() p:add_disk{ center = { 0.95, 0.5 }, radius = 0.2, material = mpm.material{ density = 1, shear = 1, bulk = 1 } } end,
+    "outside the grid", "disk across the edge without clip")
+  local c = p:add_disk{ center = { 0.95, 0.5 }, radius = 0.2, clip = true, material = mpm.material{ density = 1, shear = 1, bulk = 1 } }
+  check.lt(p:grain(c).points, p:grain(g).points, "clip keeps only the points inside the grid")
+  local f = p:field("grain")
+  check.eq(#f.values, 100, "field: one value per cell")
+end
 
 -- grains
 check.errors(function() m:add_disk{ center = { 0.5, 0.5 }, radius = 0.2, material = mat, points_per_cell = 0 } end,
