@@ -352,6 +352,12 @@ static int add_grain(lua_State *L, const char *call, mpm_shape shape)
         return bind_raise(L, call, &err);
     if (hydro && mpm_hydrostatic(s, (size_t)id, &err))
         return bind_raise(L, call, &err);
+    size_t other;
+    double overlap = mpm_grain_overlap(s, (size_t)id, &other);
+    if (overlap > 0)
+        fprintf(stderr, "grainlab: warning: %s: grain %ld overlaps grain %zu by %g m; overlapping "
+                "grains share material points' cells from the start (with 'friction' they are "
+                "pushed apart, with 'noslip' glued)\n", call, id + 1, other + 1, overlap);
     lua_pushinteger(L, id + 1);
     return 1;
 }
@@ -363,7 +369,7 @@ static int l_add_rect(lua_State *L) { return add_grain(L, "add_rect", MPM_RECT);
 static int l_contact(lua_State *L)
 {
     static const char *const fields[] = {"model", "mu", "normals", "separation", "strain_cap",
-                                         NULL};
+                                         "conserve", NULL};
     static const char *const names[] = {"noslip", "friction", NULL};
     mpm_scene *s = check_scene(L, 1);
     bind_check_table(L, 2, "contact");
@@ -379,6 +385,7 @@ static int l_contact(lua_State *L)
         return bind_field_error(L, 2, "contact", "separation", "number in [0, 1]");
     }
     o.strain_cap = bind_field_number(L, 2, "contact", "strain_cap", o.strain_cap, BIND_NONNEG);
+    o.conserve = bind_field_boolean(L, 2, "contact", "conserve", o.conserve);
     if (mpm_set_contact_options(s, &o, &err))
         return bind_raise(L, "contact", &err);
     if (model == MPM_CONTACT_FRICTION) {
@@ -764,6 +771,8 @@ static int l_info(lua_State *L)
     lua_setfield(L, -2, "normals");
     set_number(L, "separation", o.separation);
     set_number(L, "strain_cap", o.strain_cap);
+    lua_pushboolean(L, o.conserve);
+    lua_setfield(L, -2, "conserve");
     return 1;
 }
 
@@ -825,7 +834,7 @@ void bind_open_mpm(lua_State *L)
          "render.field."},
         {"contact", l_contact,
          "m:contact{ model = 'noslip' | 'friction', mu = 0.3, normals = 'averaged'|'own'|'linear', "
-         "separation = 0, strain_cap = 0 }",
+         "separation = 0, strain_cap = 0, conserve = true }",
          "The grain contact model. 'noslip' (default): the single centre-of-mass velocity field "
          "of the basic algorithm (Sec. 2); grains stick on contact. 'friction' (Sec. 3; mu >= 0 "
          "required, 0 = frictionless): each grain also has its own nodal field, stored only at "
@@ -840,8 +849,9 @@ void bind_open_mpm(lua_State *L)
          "'linear' as 'averaged' with linear-shape gradients. separation: a shared node is a "
          "contact only when the grains' nodal volumes fill this fraction of the cell (against "
          "contact at a distance; 0 = off). strain_cap: corrections limited to |dv| dt / h <= "
-         "cap (0 = off). With three or more grains at a node, the momentum the corrections "
-         "change is given back as a common velocity shift of the corrected grains."},
+         "cap (0 = off). conserve (default true): the momentum the corrections change at a node "
+         "(three or more grains, 'own' normals, the cap) is given back as a common velocity "
+         "shift of the corrected grains there."},
         {"timestep", l_timestep, "m:timestep{ cfl = 0.4 }",
          "The CFL limit h / (c + max|v|) (h the smaller cell side, c = sqrt((K + 4G/3)/rho) the "
          "largest P-wave speed), the automatic step cfl x limit, the wave speed and the fastest "

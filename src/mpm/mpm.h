@@ -134,6 +134,10 @@ mpm_grain_def mpm_default_grain_def(void);
 long mpm_add_grain(mpm_scene *s, const mpm_grain_def *g, core_error *err);
 size_t mpm_grain_count(const mpm_scene *s);
 size_t mpm_point_count(const mpm_scene *s);
+/* The deepest overlap of grain id's shape with an earlier grain's (disks: r1 + r2 - distance,
+ * rectangles and mixed pairs: the smaller side of the bounding boxes' intersection; minimum
+ * image on periodic axes). Returns the depth (0: none) and that grain in *other. */
+double mpm_grain_overlap(const mpm_scene *s, size_t id, size_t *other);
 
 /* Initial stress of a grain at rest under the scene's gravity: the static pressure with
  * grad p = rho g (the paper's incline), p = 0 at the grain's highest point against g. Sets each
@@ -207,6 +211,10 @@ typedef struct mpm_contact_options {
     /* Cap on the contact-imposed strain: a correction dv at a node is scaled so that
      * |dv| dt / h <= strain_cap (0 = off). */
     double strain_cap;
+    /* Give back, at each node, the momentum the corrections changed (a common velocity shift of
+     * the corrected grains there): non-zero with three or more grains at a node, with 'own'
+     * normals, or with the strain cap. Default true. */
+    bool conserve;
 } mpm_contact_options;
 mpm_contact_options mpm_default_contact_options(void);
 core_status mpm_set_contact_options(mpm_scene *s, const mpm_contact_options *o, core_error *err);

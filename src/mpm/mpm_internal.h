@@ -92,6 +92,7 @@ struct mpm_scene {
     int nmat, matcap;
     size_t ngrains, gcap;
     size_t *gstart, *gcount;
+    mpm_grain_def *gdef;    /* each grain's shape, for the overlap warning */
 
     mpm_contact_model contact;
     double time;

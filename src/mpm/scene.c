@@ -227,6 +227,7 @@ void mpm_destroy(mpm_scene *s)
     free(s->mats);
     free(s->gstart);
     free(s->gcount);
+    free(s->gdef);
     free(s);
 }
 
@@ -406,6 +407,12 @@ long mpm_add_grain(mpm_scene *s, const mpm_grain_def *g, core_error *err)
             return -1;
         }
         s->gcount = b;
+        mpm_grain_def *gd = realloc(s->gdef, cap * sizeof *gd);
+        if (!gd) {
+            core_fail(err, CORE_ERR_NOMEM, "out of memory for grains");
+            return -1;
+        }
+        s->gdef = gd;
         if (s->gpres) {
             int *c = realloc(s->gpres, cap * sizeof *c);
             if (!c) {
@@ -451,6 +458,7 @@ long mpm_add_grain(mpm_scene *s, const mpm_grain_def *g, core_error *err)
             s->mat[p] = g->material;
             p++;
         }
+    s->gdef[s->ngrains] = *g;
     s->gstart[s->ngrains] = s->np;
     s->gcount[s->ngrains] = count;
     s->np = p;
@@ -571,7 +579,7 @@ core_status mpm_set_velocities(mpm_scene *s, const double *vx, const double *vy,
 mpm_contact_options mpm_default_contact_options(void)
 {
     return (mpm_contact_options){.normals = MPM_NORMALS_AVERAGED, .separation = 0,
-                                 .strain_cap = 0};
+                                 .strain_cap = 0, .conserve = true};
 }
 
 core_status mpm_set_contact_options(mpm_scene *s, const mpm_contact_options *o, core_error *err)
@@ -693,4 +701,54 @@ core_status mpm_hydrostatic(mpm_scene *s, size_t grain, core_error *err)
         s->eps_p[p] = eps;
     }
     return CORE_OK;
+}
+
+static void bounds(const mpm_grain_def *g, double lo[2], double hi[2])
+{
+    for (int a = 0; a < 2; a++) {
+        lo[a] = g->shape == MPM_DISK ? g->center[a] - g->radius : g->lo[a];
+        hi[a] = g->shape == MPM_DISK ? g->center[a] + g->radius : g->hi[a];
+    }
+}
+
+double mpm_grain_overlap(const mpm_scene *s, size_t id, size_t *other)
+{
+    double best = 0;
+    *other = 0;
+    if (id >= s->ngrains)
+        return 0;
+    const mpm_grain_def *a = &s->gdef[id];
+    for (size_t k = 0; k < id; k++) {
+        const mpm_grain_def *b = &s->gdef[k];
+        double depth;
+        if (a->shape == MPM_DISK && b->shape == MPM_DISK) {
+            double d2 = 0;
+            for (int ax = 0; ax < 2; ax++) {
+                double d = a->center[ax] - b->center[ax];
+                if (s->def.periodic[ax])
+                    d -= s->def.size[ax] * floor(d / s->def.size[ax] + 0.5);
+                d2 += d * d;
+            }
+            depth = a->radius + b->radius - sqrt(d2);
+        } else {
+            double alo[2], ahi[2], blo[2], bhi[2];
+            bounds(a, alo, ahi);
+            bounds(b, blo, bhi);
+            depth = INFINITY;
+            for (int ax = 0; ax < 2; ax++) {
+                double shift = 0;
+                if (s->def.periodic[ax]) {
+                    double L = s->def.size[ax], d = 0.5 * (alo[ax] + ahi[ax] - blo[ax] - bhi[ax]);
+                    shift = L * floor(d / L + 0.5);
+                }
+                double w = fmin(ahi[ax], bhi[ax] + shift) - fmax(alo[ax], blo[ax] + shift);
+                depth = fmin(depth, w);
+            }
+        }
+        if (depth > best) {
+            best = depth;
+            *other = k;
+        }
+    }
+    return best;
 }

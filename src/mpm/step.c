@@ -484,7 +484,7 @@ static void contact_correct(mpm_scene *s, double *vx, double *vy, bool decide, d
         dp[nn + i] += s->nm[e] * cy;
         dp[2 * nn + i] += s->nm[e];
     }
-    if (!any)
+    if (!any || !s->opt.conserve)
         return;
     for (size_t q = 0; q < s->npairs; q++) {
         const int i = s->pnode[q];

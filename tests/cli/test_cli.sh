@@ -96,6 +96,15 @@ for pct in " 10%" " 50%" " 90%"; do has "$err" "sweep: $pct" progress-lines; don
 has "$err" "sweep: done, 50 cases in" progress-lines; lines "$err" 10 progress-lines
 run "$G" --quiet progress.lua </dev/null; expect_rc 0 progress-quiet; [ -z "$err" ] && ok || bad "progress-quiet: stderr not empty"
 
+# --- warnings go to stderr and do not stop the script ---
+run "$G" -e 'local m = mpm.scene{ cells = { 10, 10 }, size = { 1, 1 } }
+local mt = mpm.material{ density = 1, shear = 1, bulk = 1 }
+m:add_disk{ center = { 0.4, 0.5 }, radius = 0.2, material = mt }
+m:add_disk{ center = { 0.7, 0.5 }, radius = 0.2, material = mt }
+print("added", m:info().grains)' </dev/null
+expect_rc 0 mpm-overlap; has "$out" "added	2" mpm-overlap
+has "$err" "grainlab: warning: add_disk: grain 2 overlaps grain 1 by 0.1 m" mpm-overlap
+
 # --- Ctrl-C (SIGINT) stops a running script with an error naming it ---
 "$G" -e 'while true do end' </dev/null >"$tmp/out" 2>"$tmp/err" &
 pid=$!
