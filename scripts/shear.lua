@@ -41,77 +41,11 @@ local n_grains = math.max(6, math.floor(369 * scale * scale + 0.5))
 local d_mean, d_min, d_max = 57e-6, 31e-6, 250e-6
 
 -- ---- packing -------------------------------------------------------------------------------
-local rng = grainlab.rng{ seed = seed }
-local d = {}
-for i = 1, n_grains do
-  local x
-  repeat x = d_min - 26e-6 * math.log(1 - rng:uniform()) until x <= math.min(d_max, 0.45 * L)
-  d[i] = x
-end
-do -- rescale the excess over d_min to make the mean exactly d_mean
-  local mean = 0
-  for i = 1, n_grains do mean = mean + d[i] / n_grains end
-  local k = (d_mean - d_min) / (mean - d_min)
-  for i = 1, n_grains do d[i] = math.min(d_min + k * (d[i] - d_min), 0.45 * L) end
-end
-table.sort(d, function(a, b) return a > b end)
-local r, x, y = {}, {}, {}
-local function dy_min(a, b) local t = a - b; return t - L * math.floor(t / L + 0.5) end
--- random placement, largest first, in a slab W0 = 1.8 L wide (periodic in y)
-local W0 = 1.8 * L
-for i = 1, n_grains do
-  r[i] = 0.5 * d[i]
-  local ok, tries = false, 0
-  repeat
-    tries = tries + 1
-    x[i], y[i] = r[i] + (W0 - 2 * r[i]) * rng:uniform(), L * rng:uniform()
-    ok = true
-    for j = 1, i - 1 do
-      local ex, ey = x[i] - x[j], dy_min(y[i], y[j])
-      if ex * ex + ey * ey < (r[i] + r[j]) ^ 2 then ok = false; break end
-    end
-  until ok or tries > 100000
-  assert(ok, "shear: could not place the grains; use a larger scale")
-end
--- DEM compaction: frictionless soft disks, the right wall pushed in from W0 to L, then settled
--- with drag; the packing is periodic in y like the MPM domain.
 local t_pack = os.clock()
-do
-  local soft = grainlab.material{ density = 1900, young = 2e8, poisson = 0.3, friction = 0, restitution = 0.3 }
-  local ds = dem.scene{ box = { { -0.1 * L, 0 }, { W0 + 0.1 * L, L } }, gravity = { 0, 0 },
-                        periodic = { false, true } }
-  ds:contact{ normal = "hertz", damping = "viscous" }
-  ds:add_wall{ point = { 0, 0 }, normal = { 1, 0 } }
-  local right = ds:add_wall{ point = { W0, 0 }, normal = { -1, 0 } }
-  for i = 1, n_grains do ds:add_disk{ pos = { x[i], y[i] }, radius = r[i], material = soft } end
-  local v_wall = 2
-  ds:wall_velocity(right, { -v_wall, 0 })
-  ds:drag(2e4)
-  ds:run{ time = (W0 - L) / v_wall }
-  ds:wall_velocity(right, { 0, 0 })
-  ds:run{ time = 2e-4 }
-  local P = ds:particles()
-  for i = 1, n_grains do x[i], y[i] = P.x[i], P.y[i] - L * math.floor(P.y[i] / L) end
-end
+local pk = grainlab.pack.slab{ size = L, n = n_grains, diameter = { d_min, d_mean, d_max }, seed = seed }
 t_pack = os.clock() - t_pack
--- remove what overlap the soft contacts left: shrink every radius by the largest relative overlap
-local worst = 0
-for i = 1, n_grains do
-  for j = i + 1, n_grains do
-    local ex, ey = x[i] - x[j], dy_min(y[i], y[j])
-    local ov = (r[i] + r[j]) - math.sqrt(ex * ex + ey * ey)
-    if ov > 0 then worst = math.max(worst, ov / (r[i] + r[j])) end
-  end
-end
-for i = 1, n_grains do r[i] = r[i] * (1 - worst - 1e-3) end
-local area, dsum = 0, 0
-for i = 1, n_grains do
-  local lo, hi = math.max(0, x[i] - r[i]), math.min(L, x[i] + r[i])
-  area = area + math.pi * r[i] ^ 2 * (hi - lo) / (2 * r[i]) -- approximate clipped share
-  dsum = dsum + 2 * r[i]
-end
-local phi = area / (L * L)
-local d_final = dsum / n_grains
+local x, y, r, phi, worst = pk.x, pk.y, pk.r, pk.area_fraction, pk.shrink
+local d_final = 2 * pk.mean_radius
 
 -- ---- MPM runs --------------------------------------------------------------------------------
 local hmx = mpm.material{ model = "vonmises", density = 1900, shear = 7.5e9, bulk = 11.4e9,

@@ -6,7 +6,9 @@
 --                         at the scene's real stiffness. In 3D, spheres are placed by random
 --                         addition and settled dynamically with softened contacts and drag, then
 --                         the stiffness is ramped back;
---   pack.settle(s, {…})   damps a packing into a quiescent state (critical background drag).
+--   pack.settle(s, {…})   damps a packing into a quiescent state (critical background drag);
+--   pack.slab{…}          a dense polydisperse disk packing of a square periodic in y, for MPM
+--                         grains (the shear test of Bardenhagen et al., Fig. 5); returns tables.
 local pack = {}
 
 local function fail(call, field, expected, got)
@@ -573,4 +575,82 @@ grainlab.doc(pack, { name = "grainlab.pack", doc = [[Packing generators (reprodu
     kept critical (slower and less robust for Hertz piles; kept for comparison).
     Returns {steps, time, drag, dt, t_peak, v_rms, v_max, z, z_no_rattlers (after the final
     steps), v_rms_settled, v_max_settled, z_settled (before them)}.]] })
+-- pack.slab{ size = L, n = 369, diameter = {d_min, d_mean, d_max}, seed = 5, width = 1.8 }
+-- Diameters d_min + an exponential of mean 26/57 d_mean (the shape of the paper's HMX sizes),
+-- truncated at min(d_max, 0.45 L) and rescaled so the mean is exactly d_mean; placed at random,
+-- largest first, in a slab width x L wide (periodic in y); compacted with the DEM module
+-- (frictionless soft Hertz disks with drag, the right wall pushed in to x = L); then every radius
+-- shrinks by the largest relative overlap left, so no two disks overlap. Returns {x, y, r,
+-- area_fraction (of the L x L square), shrink, mean_radius}.
+function pack.slab(opts)
+  check_opts("slab", opts, { size = true, n = true, diameter = true, seed = true, width = true })
+  local L = opts.size
+  if type(L) ~= "number" or not (L > 0) then fail("slab", "size", "positive number", L) end
+  local n = positive_int("slab", opts, "n", 369)
+  local dd = opts.diameter or { 31e-6, 57e-6, 250e-6 }
+  if type(dd) ~= "table" or #dd ~= 3 or not (dd[1] > 0 and dd[1] < dd[2] and dd[2] < dd[3]) then
+    fail("slab", "diameter", "{d_min, d_mean, d_max} with 0 < d_min < d_mean < d_max", dd)
+  end
+  local d_min, d_mean, d_max = dd[1], dd[2], math.min(dd[3], 0.45 * L)
+  local W0 = opts.width or 1.8
+  if type(W0) ~= "number" or not (W0 > 1) then fail("slab", "width", "number > 1", W0) end
+  W0 = W0 * L
+  local rng = grainlab.rng{ seed = opts.seed or 5 }
+  local d = {}
+  for i = 1, n do
+    local v
+    repeat v = d_min - (d_mean - d_min) * math.log(1 - rng:uniform()) until v <= d_max
+    d[i] = v
+  end
+  local mean = 0
+  for i = 1, n do mean = mean + d[i] / n end
+  local k = (d_mean - d_min) / (mean - d_min)
+  for i = 1, n do d[i] = math.min(d_min + k * (d[i] - d_min), d_max) end
+  table.sort(d, function(a, b) return a > b end)
+  local function dy_min(a, b) local t = a - b; return t - L * math.floor(t / L + 0.5) end
+  local x, y, r = {}, {}, {}
+  for i = 1, n do
+    r[i] = 0.5 * d[i]
+    local ok, tries = false, 0
+    repeat
+      tries = tries + 1
+      x[i], y[i] = r[i] + (W0 - 2 * r[i]) * rng:uniform(), L * rng:uniform()
+      ok = true
+      for j = 1, i - 1 do
+        local ex, ey = x[i] - x[j], dy_min(y[i], y[j])
+        if ex * ex + ey * ey < (r[i] + r[j]) ^ 2 then ok = false; break end
+      end
+    until ok or tries > 100000
+    if not ok then error("slab: no room for the disks in the initial slab; use fewer or smaller disks", 2) end
+  end
+  local soft = grainlab.material{ density = 1900, young = 2e8, poisson = 0.3, friction = 0, restitution = 0.3 }
+  local ds = dem.scene{ box = { { -0.1 * L, 0 }, { W0 + 0.1 * L, L } }, gravity = { 0, 0 }, periodic = { false, true } }
+  ds:contact{ normal = "hertz", damping = "viscous" }
+  ds:add_wall{ point = { 0, 0 }, normal = { 1, 0 } }
+  local right = ds:add_wall{ point = { W0, 0 }, normal = { -1, 0 } }
+  for i = 1, n do ds:add_disk{ pos = { x[i], y[i] }, radius = r[i], material = soft } end
+  local v_wall = 2
+  ds:wall_velocity(right, { -v_wall, 0 })
+  ds:drag(2e4)
+  ds:run{ time = (W0 - L) / v_wall }
+  ds:wall_velocity(right, { 0, 0 })
+  ds:run{ time = 2e-4 }
+  local P = ds:particles()
+  for i = 1, n do x[i], y[i] = P.x[i], P.y[i] - L * math.floor(P.y[i] / L) end
+  local worst = 0
+  for i = 1, n do
+    for j = i + 1, n do
+      local ex, ey = x[i] - x[j], dy_min(y[i], y[j])
+      local ov = (r[i] + r[j]) - math.sqrt(ex * ex + ey * ey)
+      if ov > 0 then worst = math.max(worst, ov / (r[i] + r[j])) end
+    end
+  end
+  local area, rsum = 0, 0
+  for i = 1, n do
+    r[i] = r[i] * (1 - worst - 1e-3)
+    area, rsum = area + math.pi * r[i] ^ 2, rsum + r[i]
+  end
+  return { x = x, y = y, r = r, area_fraction = area / (L * L), shrink = worst + 1e-3, mean_radius = rsum / n }
+end
+
 return pack

@@ -194,8 +194,6 @@ static void to_grid(mpm_scene *s)
             s->nfy[i] += w[k] * m * gy0 - (sxy * gx[k] + syy * gy[k]);
         }
     }
-    if (s->nmx)
-        moments(s);
 }
 
 /* The wall rule of plane pl on one nodal velocity, relative to the wall's velocity. For a
@@ -294,28 +292,28 @@ static void apply_walls_pairs(mpm_scene *s, double *vx, double *vy, bool decide)
     }
 }
 
-/* The sparse per-grain nodal fields of the frictional contact. One entry per (grain, node) pair
- * that a grain's points touch, found grain by grain (points are stored grain by grain) with a
- * per-node scratch mark that is reset after each grain: the cost is linear in the points, and no
- * grains x nodes array exists. Entry nnodes + q of the nodal arrays holds the grain's mass
- * (Eq. 16), momentum (Eq. 5) and force (Eq. 7) over its own points, and its nodal volume
- * sum_p N_ip V_p. pnx, pny hold sum_p m_p grad N_i(x_p) over the grain, minus the gradient of
- * its mass field at the node (it points out of the grain), and tgx, tgy the same over all grains;
- * with normals from quadratic B-splines (Eq. 24) and linear transfers, a second pass adds the
- * B-spline gradients of each grain's points to the pairs it already has (the 9-node support). A
- * point moves with its grain's field at nodes shared by two or more grains and with the
- * centre-of-mass node elsewhere, so an isolated grain evolves exactly as with noslip. */
+/* The sparse per-grain nodal fields of the frictional contact, and from them the centre-of-mass
+ * field. One entry per (grain, node) pair that a grain's points touch, found grain by grain
+ * (points are stored grain by grain) with a per-node scratch mark that is reset after each grain:
+ * the cost is linear in the points, and no grains x nodes array exists. Entry nnodes + q of the
+ * nodal arrays holds the grain's mass (Eq. 16), momentum (Eq. 5) and force (Eq. 7) over its own
+ * points; the centre-of-mass entries are their sums (Eqs. 5-7 over all points), so no separate
+ * transfer is needed. pnx, pny hold the gradient of the grain's mass field at the node, outward:
+ * sum_p m_p grad N_i(x_p) over the grain, with the transfer's shape functions or (normals
+ * 'averaged' and 'own' with linear transfers) with quadratic B-splines (Eq. 24) in a second pass
+ * that visits only the points within reach of a shared node. tgx, tgy at a shared node: the sum
+ * of its grains' gradients, so that 2 g - g_all of two grains are exactly opposite. A point moves
+ * with its grain's field at nodes shared by two or more grains and with the centre-of-mass node
+ * elsewhere, so an isolated grain evolves exactly as with noslip. */
 static void grain_fields(mpm_scene *s)
 {
     const size_t nn = s->nnodes;
     const int ns = s->ns;
     const double gx0 = s->def.gravity[0], gy0 = s->def.gravity[1];
     const bool spline_normals = s->opt.normals != MPM_NORMALS_LINEAR && ns != 9;
+    const bool volumes = s->opt.separation > 0;
     const double ox = s->def.origin[0], oy = s->def.origin[1];
     memset(s->ngr, 0, nn * sizeof(int));
-    memset(s->tgx, 0, nn * sizeof(double));
-    memset(s->tgy, 0, nn * sizeof(double));
-    memset(s->tvol, 0, nn * sizeof(double));
     size_t q = 0;
     for (size_t g = 0; g < s->ngrains; g++) {
         const size_t p0 = s->gstart[g], p1 = p0 + s->gcount[g], q0 = q;
@@ -323,8 +321,10 @@ static void grain_fields(mpm_scene *s)
             const double m = s->m[p], px = m * s->vx[p], py = m * s->vy[p];
             const double V = s->v0[p] * (s->F[0][p] * s->F[3][p] - s->F[1][p] * s->F[2][p]);
             const double sxx = V * s->sig[0][p], syy = V * s->sig[1][p], sxy = V * s->sig[2][p];
+            const double fgx = m * gx0, fgy = m * gy0;
             const int *n = &s->sn[ns * p];
             const double *w = &s->sw[ns * p], *gx = &s->sgx[ns * p], *gy = &s->sgy[ns * p];
+            int *sv = &s->sv[ns * p];
             for (int k = 0; k < ns; k++) {
                 const int i = n[k];
                 int r = s->mark[i];
@@ -339,53 +339,104 @@ static void grain_fields(mpm_scene *s)
                     s->pnx[r] = s->pny[r] = s->pvol[r] = 0;
                 }
                 const size_t e = nn + (size_t)r;
-                s->nm[e] += w[k] * m;
-                s->npx[e] += w[k] * px;
-                s->npy[e] += w[k] * py;
-                s->nfx[e] += w[k] * m * gx0 - (sxx * gx[k] + sxy * gy[k]);
-                s->nfy[e] += w[k] * m * gy0 - (sxy * gx[k] + syy * gy[k]);
-                s->pvol[r] += w[k] * V;
-                s->tvol[i] += w[k] * V;
+                const double wk = w[k];
+                s->nm[e] += wk * m;
+                s->npx[e] += wk * px;
+                s->npy[e] += wk * py;
+                s->nfx[e] += wk * fgx - (sxx * gx[k] + sxy * gy[k]);
+                s->nfy[e] += wk * fgy - (sxy * gx[k] + syy * gy[k]);
+                if (volumes)
+                    s->pvol[r] += wk * V;
                 if (!spline_normals) {
                     s->pnx[r] += m * gx[k];
                     s->pny[r] += m * gy[k];
-                    s->tgx[i] += m * gx[k];
-                    s->tgy[i] += m * gy[k];
                 }
-                s->sv[ns * p + k] = (int)e;
+                sv[k] = (int)e;
             }
         }
-        if (spline_normals)
-            for (size_t p = p0; p < p1; p++) {
-                double wx[3], dx[3], wy[3], dy[3];
-                const int bi = bspline((s->x[p] - ox) * s->inv_hx, wx, dx);
-                const int bj = bspline((s->y[p] - oy) * s->inv_hy, wy, dy);
-                const double m = s->m[p];
-                for (int b = 0; b < 3; b++) {
-                    const int J = node_of(s, 1, bj + b);
-                    if (J < 0)
-                        continue;
-                    for (int a = 0; a < 3; a++) {
-                        const int I = node_of(s, 0, bi + a);
-                        if (I < 0)
-                            continue;
-                        const int i = J * s->nnx + I;
-                        const double ggx = m * dx[a] * wy[b] * s->inv_hx;
-                        const double ggy = m * wx[a] * dy[b] * s->inv_hy;
-                        s->tgx[i] += ggx;
-                        s->tgy[i] += ggy;
-                        const int r = s->mark[i];
-                        if (r >= 0) {
-                            s->pnx[r] += ggx;
-                            s->pny[r] += ggy;
-                        }
-                    }
-                }
-            }
         for (size_t r = q0; r < q; r++)
             s->mark[s->pnode[r]] = -1;
     }
     s->npairs = q;
+    /* the centre-of-mass field: sums over the pairs */
+    memset(s->nm, 0, nn * sizeof(double));
+    memset(s->npx, 0, nn * sizeof(double));
+    memset(s->npy, 0, nn * sizeof(double));
+    memset(s->nfx, 0, nn * sizeof(double));
+    memset(s->nfy, 0, nn * sizeof(double));
+    for (size_t r = 0; r < q; r++) {
+        const int i = s->pnode[r];
+        const size_t e = nn + r;
+        s->nm[i] += s->nm[e];
+        s->npx[i] += s->npx[e];
+        s->npy[i] += s->npy[e];
+        s->nfx[i] += s->nfx[e];
+        s->nfy[i] += s->nfy[e];
+    }
+    if (spline_normals) {
+        /* Eq. 24 with linear transfers: each grain's B-spline mass gradient at its shared pairs,
+         * from the points whose 3 x 3 B-spline nodes include one of them. */
+        for (size_t g = 0, r0 = 0; g < s->ngrains; g++) {
+            const size_t p0 = s->gstart[g], p1 = p0 + s->gcount[g];
+            size_t r1 = r0;
+            bool shared = false;
+            while (r1 < q && s->pgrain[r1] == (int)g) {
+                if (s->ngr[s->pnode[r1]] > 1) {
+                    s->mark[s->pnode[r1]] = (int)r1;
+                    shared = true;
+                }
+                r1++;
+            }
+            if (shared)
+                for (size_t p = p0; p < p1; p++) {
+                    double wx[3], dx[3], wy[3], dy[3];
+                    const int bi = bspline((s->x[p] - ox) * s->inv_hx, wx, dx);
+                    const int bj = bspline((s->y[p] - oy) * s->inv_hy, wy, dy);
+                    int I[3], J[3];
+                    bool any = false;
+                    for (int a = 0; a < 3; a++) {
+                        I[a] = node_of(s, 0, bi + a);
+                        J[a] = node_of(s, 1, bj + a);
+                    }
+                    for (int b = 0; b < 3 && !any; b++)
+                        for (int a = 0; a < 3 && !any; a++)
+                            any = I[a] >= 0 && J[b] >= 0 && s->mark[J[b] * s->nnx + I[a]] >= 0;
+                    if (!any)
+                        continue;
+                    const double m = s->m[p];
+                    for (int b = 0; b < 3; b++) {
+                        if (J[b] < 0)
+                            continue;
+                        for (int a = 0; a < 3; a++) {
+                            if (I[a] < 0)
+                                continue;
+                            const int r = s->mark[J[b] * s->nnx + I[a]];
+                            if (r >= 0) {
+                                s->pnx[r] += m * dx[a] * wy[b] * s->inv_hx;
+                                s->pny[r] += m * wx[a] * dy[b] * s->inv_hy;
+                            }
+                        }
+                    }
+                }
+            for (size_t r = r0; r < r1; r++)
+                s->mark[s->pnode[r]] = -1;
+            r0 = r1;
+        }
+    }
+    /* at shared nodes: the sum of the grains' gradients and nodal volumes */
+    for (size_t r = 0; r < q; r++) {
+        const int i = s->pnode[r];
+        if (s->ngr[i] > 1)
+            s->tgx[i] = s->tgy[i] = s->tvol[i] = 0;
+    }
+    for (size_t r = 0; r < q; r++) {
+        const int i = s->pnode[r];
+        if (s->ngr[i] > 1) {
+            s->tgx[i] += s->pnx[r];
+            s->tgy[i] += s->pny[r];
+            s->tvol[i] += s->pvol[r];
+        }
+    }
     for (size_t e = 0; e < (size_t)ns * s->np; e++)
         if (s->ngr[s->sn[e]] < 2)
             s->sv[e] = s->sn[e];
@@ -719,9 +770,12 @@ core_status mpm_run(mpm_scene *s, const mpm_run_def *run, long *done, core_error
             dt = run->time_end - s->time;
         stencil(s);
         mark_forced(s);
-        to_grid(s);
         if (friction)
-            grain_fields(s);
+            grain_fields(s); /* the centre-of-mass field too */
+        else
+            to_grid(s);
+        if (s->nmx)
+            moments(s);
         grid_update(s, dt);
         if (friction)
             contact_update(s, dt);

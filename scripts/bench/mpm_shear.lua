@@ -1,0 +1,75 @@
+-- Benchmark: the full MPM shear problem of Bardenhagen, Brackbill & Sulsky (1998), Sec. 4 (issue 5,
+-- "Performance"): 369 HMX grains packed by grainlab.pack.slab (area fraction ~0.82, ~74,000
+-- points at 4 per cell), 150 x 150 cells over 1.2 mm, periodic in y, frictional contact mu = 0.3,
+-- edge grains fixed / moved up at 100 m/s. The time step is fixed so that 80% shear takes 25,124
+-- cycles as in the paper (dt = 9.6 us / 25,124 = 3.82e-10 s, Courant number ~0.16; the paper
+-- needed about 30 h on a Cray YMP).
+-- Preparation (not timed): the packing and `warm` cycles (default 200) so that contacts exist.
+-- Then `cycles` cycles (default 400) are timed on 1 and 2 threads (or on `threads` only), each
+-- continuing the same run.
+--   grainlab scripts/bench/mpm_shear.lua [cycles=400] [warm=200] [threads=N] [model=friction|noslip]
+--   valgrind --tool=callgrind --instr-atstart=no grainlab scripts/bench/mpm_shear.lua \
+--       cycles=20 warm=20 threads=1 callgrind=true   (instructions per particle-step)
+-- Metrics: particle_steps_per_s (per thread count), wall_s, projected_full_run_s (25,124 cycles at
+-- the measured rate of the last thread count), points, grains.
+local cycles = math.tointeger(params.cycles or 400)
+local warm = math.tointeger(params.warm or 200)
+local model = params.model or "friction"
+local callgrind = params.callgrind == true
+local L, v, cells = 1.2e-3, 100, 150
+local full_cycles = 25124
+local dt = 0.8 * L / v / full_cycles
+
+local t0 = grainlab.clock()
+local pk = grainlab.pack.slab{ size = L, n = 369, diameter = { 31e-6, 57e-6, 250e-6 }, seed = 5 }
+local hmx = mpm.material{ model = "vonmises", density = 1900, shear = 7.5e9, bulk = 11.4e9, yield = 0.3e9,
+                          hardening = 0.01e9 }
+local m = mpm.scene{ cells = { cells, cells }, size = { L, L }, periodic = { false, true },
+                     walls = { left = "noslip", right = { kind = "noslip", velocity = { 0, v } } } }
+local h = L / cells
+for i = 1, #pk.x do
+  local g = m:add_disk{ center = { pk.x[i], pk.y[i] }, radius = pk.r[i], material = hmx, points_per_cell = 2, clip = true }
+  if pk.x[i] - pk.r[i] < h then m:prescribe(g, { 0, 0 }) elseif pk.x[i] + pk.r[i] > L - h then m:prescribe(g, { 0, v }) end
+end
+if model == "friction" then m:contact{ model = "friction", mu = 0.3 } end
+local np = m:info().points
+grainlab.threads(params.prep_threads or 1)
+m:run{ steps = warm, dt = dt, progress = false }
+local t_prep = grainlab.clock() - t0
+
+local function timed(threads)
+  grainlab.threads(threads)
+  if callgrind then os.execute("callgrind_control -i on >/dev/null") end
+  local w0 = grainlab.clock()
+  m:run{ steps = cycles, dt = dt, progress = false }
+  local wall = grainlab.clock() - w0
+  if callgrind then os.execute("callgrind_control -i off >/dev/null") end
+  return np * cycles / wall, wall
+end
+
+local metrics = { points = np, grains = #pk.x, area_fraction = pk.area_fraction, dt_s = dt, cycles = cycles,
+                  warm_cycles = warm, prepare_s = t_prep }
+local list = params.threads and { params.threads } or { 1, 2 }
+local total = 0
+for _, th in ipairs(list) do
+  local rate, wall = timed(th)
+  metrics["particle_steps_per_s_" .. th .. "_threads"] = rate
+  metrics["wall_s_" .. th .. "_threads"] = wall
+  metrics["projected_full_run_s_" .. th .. "_threads"] = wall / cycles * full_cycles
+  total = total + wall
+end
+local last = list[#list]
+metrics.particle_steps_per_s = metrics["particle_steps_per_s_" .. last .. "_threads"]
+metrics.projected_full_run_s = metrics["projected_full_run_s_" .. last .. "_threads"]
+metrics.wall_s = total
+
+local e = m:measure("energy")
+grainlab.report{
+  scenario = "bench_mpm_shear",
+  params = { cycles = cycles, warm = warm, threads = params.threads or "1,2", model = model, cells = cells },
+  metrics = metrics,
+  checks = {
+    { name = "finite_energy", pass = e.total == e.total and e.total < math.huge },
+    { name = "projected_full_run_under_5_min", value = metrics.projected_full_run_s, limit = 300 },
+  },
+}
