@@ -94,6 +94,15 @@ struct mpm_scene {
     size_t *gstart, *gcount;
     mpm_grain_def *gdef;    /* each grain's shape, for the overlap warning */
 
+    /* threads: nt contiguous point ranges [tp[t], tp[t+1]) aligned to grains (tg[t] the first
+     * grain of range t), so that a grain's points, its per-grain field entries and the nodes
+     * only it touches belong to one thread; per-thread scratch: marks (nt x nnodes) and the
+     * noslip transfer's node buffers (nt - 1 x 5 x nnodes) */
+    int nt, ntcap;
+    size_t *tp, *tg, *tq, *tc;
+    int *tmark;
+    double *tbuf;
+
     mpm_contact_model contact;
     double time;
     long steps;

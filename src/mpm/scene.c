@@ -228,6 +228,12 @@ void mpm_destroy(mpm_scene *s)
     free(s->gstart);
     free(s->gcount);
     free(s->gdef);
+    free(s->tp);
+    free(s->tg);
+    free(s->tq);
+    free(s->tc);
+    free(s->tmark);
+    free(s->tbuf);
     free(s);
 }
 

@@ -6,8 +6,80 @@
 #include <math.h>
 #include <string.h>
 
+#include <stdlib.h>
+
 #include "core/interrupt.h"
+#include "core/threads.h"
 #include "mpm/mpm_internal.h"
+
+#ifdef GRAINLAB_HAVE_OPENMP
+#include <omp.h>
+#define THREAD_ID() omp_get_thread_num()
+#else
+#define THREAD_ID() 0
+#endif
+
+/* Threads: every parallel region runs s->nt threads, thread t on points [tp[t], tp[t+1]). The
+ * ranges and all reductions are fixed for a thread count, so results are the same bits run
+ * after run (and differ from another thread count only by summation order). */
+static core_status threads_setup(mpm_scene *s, core_error *err)
+{
+    int nt = threads_get();
+    if (s->np < 8192)
+        nt = 1;
+    if (nt > 64)
+        nt = 64;
+    if (nt > (int)s->ngrains)
+        nt = (int)s->ngrains;
+    if (nt < 1)
+        nt = 1;
+    if (nt > s->ntcap || !s->tp) {
+        size_t *a = realloc(s->tp, (size_t)(nt + 1) * sizeof *a);
+        if (!a)
+            return core_fail(err, CORE_ERR_NOMEM, "out of memory for %d threads", nt);
+        s->tp = a;
+        size_t *b = realloc(s->tg, (size_t)(nt + 1) * sizeof *b);
+        if (!b)
+            return core_fail(err, CORE_ERR_NOMEM, "out of memory for %d threads", nt);
+        s->tg = b;
+        size_t *c = realloc(s->tq, (size_t)(nt + 1) * sizeof *c);
+        if (!c)
+            return core_fail(err, CORE_ERR_NOMEM, "out of memory for %d threads", nt);
+        s->tq = c;
+        size_t *d = realloc(s->tc, (size_t)(nt + 1) * sizeof *d);
+        if (!d)
+            return core_fail(err, CORE_ERR_NOMEM, "out of memory for %d threads", nt);
+        s->tc = d;
+        free(s->tmark);
+        free(s->tbuf);
+        s->tmark = malloc((size_t)nt * s->nnodes * sizeof *s->tmark);
+        s->tbuf = nt > 1 ? malloc((size_t)(nt - 1) * 5 * s->nnodes * sizeof *s->tbuf) : NULL;
+        if (!s->tmark || (nt > 1 && !s->tbuf))
+            return core_fail(err, CORE_ERR_NOMEM, "out of memory for %d threads", nt);
+        for (size_t i = 0; i < (size_t)nt * s->nnodes; i++)
+            s->tmark[i] = -1;
+        s->ntcap = nt;
+    }
+    s->nt = nt;
+    /* grain-aligned ranges with about np / nt points each */
+    s->tg[0] = 0;
+    s->tp[0] = 0;
+    size_t g = 0;
+    for (int t = 1; t < nt; t++) {
+        const size_t want = s->np * (size_t)t / (size_t)nt;
+        while (g < s->ngrains && s->gstart[g] + s->gcount[g] <= want)
+            g++;
+        if (g < s->ngrains && want - s->gstart[g] > s->gstart[g] + s->gcount[g] - want)
+            g++; /* the boundary nearer to the target */
+        if (g <= s->tg[t - 1])
+            g = s->tg[t - 1] + 1 < s->ngrains ? s->tg[t - 1] + 1 : s->ngrains;
+        s->tg[t] = g;
+        s->tp[t] = g < s->ngrains ? s->gstart[g] : s->np;
+    }
+    s->tg[nt] = s->ngrains;
+    s->tp[nt] = s->np;
+    return CORE_OK;
+}
 
 mpm_run_def mpm_default_run_def(void)
 {
@@ -17,6 +89,7 @@ mpm_run_def mpm_default_run_def(void)
 static double max_speed(const mpm_scene *s)
 {
     double v2 = 0;
+#pragma omp parallel for schedule(static) reduction(max : v2) if (s->np > 8192)
     for (size_t p = 0; p < s->np; p++) {
         double w = s->vx[p] * s->vx[p] + s->vy[p] * s->vy[p];
         if (w > v2)
@@ -73,12 +146,12 @@ static inline int bspline(double xi, double w[3], double d[3])
 /* Each point's nodes, weights N_i(x_p) and gradients G_pi (Eq. 8): linear tensor-product shape
  * functions (4 nodes) or quadratic B-splines (9). Points are inside the grid here (checked at the
  * end of every step). */
-static void stencil(mpm_scene *s)
+static void stencil(mpm_scene *s, size_t pa, size_t pb)
 {
     const double ox = s->def.origin[0], oy = s->def.origin[1];
     const int nx = s->def.cells[0], ny = s->def.cells[1], nnx = s->nnx, ns = s->ns;
     const double ihx = s->inv_hx, ihy = s->inv_hy;
-    for (size_t p = 0; p < s->np; p++) {
+    for (size_t p = pa; p < pb; p++) {
         const double xi = (s->x[p] - ox) * ihx, eta = (s->y[p] - oy) * ihy;
         int *n = &s->sn[ns * p];
         double *w = &s->sw[ns * p], *gx = &s->sgx[ns * p], *gy = &s->sgy[ns * p];
@@ -168,32 +241,64 @@ static void moments(mpm_scene *s)
 }
 
 /* Step 1: lumped mass (Eq. 6), momentum (Eq. 5), internal force (Eq. 7, m_p / rho_p = V_p) and
- * gravity m_i g. */
-static void to_grid(mpm_scene *s)
+ * gravity m_i g, for points [pa, pb) into the five nodal arrays f[0..4] (mass, momentum x, y,
+ * force x, y). */
+static void to_grid_range(const mpm_scene *s, size_t pa, size_t pb, double *const f[5])
 {
-    const size_t nn = s->nnodes;
-    memset(s->nm, 0, nn * sizeof(double));
-    memset(s->npx, 0, nn * sizeof(double));
-    memset(s->npy, 0, nn * sizeof(double));
-    memset(s->nfx, 0, nn * sizeof(double));
-    memset(s->nfy, 0, nn * sizeof(double));
+    double *nm = f[0], *npx = f[1], *npy = f[2], *nfx = f[3], *nfy = f[4];
     const double gx0 = s->def.gravity[0], gy0 = s->def.gravity[1];
     const int ns = s->ns;
-    for (size_t p = 0; p < s->np; p++) {
+    for (size_t p = pa; p < pb; p++) {
         const double m = s->m[p], px = m * s->vx[p], py = m * s->vy[p];
         const double V = s->v0[p] * (s->F[0][p] * s->F[3][p] - s->F[1][p] * s->F[2][p]);
         const double sxx = V * s->sig[0][p], syy = V * s->sig[1][p], sxy = V * s->sig[2][p];
+        const double fgx = m * gx0, fgy = m * gy0;
         const int *n = &s->sn[ns * p];
         const double *w = &s->sw[ns * p], *gx = &s->sgx[ns * p], *gy = &s->sgy[ns * p];
         for (int k = 0; k < ns; k++) {
             const int i = n[k];
-            s->nm[i] += w[k] * m;
-            s->npx[i] += w[k] * px;
-            s->npy[i] += w[k] * py;
-            s->nfx[i] += w[k] * m * gx0 - (sxx * gx[k] + sxy * gy[k]);
-            s->nfy[i] += w[k] * m * gy0 - (sxy * gx[k] + syy * gy[k]);
+            nm[i] += w[k] * m;
+            npx[i] += w[k] * px;
+            npy[i] += w[k] * py;
+            nfx[i] += w[k] * fgx - (sxx * gx[k] + sxy * gy[k]);
+            nfy[i] += w[k] * fgy - (sxy * gx[k] + syy * gy[k]);
         }
     }
+}
+
+/* The nodal arrays of thread t: the scene's for t = 0, else its buffer (n arrays of nn). */
+static void thread_arrays(mpm_scene *s, int t, double *const main[], int n, double *out[])
+{
+    for (int k = 0; k < n; k++)
+        out[k] = t == 0 ? main[k] : s->tbuf + ((size_t)(t - 1) * 5 + (size_t)k) * s->nnodes;
+}
+
+/* Adds the threads' buffers to the nodal arrays, in thread order (inside the parallel region,
+ * after every thread has scattered). */
+static void reduce_buffers(mpm_scene *s, double *const main[], int n)
+{
+    if (s->nt == 1)
+        return;
+    const size_t nn = s->nnodes;
+#pragma omp barrier
+#pragma omp for schedule(static)
+    for (size_t i = 0; i < nn; i++)
+        for (int u = 1; u < s->nt; u++)
+            for (int k = 0; k < n; k++)
+                main[k][i] += s->tbuf[((size_t)(u - 1) * 5 + (size_t)k) * nn + i];
+}
+
+/* The centre-of-mass transfer (noslip), inside the parallel region: each thread scatters its
+ * points into its own arrays, then they are added up. */
+static void to_grid(mpm_scene *s, int t)
+{
+    double *const main[5] = {s->nm, s->npx, s->npy, s->nfx, s->nfy};
+    double *f[5];
+    thread_arrays(s, t, main, 5, f);
+    for (int k = 0; k < 5; k++)
+        memset(f[k], 0, s->nnodes * sizeof(double));
+    to_grid_range(s, s->tp[t], s->tp[t + 1], f);
+    reduce_buffers(s, main, 5);
 }
 
 /* The wall rule of plane pl on one nodal velocity, relative to the wall's velocity. For a
@@ -254,6 +359,7 @@ static inline bool near_plane(const mpm_scene *s, int k, size_t i)
  * at the nodes they touch. */
 static void apply_walls(mpm_scene *s, double *vx, double *vy, bool decide)
 {
+#pragma omp for schedule(static)
     for (size_t i = 0; i < s->nnodes; i++) {
         const unsigned char w = s->nwall[i];
         if (w)
@@ -273,6 +379,7 @@ static void apply_walls(mpm_scene *s, double *vx, double *vy, bool decide)
 static void apply_walls_pairs(mpm_scene *s, double *vx, double *vy, bool decide)
 {
     const size_t nn = s->nnodes;
+#pragma omp for schedule(static)
     for (size_t q = 0; q < s->npairs; q++) {
         const int i = s->pnode[q];
         if (s->ngr[i] < 2)
@@ -305,7 +412,24 @@ static void apply_walls_pairs(mpm_scene *s, double *vx, double *vy, bool decide)
  * of its grains' gradients, so that 2 g - g_all of two grains are exactly opposite. A point moves
  * with its grain's field at nodes shared by two or more grains and with the centre-of-mass node
  * elsewhere, so an isolated grain evolves exactly as with noslip. */
-static void grain_fields(mpm_scene *s)
+static void move_pairs(mpm_scene *s, size_t to, size_t from, size_t n)
+{
+    if (to == from || n == 0)
+        return;
+    const size_t nn = s->nnodes;
+    double *node[5] = {s->nm, s->npx, s->npy, s->nfx, s->nfy};
+    for (int k = 0; k < 5; k++)
+        memmove(node[k] + nn + to, node[k] + nn + from, n * sizeof(double));
+    double *pair[3] = {s->pnx, s->pny, s->pvol};
+    for (int k = 0; k < 3; k++)
+        memmove(pair[k] + to, pair[k] + from, n * sizeof(double));
+    memmove(s->pnode + to, s->pnode + from, n * sizeof(int));
+    memmove(s->pgrain + to, s->pgrain + from, n * sizeof(int));
+}
+
+/* Inside the parallel region; thread t takes its grains. Their pairs are first written from
+ * ns * tp[t] (a grain has at most ns pairs per point), then packed in thread order. */
+static void grain_fields(mpm_scene *s, int t)
 {
     const size_t nn = s->nnodes;
     const int ns = s->ns;
@@ -313,9 +437,10 @@ static void grain_fields(mpm_scene *s)
     const bool spline_normals = s->opt.normals != MPM_NORMALS_LINEAR && ns != 9;
     const bool volumes = s->opt.separation > 0;
     const double ox = s->def.origin[0], oy = s->def.origin[1];
-    memset(s->ngr, 0, nn * sizeof(int));
-    size_t q = 0;
-    for (size_t g = 0; g < s->ngrains; g++) {
+    int *mark = s->tmark + (size_t)t * nn;
+    const size_t base = (size_t)ns * s->tp[t];
+    size_t q = base;
+    for (size_t g = s->tg[t]; g < s->tg[t + 1]; g++) {
         const size_t p0 = s->gstart[g], p1 = p0 + s->gcount[g], q0 = q;
         for (size_t p = p0; p < p1; p++) {
             const double m = s->m[p], px = m * s->vx[p], py = m * s->vy[p];
@@ -327,13 +452,12 @@ static void grain_fields(mpm_scene *s)
             int *sv = &s->sv[ns * p];
             for (int k = 0; k < ns; k++) {
                 const int i = n[k];
-                int r = s->mark[i];
+                int r = mark[i];
                 if (r < 0) {
                     r = (int)q++;
-                    s->mark[i] = r;
+                    mark[i] = r;
                     s->pnode[r] = i;
                     s->pgrain[r] = (int)g;
-                    s->ngr[i]++;
                     const size_t e = nn + (size_t)r;
                     s->nm[e] = s->npx[e] = s->npy[e] = s->nfx[e] = s->nfy[e] = 0;
                     s->pnx[r] = s->pny[r] = s->pvol[r] = 0;
@@ -351,38 +475,57 @@ static void grain_fields(mpm_scene *s)
                     s->pnx[r] += m * gx[k];
                     s->pny[r] += m * gy[k];
                 }
-                sv[k] = (int)e;
+                sv[k] = r; /* the pair, renumbered after packing */
             }
         }
         for (size_t r = q0; r < q; r++)
-            s->mark[s->pnode[r]] = -1;
+            mark[s->pnode[r]] = -1;
     }
-    s->npairs = q;
-    /* the centre-of-mass field: sums over the pairs */
-    memset(s->nm, 0, nn * sizeof(double));
-    memset(s->npx, 0, nn * sizeof(double));
-    memset(s->npy, 0, nn * sizeof(double));
-    memset(s->nfx, 0, nn * sizeof(double));
-    memset(s->nfy, 0, nn * sizeof(double));
-    for (size_t r = 0; r < q; r++) {
-        const int i = s->pnode[r];
-        const size_t e = nn + r;
-        s->nm[i] += s->nm[e];
-        s->npx[i] += s->npx[e];
-        s->npy[i] += s->npy[e];
-        s->nfx[i] += s->nfx[e];
-        s->nfy[i] += s->nfy[e];
+    s->tc[t] = q - base;
+#pragma omp barrier
+#pragma omp master
+    {
+        /* pack the threads' pairs; count the grains at each node; the centre-of-mass field is
+         * the sum of the grain fields */
+        size_t off = 0;
+        for (int u = 0; u < s->nt; u++) {
+            s->tq[u] = off;
+            move_pairs(s, off, (size_t)ns * s->tp[u], s->tc[u]);
+            off += s->tc[u];
+        }
+        s->tq[s->nt] = off;
+        s->npairs = off;
+        memset(s->ngr, 0, nn * sizeof(int));
+        double *const node[5] = {s->nm, s->npx, s->npy, s->nfx, s->nfy};
+        for (int k = 0; k < 5; k++)
+            memset(node[k], 0, nn * sizeof(double));
+        for (size_t r = 0; r < off; r++) {
+            const int i = s->pnode[r];
+            s->ngr[i]++;
+            for (int k = 0; k < 5; k++)
+                node[k][i] += node[k][nn + r];
+        }
+    }
+#pragma omp barrier
+    /* each point's stencil: its grain's entry at shared nodes, the centre of mass elsewhere */
+    {
+        const long shift = (long)base - (long)s->tq[t];
+        for (size_t e = (size_t)ns * s->tp[t]; e < (size_t)ns * s->tp[t + 1]; e++) {
+            const int i = s->sn[e];
+            s->sv[e] = s->ngr[i] < 2 ? i : (int)(nn + (size_t)((long)s->sv[e] - shift));
+        }
     }
     if (spline_normals) {
         /* Eq. 24 with linear transfers: each grain's B-spline mass gradient at its shared pairs,
          * from the points whose 3 x 3 B-spline nodes include one of them. */
-        for (size_t g = 0, r0 = 0; g < s->ngrains; g++) {
+        size_t r0 = s->tq[t];
+        for (size_t g = s->tg[t]; g < s->tg[t + 1]; g++) {
             const size_t p0 = s->gstart[g], p1 = p0 + s->gcount[g];
             size_t r1 = r0;
             bool shared = false;
-            while (r1 < q && s->pgrain[r1] == (int)g) {
+            while (r1 < s->tq[t + 1] && s->pgrain[r1] == (int)g) {
                 if (s->ngr[s->pnode[r1]] > 1) {
-                    s->mark[s->pnode[r1]] = (int)r1;
+                    mark[s->pnode[r1]] = (int)r1;
                     shared = true;
                 }
                 r1++;
@@ -400,7 +543,7 @@ static void grain_fields(mpm_scene *s)
                     }
                     for (int b = 0; b < 3 && !any; b++)
                         for (int a = 0; a < 3 && !any; a++)
-                            any = I[a] >= 0 && J[b] >= 0 && s->mark[J[b] * s->nnx + I[a]] >= 0;
+                            any = I[a] >= 0 && J[b] >= 0 && mark[J[b] * s->nnx + I[a]] >= 0;
                     if (!any)
                         continue;
                     const double m = s->m[p];
@@ -410,7 +553,7 @@ static void grain_fields(mpm_scene *s)
                         for (int a = 0; a < 3; a++) {
                             if (I[a] < 0)
                                 continue;
-                            const int r = s->mark[J[b] * s->nnx + I[a]];
+                            const int r = mark[J[b] * s->nnx + I[a]];
                             if (r >= 0) {
                                 s->pnx[r] += m * dx[a] * wy[b] * s->inv_hx;
                                 s->pny[r] += m * wx[a] * dy[b] * s->inv_hy;
@@ -419,27 +562,29 @@ static void grain_fields(mpm_scene *s)
                     }
                 }
             for (size_t r = r0; r < r1; r++)
-                s->mark[s->pnode[r]] = -1;
+                mark[s->pnode[r]] = -1;
             r0 = r1;
         }
     }
-    /* at shared nodes: the sum of the grains' gradients and nodal volumes */
-    for (size_t r = 0; r < q; r++) {
-        const int i = s->pnode[r];
-        if (s->ngr[i] > 1)
-            s->tgx[i] = s->tgy[i] = s->tvol[i] = 0;
-    }
-    for (size_t r = 0; r < q; r++) {
-        const int i = s->pnode[r];
-        if (s->ngr[i] > 1) {
-            s->tgx[i] += s->pnx[r];
-            s->tgy[i] += s->pny[r];
-            s->tvol[i] += s->pvol[r];
+#pragma omp barrier
+#pragma omp master
+    {
+        /* at shared nodes: the sum of the grains' gradients and nodal volumes */
+        for (size_t r = 0; r < s->npairs; r++) {
+            const int i = s->pnode[r];
+            if (s->ngr[i] > 1)
+                s->tgx[i] = s->tgy[i] = s->tvol[i] = 0;
+        }
+        for (size_t r = 0; r < s->npairs; r++) {
+            const int i = s->pnode[r];
+            if (s->ngr[i] > 1) {
+                s->tgx[i] += s->pnx[r];
+                s->tgy[i] += s->pny[r];
+                s->tvol[i] += s->pvol[r];
+            }
         }
     }
-    for (size_t e = 0; e < (size_t)ns * s->np; e++)
-        if (s->ngr[s->sn[e]] < 2)
-            s->sv[e] = s->sn[e];
+#pragma omp barrier
 }
 
 /* Step 2: v_i^n from Eq. 5 and v_i^{n+1} from Eq. 9. v_i^n = p_i / m_i is a mass-weighted mean of
@@ -449,6 +594,7 @@ static void grain_fields(mpm_scene *s)
 static void grid_update(mpm_scene *s, double dt)
 {
     const double m_min = s->m_min;
+#pragma omp for schedule(static)
     for (size_t i = 0; i < s->nnodes; i++) {
         double m = s->nm[i];
         if (m > 0) {
@@ -557,6 +703,7 @@ static void contact_update(mpm_scene *s, double dt)
 {
     const size_t nn = s->nnodes;
     const double m_min = s->m_min;
+#pragma omp for schedule(static)
     for (size_t q = 0; q < s->npairs; q++) {
         const int i = s->pnode[q];
         if (s->ngr[i] < 2)
@@ -574,16 +721,18 @@ static void contact_update(mpm_scene *s, double dt)
         s->nay[e] = s->nvy[e] + k * s->nfy[e];
     }
     apply_walls_pairs(s, s->nax, s->nay, true);
+#pragma omp master
     contact_correct(s, s->nax, s->nay, true, dt);
+#pragma omp barrier
 }
 
-/* Step 3: positions (Eq. 10) and velocities (Eq. 11, blended with PIC); a prescribed grain's
- * points keep its velocity exactly. */
-static void to_points(mpm_scene *s, double dt)
+/* Step 3: positions (Eq. 10) and velocities (Eq. 11, blended with PIC) of thread t's points; a
+ * prescribed grain's points keep its velocity exactly. */
+static void to_points(mpm_scene *s, double dt, int t)
 {
     const double pic = s->def.pic, flip = 1 - pic;
     const int ns = s->ns;
-    for (size_t p = 0; p < s->np; p++) {
+    for (size_t p = s->tp[t]; p < s->tp[t + 1]; p++) {
         const int *n = &s->sf[ns * p];
         const double *w = &s->sw[ns * p];
         double dvx = 0, dvy = 0, ax = 0, ay = 0;
@@ -602,7 +751,7 @@ static void to_points(mpm_scene *s, double dt)
         s->vy[p] = flip * (s->vy[p] + dvy) + pic * ay;
     }
     if (s->npres)
-        for (size_t g = 0; g < s->ngrains; g++) {
+        for (size_t g = s->tg[t]; g < s->tg[t + 1]; g++) {
             const int k = s->gpres[g];
             if (k < 0)
                 continue;
@@ -614,30 +763,50 @@ static void to_points(mpm_scene *s, double dt)
 }
 
 /* MUSL: the updated point momenta mapped back (Eq. 5 with v_p^{n+1}) give the nodal velocities
- * the strain increment is taken from; with friction each grain's own field at shared nodes. */
-static void remap(mpm_scene *s, double dt)
+ * the strain increment is taken from; with friction each grain's own field at shared nodes.
+ * Inside the parallel region. With friction every entry a point feeds (its grain's pair, or a
+ * node only its grain touches) belongs to its thread; noslip scatters into thread buffers. */
+static void remap(mpm_scene *s, double dt, int t)
 {
-    const size_t nn = s->nnodes + s->npairs;
+    const size_t nn = s->nnodes, ne = s->nnodes + s->npairs;
     const int ns = s->ns;
-    memset(s->npx, 0, nn * sizeof(double));
-    memset(s->npy, 0, nn * sizeof(double));
-    for (size_t p = 0; p < s->np; p++) {
+    const bool friction = s->contact == MPM_CONTACT_FRICTION;
+    double *const main[2] = {s->npx, s->npy};
+    double *f[2] = {s->npx, s->npy};
+    if (friction) {
+#pragma omp for schedule(static)
+        for (size_t i = 0; i < ne; i++)
+            s->npx[i] = s->npy[i] = 0;
+    } else {
+        thread_arrays(s, t, main, 2, f);
+        memset(f[0], 0, nn * sizeof(double));
+        memset(f[1], 0, nn * sizeof(double));
+    }
+    for (size_t p = s->tp[t]; p < s->tp[t + 1]; p++) {
         const double px = s->m[p] * s->vx[p], py = s->m[p] * s->vy[p];
         const int *n = &s->sf[ns * p];
         const double *w = &s->sw[ns * p];
         for (int k = 0; k < ns; k++) {
-            s->npx[n[k]] += w[k] * px;
-            s->npy[n[k]] += w[k] * py;
+            f[0][n[k]] += w[k] * px;
+            f[1][n[k]] += w[k] * py;
         }
     }
-    /* At shared nodes the points fed their grains' entries; the centre-of-mass momentum is
-     * their sum. */
-    for (size_t q = 0; q < s->npairs; q++)
-        if (s->ngr[s->pnode[q]] > 1) {
-            s->npx[s->pnode[q]] += s->npx[s->nnodes + q];
-            s->npy[s->pnode[q]] += s->npy[s->nnodes + q];
-        }
-    for (size_t i = 0; i < nn; i++) {
+    if (friction) {
+#pragma omp barrier
+#pragma omp master
+        /* At shared nodes the points fed their grains' entries; the centre-of-mass momentum is
+         * their sum. */
+        for (size_t q = 0; q < s->npairs; q++)
+            if (s->ngr[s->pnode[q]] > 1) {
+                s->npx[s->pnode[q]] += s->npx[nn + q];
+                s->npy[s->pnode[q]] += s->npy[nn + q];
+            }
+#pragma omp barrier
+    } else {
+        reduce_buffers(s, main, 2);
+    }
+#pragma omp for schedule(static)
+    for (size_t i = 0; i < ne; i++) {
         double m = s->nm[i];
         s->nax[i] = m > 0 ? s->npx[i] / m : 0;
         s->nay[i] = m > 0 ? s->npy[i] / m : 0;
@@ -653,17 +822,19 @@ static void remap(mpm_scene *s, double dt)
          * correction: 1.64; remap correction re-deciding Eq. 12 on the remapped field (contact
          * switching on and off every other step): 1.58; the marks of the momentum update:
          * 1.03. */
+#pragma omp master
         contact_correct(s, s->nax, s->nay, false, dt);
+#pragma omp barrier
     }
 }
 
 /* Step 3, continued: velocity gradient L = sum_i v_i G_pi, F <- (I + dt L) F, stress update.
  * Returns the first point that inverts, or (size_t)-1. */
-static size_t constitutive(mpm_scene *s, double dt)
+static size_t constitutive(mpm_scene *s, double dt, int t)
 {
     size_t bad = (size_t)-1;
     const int ns = s->ns;
-    for (size_t p = 0; p < s->np; p++) {
+    for (size_t p = s->tp[t]; p < s->tp[t + 1]; p++) {
         const int *n = &s->sf[ns * p];
         const double *gx = &s->sgx[ns * p], *gy = &s->sgy[ns * p];
         double L[4] = {0, 0, 0, 0};
@@ -706,16 +877,20 @@ static core_status unstable(const mpm_scene *s, size_t p, const char *what, cons
 }
 
 /* Non-finite values, points outside the grid on axes that are not periodic; periodic axes wrap. */
-static core_status check_points(mpm_scene *s, core_error *err)
+/* Wraps points on periodic axes; returns the first point that is non-finite (*why = 0) or
+ * outside the grid on an axis that is not periodic (*why = 1), or (size_t)-1. */
+static size_t check_points(mpm_scene *s, int *why)
 {
     const mpm_scene_def *d = &s->def;
+    size_t first = (size_t)-1;
+#pragma omp parallel for schedule(static) reduction(min : first) num_threads(s->nt) if (s->nt > 1)
     for (size_t p = 0; p < s->np; p++) {
         double *c[2] = {&s->x[p], &s->y[p]};
         if (!isfinite(*c[0]) || !isfinite(*c[1]) || !isfinite(s->vx[p]) || !isfinite(s->vy[p]) ||
-            !isfinite(s->sig[0][p]) || !isfinite(s->sig[1][p]) || !isfinite(s->sig[2][p]))
-            return unstable(s, p, "has a non-finite position, velocity or stress",
-                            "the time step is too large for the wave speed (use dt = \"auto\" or "
-                            "a smaller cfl)", err);
+            !isfinite(s->sig[0][p]) || !isfinite(s->sig[1][p]) || !isfinite(s->sig[2][p])) {
+            first = p < first ? p : first;
+            continue;
+        }
         for (int a = 0; a < 2; a++) {
             double o = d->origin[a], L = d->size[a];
             if (d->periodic[a]) {
@@ -724,13 +899,15 @@ static core_status check_points(mpm_scene *s, core_error *err)
                 if (*c[a] >= o + L) /* rounding of a value just below o */
                     *c[a] = o;
             } else if (*c[a] < o - s->slack[a][0] || *c[a] > o + L + s->slack[a][1]) {
-                return unstable(s, p, "left the grid",
-                                "an edge without a wall (walls = 'none'), or a time step too "
-                                "large for the speed", err);
+                first = p < first ? p : first;
             }
         }
     }
-    return CORE_OK;
+    if (first != (size_t)-1)
+        *why = isfinite(s->x[first]) && isfinite(s->y[first]) && isfinite(s->vx[first]) &&
+               isfinite(s->vy[first]) && isfinite(s->sig[0][first]) &&
+               isfinite(s->sig[1][first]) && isfinite(s->sig[2][first]);
+    return first;
 }
 
 core_status mpm_run(mpm_scene *s, const mpm_run_def *run, long *done, core_error *err)
@@ -744,20 +921,23 @@ core_status mpm_run(mpm_scene *s, const mpm_run_def *run, long *done, core_error
         return core_fail(err, CORE_ERR_ARG, "cfl must be in (0, 1], got %g", run->cfl);
     if (s->np == 0)
         return core_fail(err, CORE_ERR_STATE, "the scene has no material points: add a grain first");
-    core_status st0;
+    core_status st;
     const bool friction = s->contact == MPM_CONTACT_FRICTION;
     if (friction) {
-        if ((st0 = mpm_contact_reserve(s, err)))
-            return st0;
+        if ((st = mpm_contact_reserve(s, err)))
+            return st;
     } else {
         s->npairs = 0;
     }
+    if ((st = threads_setup(s, err)))
+        return st;
     s->sf = friction ? s->sv : s->sn;
     const double h = s->hx < s->hy ? s->hx : s->hy;
     mpm_timestep ts;
-    core_status st = mpm_timestep_info(s, run->cfl > 0 && run->cfl <= 1 ? run->cfl : 1, &ts, err);
-    if (st)
+    if ((st = mpm_timestep_info(s, run->cfl > 0 && run->cfl <= 1 ? run->cfl : 1, &ts, err)))
         return st;
+    const bool musl = s->def.update == MPM_MUSL;
+    size_t tbad[64];
     while (*done < run->steps) {
         if (run->time_end >= 0 && s->time >= run->time_end * (1 - 1e-14))
             break;
@@ -768,27 +948,46 @@ core_status mpm_run(mpm_scene *s, const mpm_run_def *run, long *done, core_error
         double dt = run->dt > 0 ? run->dt : run->cfl * h / (ts.wave_speed + max_speed(s));
         if (run->time_end >= 0 && s->time + dt > run->time_end)
             dt = run->time_end - s->time;
-        stencil(s);
-        mark_forced(s);
-        if (friction)
-            grain_fields(s); /* the centre-of-mass field too */
-        else
-            to_grid(s);
-        if (s->nmx)
-            moments(s);
-        grid_update(s, dt);
-        if (friction)
-            contact_update(s, dt);
-        to_points(s, dt);
-        if (s->def.update == MPM_MUSL)
-            remap(s, dt);
-        size_t bad = constitutive(s, dt);
+#pragma omp parallel num_threads(s->nt) if (s->nt > 1)
+        {
+            const int t = THREAD_ID();
+            stencil(s, s->tp[t], s->tp[t + 1]);
+#pragma omp barrier
+#pragma omp master
+            mark_forced(s);
+#pragma omp barrier
+            if (friction)
+                grain_fields(s, t); /* the centre-of-mass field too */
+            else
+                to_grid(s, t);
+#pragma omp barrier
+#pragma omp master
+            if (s->nmx)
+                moments(s);
+#pragma omp barrier
+            grid_update(s, dt);
+            if (friction)
+                contact_update(s, dt);
+            to_points(s, dt, t);
+#pragma omp barrier
+            if (musl)
+                remap(s, dt, t);
+            tbad[t] = constitutive(s, dt, t);
+        }
+        for (int t = 0; t < s->nt; t++)
+            if (tbad[t] != (size_t)-1)
+                return unstable(s, tbad[t], "was inverted (det F <= 0)",
+                                "the time step is too large for the wave speed, or a point too "
+                                "strongly compressed between walls", err);
+        int why = 0;
+        size_t bad = check_points(s, &why);
         if (bad != (size_t)-1)
-            return unstable(s, bad, "was inverted (det F <= 0)",
-                            "the time step is too large for the wave speed, or a point too "
-                            "strongly compressed between walls", err);
-        if ((st = check_points(s, err)))
-            return st;
+            return why ? unstable(s, bad, "left the grid",
+                                  "an edge without a wall (walls = 'none'), or a time step too "
+                                  "large for the speed", err)
+                       : unstable(s, bad, "has a non-finite position, velocity or stress",
+                                  "the time step is too large for the wave speed (use dt = "
+                                  "\"auto\" or a smaller cfl)", err);
         s->time += dt;
         s->steps++;
         ++*done;
