@@ -57,6 +57,9 @@ double dsmc_particle_volume(const dsmc_scene *s); /* pi R^2 (2D), 4/3 pi R^3 (3D
 double dsmc_volume(const dsmc_scene *s);          /* box area (2D) or volume (3D) */
 size_t dsmc_cell_count(const dsmc_scene *s);
 void dsmc_cell_size(const dsmc_scene *s, double h[3]);
+/* Bytes allocated for the particle arrays (position, velocity, cell index) and for the per-cell
+ * arrays (carried remainder, sort offsets). */
+void dsmc_memory(const dsmc_scene *s, size_t *particle_bytes, size_t *cell_bytes);
 /* Largest number of particles the box holds at the packing limit: nu_rcp V / V_particle. */
 size_t dsmc_capacity(const dsmc_scene *s);
 /* The chi that Eq. 1 applies at packing fraction nu for the scene's excluded-volume model. */

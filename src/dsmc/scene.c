@@ -158,6 +158,12 @@ void dsmc_cell_size(const dsmc_scene *s, double h[3])
         h[k] = k < s->D ? s->h[k] : 0;
 }
 
+void dsmc_memory(const dsmc_scene *s, size_t *particle_bytes, size_t *cell_bytes)
+{
+    *particle_bytes = s->cap * (2 * (size_t)s->D * sizeof(double) + sizeof(uint32_t));
+    *cell_bytes = s->ncells * (sizeof(double) + 2 * sizeof(size_t)) + sizeof(size_t);
+}
+
 size_t dsmc_capacity(const dsmc_scene *s)
 {
     return (size_t)floor(s->def.packing_limit * dsmc_volume(s) / s->vpart);
@@ -183,9 +189,7 @@ static core_status reserve(dsmc_scene *s, size_t n, core_error *err)
 {
     if (n <= s->cap)
         return CORE_OK;
-    size_t cap = s->cap ? s->cap : 64;
-    while (cap < n)
-        cap *= 2;
+    size_t cap = 2 * s->cap > n ? 2 * s->cap : n; /* exact on a first fill */
     for (int k = 0; k < s->D; k++) {
         double *a = realloc(s->x[k], cap * sizeof(double));
         if (!a)

@@ -756,6 +756,10 @@ static int l_info(lua_State *L)
     lua_setfield(L, -2, "capacity");
     lua_pushstring(L, EXCLUDED_NAMES[d->excluded]);
     lua_setfield(L, -2, "excluded_volume");
+    size_t pb, cb;
+    dsmc_memory(s, &pb, &cb);
+    set_number(L, "particle_bytes", (double)pb);
+    set_number(L, "cell_bytes", (double)cb);
     set_number(L, "time", dsmc_time(s));
     lua_pushinteger(L, dsmc_steps_done(s));
     lua_setfield(L, -2, "steps");
@@ -852,7 +856,8 @@ void bind_open_dsmc(lua_State *L)
         {"info", l_info, "s:info()",
          "dim, box, cells, cell_size, gravity, count, radius, mass, density, restitution, "
          "cross_section (sigma of Eq. 1), volume, packing, chi, packing_limit, capacity, "
-         "excluded_volume, time, steps."},
+         "excluded_volume, time, steps, particle_bytes and cell_bytes (memory of the particle "
+         "arrays: position, velocity, cell index; and of the per-cell arrays)."},
         {NULL, NULL, NULL, NULL}};
     static const luaL_Reg meta[] = {
         {"__gc", l_gc}, {"__close", l_gc}, {"__tostring", l_tostring}, {NULL, NULL}};

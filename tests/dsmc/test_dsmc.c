@@ -15,8 +15,9 @@
 
 static const double PI = 3.14159265358979323846;
 
-/* A periodic box of N particles at packing nu with about `per_cell` particles per cell, all
- * speeds equal to v0 (not Maxwellian), point particles (chi = 1). */
+/* A periodic box of N particles at packing nu with about `per_cell` particles per cell, point
+ * particles (chi = 1); v0 > 0: all speeds equal to v0 (not Maxwellian), v0 < 0: Maxwellian with
+ * T/m = v0^2. */
 static dsmc_scene *gas(int D, size_t N, double nu, int per_cell, double e, double v0)
 {
     dsmc_scene_def d = dsmc_default_scene_def();
@@ -38,7 +39,10 @@ static dsmc_scene *gas(int D, size_t N, double nu, int per_cell, double e, doubl
     assert_int_equal(dsmc_create(&d, &s, &err), CORE_OK);
     dsmc_fill_def f = dsmc_default_fill_def();
     f.n = N;
-    f.speed = v0;
+    if (v0 > 0)
+        f.speed = v0;
+    else
+        f.temperature = dsmc_mass(s) * v0 * v0;
     f.seed = 7;
     assert_int_equal(dsmc_fill(s, &f, &err), CORE_OK);
     return s;
@@ -72,7 +76,7 @@ static void run(dsmc_scene *s, long steps, double dt)
  * step are omega tau / 2 (each collision involves two particles). */
 static void elastic(int D)
 {
-    const size_t N = 20000;
+    const size_t N = 10000;
     dsmc_scene *s = gas(D, N, 0.005, 20, 1.0, 1.0);
     dsmc_moments m0, m;
     dsmc_measure_moments(s, &m0);
@@ -87,9 +91,10 @@ static void elastic(int D)
     for (int k = 0; k < D; k++)
         assert_true(fabs(m.momentum[k] - m0.momentum[k]) <= 1e-12 * pscale);
 
-    /* Kurtosis averaged over 100 snapshots 2 collision times apart (2e6 samples). */
+    /* Kurtosis averaged over 60 snapshots 2 collision times apart (6e5 samples, standard error
+     * about 2/sqrt(6e5) = 0.003 in 2D). */
     double ksum = 0;
-    const int snaps = 100, batch = 10;
+    const int snaps = 60, batch = 10;
     double bsum[10] = {0};
     dsmc_reset_stats(s);
     for (int k = 0; k < snaps; k++) {
@@ -145,10 +150,11 @@ static void test_elastic_3d(void **state)
 static void haff_count(int D, double e)
 {
     const size_t N = 10000;
-    dsmc_scene *s = gas(D, N, 0.005, 20, e, 1.0);
+    dsmc_scene *s = gas(D, N, 0.005, 20, e, -1.0);
     dsmc_moments m;
-    run(s, 20, 1e-4); /* a few collisions per particle: e < 1 acts on an already mixed gas */
     double dt = 0.1 / dsmc_collision_frequency(s);
+    run(s, 20, dt); /* one collision per particle: from Maxwell-Boltzmann towards the cooling state */
+    dt = 0.1 / dsmc_collision_frequency(s);
     double sx = 0, sy = 0, sxx = 0, sxy = 0;
     int k = 0;
     for (; k < 60; k++) {
@@ -230,23 +236,24 @@ static void test_walls(void **state)
 static void test_threads(void **state)
 {
     (void)state;
+    enum { N = 60000 }; /* above the size where the kernels go parallel */
     double *out[2][4];
     for (int t = 0; t < 2; t++) {
         threads_set(t + 1);
-        dsmc_scene *s = gas(2, 5000, 0.01, 10, 0.7, 1.0);
-        run(s, 50, 1e-3);
+        dsmc_scene *s = gas(2, N, 0.01, 10, 0.7, 1.0);
+        run(s, 20, 1e-3);
         dsmc_particles p;
         dsmc_get_particles(s, &p);
         for (int k = 0; k < 2; k++) {
-            out[t][k] = malloc(5000 * sizeof(double));
-            out[t][k + 2] = malloc(5000 * sizeof(double));
-            memcpy(out[t][k], p.x[k], 5000 * sizeof(double));
-            memcpy(out[t][k + 2], p.v[k], 5000 * sizeof(double));
+            out[t][k] = malloc(N * sizeof(double));
+            out[t][k + 2] = malloc(N * sizeof(double));
+            memcpy(out[t][k], p.x[k], N * sizeof(double));
+            memcpy(out[t][k + 2], p.v[k], N * sizeof(double));
         }
         dsmc_destroy(s);
     }
     for (int k = 0; k < 4; k++) {
-        assert_memory_equal(out[0][k], out[1][k], 5000 * sizeof(double));
+        assert_memory_equal(out[0][k], out[1][k], N * sizeof(double));
         free(out[0][k]);
         free(out[1][k]);
     }
