@@ -119,7 +119,8 @@ void dsmc_wall_motion(const dsmc_scene *s, int side, double t, double *pos, doub
 
 /* ---- running --------------------------------------------------------------------------------- */
 /* The paper's validity conditions for a step tau, with the particle-weighted mean density
- * n_w = sum N_c^2 / sum (N_c V_c) (the density the average particle sees) and the temperature:
+ * n_w = sum N_c (N_c - 1) / sum (N_c V_c) (the density of partners the average particle sees;
+ * unbiased by the cells' Poisson noise, which N_c^2 would add as 1/V_c) and the temperature:
  * (i) collisional regime: the mean free path below the box's smallest side (Knudsen number < 1);
  * (ii) the mean free path larger than the largest cell side; (iii) the mean collision time 1/omega
  * larger than tau. lambda = 1 / (2 sqrt2 n sigma_d chi) (2D), 1 / (sqrt2 pi n sigma_d^2 chi) (3D),

@@ -407,7 +407,7 @@ core_status dsmc_check_validity(const dsmc_scene *s, double dt, dsmc_validity *o
     double sum2 = 0;
     for (size_t c = 0; c < s->ncells; c++) {
         double nc = (double)(s->start[c + 1] - s->start[c]);
-        sum2 += nc * nc;
+        sum2 += nc * (nc - 1);
     }
     double n = sum2 / ((double)s->n * s->cell_volume);
     dsmc_moments m;
