@@ -118,6 +118,18 @@ local function run_case(d, e)
   local tau_maxwell = 2 * d / ((1 - e * e) * w_s)
   local tau_hcs = tau_maxwell / (1 + 3 * a2 / 16)
   local final = s:measure("temperature")
+  if d == 2 and e == 0.5 then -- the end state, to see that it is still homogeneous
+    local p = s:particles()
+    render.points{ file = "images/haff_particles.png", x = p.x, y = p.y, values = p.speed, size = 3,
+                   extent = { { 0, 0 }, { L, L } }, width = 900,
+                   range = { 0, 2 * math.sqrt(d * final.t_over_m) }, -- 0 .. twice the rms speed
+                   title = string.format("2D, e = 0.5, N = %d after T fell %dx: particles by speed", N, drop),
+                   label = "speed (m/s)" }
+    local f = s:measure("fields")
+    render.field{ file = "images/haff_density.png", nx = f.nx, ny = f.ny, values = f.packing,
+                  extent = f.extent, width = 900, title = "same state: packing fraction per cell",
+                  label = "packing fraction" }
+  end
   return {
     d = d, e = e, series = series, start = start, a2_theory = a2, a2_measured = final.a2,
     slope = slope, slope_maxwell = slope_maxwell, slope_hcs = slope_hcs,
