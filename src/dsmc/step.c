@@ -188,7 +188,7 @@ static flight_totals flight(dsmc_scene *s, double dt, size_t bcount[DSMC_SORT_BL
     const int sh = block_shift(s->ncells);
     for (int b = 0; b < DSMC_SORT_BLOCKS; b++)
         bcount[b] = 0;
-#pragma omp parallel for schedule(static) reduction(+ : hits, bcount[:DSMC_SORT_BLOCKS]) \
+#pragma omp parallel for schedule(dynamic, 8192) reduction(+ : hits, bcount[:DSMC_SORT_BLOCKS]) \
     reduction(| : bad) if (n >= DSMC_PARALLEL_MIN)
     for (long i = 0; i < n; i++) {
         double x[3], v[3];
