@@ -3,24 +3,24 @@
 -- step error is largest). Error: |tau_H(fit) / tau_H(theory with a2) - 1| and the error of the
 -- per-collision slope (derivations in scripts/haff.lua); wall time: the s:run calls only.
 --
--- Sweeps (each around the base point nu = 0.004, N = 20000, 20 particles per cell, cell side
--- 0.92 mean free paths, omega dt = 0.01, i.e. zeta dt = 0.00375):
---   cells: cell side h against the mean free path lambda, h/lambda in 0.23 .. 7.4 at fixed N and
+-- Sweeps (each around the base point nu = 0.004, N = 20000, 5 particles per cell, cell side
+-- 0.45 mean free paths, omega dt = 0.01, i.e. zeta dt = 0.00375), dilute limit chi = 1:
+--   cells: cell side h against the mean free path lambda, h/lambda in 0.11 .. 3.6 at fixed N and
 --          nu (particles per cell change with it: n h^2);
 --   dt:    omega dt (dt against the mean collision time 1/omega, re-chosen as the gas cools) in
 --          0.003 .. 3;
---   ppc:   particles per cell 2 .. 50 at h/lambda ~ 0.9, by changing the packing (nu = 0.04 ..
---          0.0016; ppc = n h^2 = (h/lambda)^2 / (8 n sigma^2)).
+--   ppc:   particles per cell 2 .. 50 at h/lambda ~ 0.45, by changing the packing (nu = 0.01 ..
+--          0.0004; ppc = n h^2 = (h/lambda)^2 / (8 n sigma^2)).
 -- Each point is the mean of `seeds` runs (default 4); the statistical floor is ~0.5%.
--- Findings (measured with the defaults; the floor is about +-1%): the step hardly matters, since
--- collisions within a step act on the updated velocities and only the candidate count lags
--- (+0.8% at omega dt = 0.003, +1.0% at 0.1, +2.0% at 1, +8.6% at 3); the cell size does not
--- matter in this homogeneous state (within the floor from h/lambda = 0.22 to 7.2, so 4 x 4 cells
--- are the cheapest within 1%; cells matter where gradients are, e.g. the vibrated bed); few
--- particles per cell at h ~ lambda do: +6.1% at 2, +3.5% at 5, +2.5% at 10, +0.8% at 50 (the same
--- pairs meet again in the next steps with the relative velocity their last collision reduced;
--- at h = 0.22 lambda and 1.2 per cell the error is at the floor, as particles cross several
--- cells between collisions).
+-- Findings (measured with the defaults; the floor is about +-0.5%): the step matters little up to
+-- omega dt = 0.3 (within the floor: collisions within a step act on the updated velocities and
+-- only the candidate count lags), then strongly: +7.1% at omega dt = 1, +28% at 3 (with 5 per
+-- cell a pair then meets several times in one step); the cell size matters through the particles
+-- it holds at h ~ lambda: +1.3% at h/lambda = 0.9 (20 per cell) and 1.8 (78 per cell), within the
+-- floor at 0.11 .. 0.45 and at 3.6; at h/lambda = 0.45, fewer particles per cell cost accuracy
+-- (+1.4% at 2, +0.3% at 10, 0.0% at 50). Wherever pairs are few and cells are not crossed between
+-- collisions, the same pairs collide again with the relative velocity their last collision
+-- reduced, and cooling per collision is too slow.
 --   grainlab scripts/study_dsmc.lua [n=20000] [seeds=4] [csv=out/study_dsmc.csv] [png=images/study_dsmc.png]
 local N = params.n or 20000
 local seeds = params.seeds or 4
@@ -40,11 +40,12 @@ end
 -- One cooling run; returns errors and wall time.
 local function haff(nu, nc, wdt, seed)
   local L = math.sqrt(N * math.pi * R * R / nu)
-  local s = dsmc.scene{ dim = 2, size = { L, L }, cells = { nc, nc }, radius = R, restitution = e, seed = seed }
+  local s = dsmc.scene{ dim = 2, size = { L, L }, cells = { nc, nc }, radius = R, restitution = e, seed = seed,
+                        excluded_volume = "none" }
   local m = s:info().mass
   s:fill{ n = N, temperature = m, seed = 100 + seed }
   local n = (N - 1) / (L * L)
-  local chi = 1 / (1 - nu / 0.82)
+  local chi = 1
   local function omega(tm) return 2 * math.sqrt(math.pi) * chi * n * 2 * R * math.sqrt(tm) end
   local T0 = s:measure("temperature").t_over_m
   local ts, Ts, cs = {}, {}, {}
@@ -94,7 +95,7 @@ end
 
 local rows = {}
 local nu0, wdt0 = 0.004, 0.01
-local nc0 = math.floor(math.sqrt(N / 20) + 0.5)
+local nc0 = math.floor(math.sqrt(N / 5) + 0.5)
 for _, k in ipairs { 4, 2, 1, 0.5, 0.25, 0.125 } do
   local nc = math.max(1, math.floor(nc0 * k + 0.5))
   rows[#rows + 1] = point("cells", "x" .. k, nu0, nc, wdt0)
@@ -102,8 +103,8 @@ end
 for _, w in ipairs { 0.003, 0.03, 0.1, 0.3, 1, 3 } do
   rows[#rows + 1] = point("dt", tostring(w), nu0, nc0, w)
 end
-for _, ppc in ipairs { 2, 5, 10, 50 } do
-  local nu = nu0 * 20 / ppc -- h/lambda fixed: ppc ~ 1/nu
+for _, ppc in ipairs { 2, 10, 20, 50 } do
+  local nu = nu0 * 5 / ppc -- h/lambda fixed: ppc ~ 1/nu
   local nc = math.floor(math.sqrt(N / ppc) + 0.5)
   rows[#rows + 1] = point("ppc", tostring(ppc), nu, nc, wdt0)
 end
@@ -118,7 +119,7 @@ assert(grainlab.write_file(csv_path, table.concat(lines, "\n") .. "\n"))
 
 -- error against wall time, one series per sweep (log-log; errors floored at 1e-4 for the axis)
 local series = {}
-for _, sw in ipairs { { "cells", "cell size h/lambda = 0.23 .. 7.4" }, { "dt", "step omega dt = 0.003 .. 3" },
+for _, sw in ipairs { { "cells", "cell size h/lambda = 0.11 .. 3.6" }, { "dt", "step omega dt = 0.003 .. 3" },
                       { "ppc", "particles per cell = 2 .. 50" } } do
   local xs, ys = {}, {}
   for _, r in ipairs(rows) do
@@ -126,6 +127,9 @@ for _, sw in ipairs { { "cells", "cell size h/lambda = 0.23 .. 7.4" }, { "dt", "
   end
   series[#series + 1] = { x = xs, y = ys, label = sw[2], style = "both" }
 end
+local xmin, xmax = math.huge, 0
+for _, r in ipairs(rows) do xmin = math.min(xmin, r.wall); xmax = math.max(xmax, r.wall) end
+series[#series + 1] = { x = { xmin, xmax }, y = { 0.005, 0.005 }, label = "statistical floor (~0.5%)", style = "line" }
 render.plot{ file = png, title = string.format("DSMC accuracy vs speed: Haff tau_H error, 2D e = %g, N = %d", e, N),
              xlabel = "wall time per run (s)", ylabel = "|tau_H fit / theory - 1|", xlog = true, ylog = true,
              series = series }
@@ -146,7 +150,8 @@ grainlab.report{
     tau_err_omega_dt_0_003 = by["dt:0.003"].tau_err, tau_err_omega_dt_0_1 = by["dt:0.1"].tau_err,
     tau_err_omega_dt_1 = by["dt:1"].tau_err, tau_err_omega_dt_3 = by["dt:3"].tau_err,
     tau_err_h_over_lambda_max = by["cells:x0.125"].tau_err, tau_err_h_over_lambda_min = by["cells:x4"].tau_err,
-    tau_err_ppc_2 = by["ppc:2"].tau_err, tau_err_ppc_50 = by["ppc:50"].tau_err,
+    tau_err_ppc_2 = by["ppc:2"].tau_err, tau_err_ppc_20 = by["ppc:20"].tau_err,
+    tau_err_ppc_50 = by["ppc:50"].tau_err, tau_err_base = by["cells:x1"].tau_err,
     cheapest_within_1pct = best and (best.sweep .. " " .. best.label) or "none",
     cheapest_within_1pct_wall_s = best and best.wall or 0,
   },
@@ -157,6 +162,7 @@ grainlab.report{
     { name = "dt_error_grows", value = math.abs(by["dt:3"].tau_err), limit = 2 * math.abs(by["dt:0.003"].tau_err), op = ">" },
     { name = "fine_dt_accurate", value = math.abs(by["dt:0.003"].tau_err), limit = 0.015 },
     { name = "ppc_error_falls", value = math.abs(by["ppc:50"].tau_err), limit = math.abs(by["ppc:2"].tau_err), op = "<" },
+    { name = "base_point_accurate", value = math.abs(by["cells:x1"].tau_err), limit = 0.015 },
     { name = "ppc_50_accurate", value = math.abs(by["ppc:50"].tau_err), limit = 0.015 },
   },
 }
