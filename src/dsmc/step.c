@@ -157,90 +157,135 @@ typedef struct flight_totals {
     int bad;
 } flight_totals;
 
-/* Moves every particle, finds its cell and counts the particles per sort range (bcount). */
-static flight_totals flight(dsmc_scene *s, double dt, size_t bcount[DSMC_SORT_BLOCKS])
-{
-    const int D = s->D;
-    const double t1 = s->t + dt;
+/* The constants of one flight step, read once: stores into the particle arrays could alias the
+ * scene, so the loop must not read them through it. */
+typedef struct flight_consts {
+    double dt, hdt2, g[3], lo[3], hi[3], L[3], inv_h[3];
+    int cells[3], sh;
+    bool per[3];
     wall_state ws[6];
-    for (int side = 0; side < 6; side++) {
-        ws[side].active = side < 2 * D && !s->def.periodic[side / 2];
-        if (ws[side].active)
-            dsmc_wall_motion(s, side, t1, &ws[side].pos, &ws[side].vel);
+    uint64_t seed, step;
+} flight_consts;
+
+/* Walls for one particle that is outside the walls on a non-periodic axis (the slow path). */
+static __attribute__((noinline)) long walls_one(const dsmc_scene *s, const flight_consts *fc,
+                                                int D, long i, double x[3], double v[3])
+{
+    long hits = 0;
+    for (int k = 0; k < D; k++) {
+        if (fc->per[k])
+            continue;
+        const wall_state *ws = fc->ws;
+        /* A fast particle may cross both walls of a thin box: a few reflections at most. */
+        for (int bounce = 0; bounce < 4; bounce++) {
+            int side = x[k] < ws[2 * k].pos ? 2 * k : x[k] > ws[2 * k + 1].pos ? 2 * k + 1 : -1;
+            if (side < 0)
+                break;
+            rng r = {{0, 0, 0, 0}};
+            if (s->walls[side].kind == DSMC_WALL_DIFFUSE)
+                dsmc_stream(&r, fc->seed, STREAM_WALL, fc->step, (uint64_t)i * 8 + (uint64_t)bounce);
+            reflect(s, side, &ws[side], fc->dt, x, v, &r);
+            hits++;
+        }
+        if (x[k] < ws[2 * k].pos)
+            x[k] = ws[2 * k].pos;
+        if (x[k] > ws[2 * k + 1].pos)
+            x[k] = ws[2 * k + 1].pos;
     }
-    double g[3], lo[3], hi[3], L[3];
+    return hits;
+}
+
+/* The flight loop for a dimension D known at compile time (called with 2 and 3). */
+static inline __attribute__((always_inline)) flight_totals
+flight_dim(dsmc_scene *s, const flight_consts *fc, size_t bcount[DSMC_SORT_BLOCKS], const int D)
+{
+    const long n = (long)s->n;
+    double *const X[3] = {s->x[0], s->x[1], s->x[2]}, *const V[3] = {s->v[0], s->v[1], s->v[2]};
+    uint32_t *const cell = s->cell;
+    const double dt = fc->dt, hdt2 = fc->hdt2;
+    double g[3], lo[3], hi[3], L[3], ih[3], wlo[3], whi[3];
+    int nc[3];
     bool per[3], any_wall = false;
     for (int k = 0; k < 3; k++) {
-        g[k] = s->def.gravity[k];
-        lo[k] = s->def.lo[k];
-        hi[k] = s->def.hi[k];
-        L[k] = hi[k] - lo[k];
-        per[k] = s->def.periodic[k];
+        g[k] = fc->g[k];
+        lo[k] = fc->lo[k];
+        hi[k] = fc->hi[k];
+        L[k] = fc->L[k];
+        ih[k] = fc->inv_h[k];
+        nc[k] = fc->cells[k];
+        per[k] = fc->per[k];
+        wlo[k] = per[k] ? -INFINITY : fc->ws[2 * k].pos;
+        whi[k] = per[k] ? INFINITY : fc->ws[2 * k + 1].pos;
         any_wall = any_wall || (k < D && !per[k]);
     }
-    const long n = (long)s->n;
-    const uint64_t seed = s->def.seed, step = (uint64_t)s->steps;
+    const int sh = fc->sh;
     long hits = 0;
     int bad = 0;
-    double *X = s->x[0], *Y = s->x[1], *Z = s->x[2], *VX = s->v[0], *VY = s->v[1], *VZ = s->v[2];
-    uint32_t *cell = s->cell;
-    const double hdt2 = 0.5 * dt * dt;
-    const int sh = block_shift(s->ncells);
     for (int b = 0; b < DSMC_SORT_BLOCKS; b++)
         bcount[b] = 0;
 #pragma omp parallel for schedule(dynamic, 8192) reduction(+ : hits, bcount[:DSMC_SORT_BLOCKS]) \
     reduction(| : bad) if (n >= DSMC_PARALLEL_MIN)
     for (long i = 0; i < n; i++) {
         double x[3], v[3];
-        x[0] = X[i] + VX[i] * dt + g[0] * hdt2;
-        x[1] = Y[i] + VY[i] * dt + g[1] * hdt2;
-        v[0] = VX[i] + g[0] * dt;
-        v[1] = VY[i] + g[1] * dt;
-        if (D == 3) {
-            x[2] = Z[i] + VZ[i] * dt + g[2] * hdt2;
-            v[2] = VZ[i] + g[2] * dt;
-        } else {
-            x[2] = 0;
-            v[2] = 0;
-        }
+        int out = 0;
         for (int k = 0; k < D; k++) {
+            x[k] = X[k][i] + V[k][i] * dt + g[k] * hdt2;
+            v[k] = V[k][i] + g[k] * dt;
             if (per[k]) {
-                if (x[k] < lo[k] || x[k] >= hi[k])
+                if (x[k] < lo[k])
+                    x[k] += L[k];
+                else if (x[k] >= hi[k])
+                    x[k] -= L[k];
+                if (!(x[k] >= lo[k] && x[k] < hi[k])) /* more than a box in one step */
                     x[k] -= L[k] * floor((x[k] - lo[k]) / L[k]);
-                continue;
+            } else {
+                out |= x[k] < wlo[k] || x[k] > whi[k];
             }
-            if (!any_wall)
-                continue;
-            /* A fast particle may cross both walls of a thin box: a few reflections at most. */
-            for (int bounce = 0; bounce < 4; bounce++) {
-                int side = x[k] < ws[2 * k].pos ? 2 * k : x[k] > ws[2 * k + 1].pos ? 2 * k + 1 : -1;
-                if (side < 0)
-                    break;
-                rng r = {{0, 0, 0, 0}};
-                if (s->walls[side].kind == DSMC_WALL_DIFFUSE)
-                    dsmc_stream(&r, seed, STREAM_WALL, step, (uint64_t)i * 8 + (uint64_t)bounce);
-                reflect(s, side, &ws[side], dt, x, v, &r);
-                hits++;
-            }
-            if (x[k] < ws[2 * k].pos)
-                x[k] = ws[2 * k].pos;
-            if (x[k] > ws[2 * k + 1].pos)
-                x[k] = ws[2 * k + 1].pos;
         }
-        X[i] = x[0];
-        Y[i] = x[1];
-        VX[i] = v[0];
-        VY[i] = v[1];
-        if (D == 3) {
-            Z[i] = x[2];
-            VZ[i] = v[2];
+        if (any_wall && out)
+            hits += walls_one(s, fc, D, i, x, v);
+        size_t c = 0;
+        double chk = 0;
+        for (int k = D - 1; k >= 0; k--) {
+            X[k][i] = x[k];
+            V[k][i] = v[k];
+            chk += x[k] + v[k];
+            double f = (x[k] - lo[k]) * ih[k];
+            int ci = f < 0 ? 0 : f >= nc[k] ? nc[k] - 1 : (int)f;
+            c = c * (size_t)nc[k] + (size_t)ci;
         }
-        bad |= !isfinite(v[0] + v[1] + v[2]) || !isfinite(x[0] + x[1] + x[2]);
-        uint32_t c = dsmc_cell_of(s, x[0], x[1], x[2]);
-        cell[i] = c;
+        bad |= !isfinite(chk);
+        cell[i] = (uint32_t)c;
         bcount[c >> sh]++;
     }
     return (flight_totals){hits, bad};
+}
+
+/* Moves every particle, finds its cell and counts the particles per sort range (bcount). */
+static flight_totals flight(dsmc_scene *s, double dt, size_t bcount[DSMC_SORT_BLOCKS])
+{
+    flight_consts fc;
+    memset(&fc, 0, sizeof fc);
+    fc.dt = dt;
+    fc.hdt2 = 0.5 * dt * dt;
+    for (int k = 0; k < 3; k++) {
+        fc.g[k] = s->def.gravity[k];
+        fc.lo[k] = s->def.lo[k];
+        fc.hi[k] = s->def.hi[k];
+        fc.L[k] = fc.hi[k] - fc.lo[k];
+        fc.inv_h[k] = s->inv_h[k];
+        fc.cells[k] = s->def.cells[k];
+        fc.per[k] = s->def.periodic[k];
+    }
+    for (int side = 0; side < 6; side++) {
+        fc.ws[side].active = side < 2 * s->D && !s->def.periodic[side / 2];
+        if (fc.ws[side].active)
+            dsmc_wall_motion(s, side, s->t + dt, &fc.ws[side].pos, &fc.ws[side].vel);
+    }
+    fc.sh = block_shift(s->ncells);
+    fc.seed = s->def.seed;
+    fc.step = (uint64_t)s->steps;
+    return s->D == 2 ? flight_dim(s, &fc, bcount, 2) : flight_dim(s, &fc, bcount, 3);
 }
 
 /* ---- collisions (Eq. 1) ----------------------------------------------------------------------- */
