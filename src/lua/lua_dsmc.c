@@ -529,6 +529,7 @@ static void measure_stats(lua_State *L, dsmc_scene *s)
     set_number(L, "particle_moves_per_s", st.particle_moves / st.wall_s);
     set_number(L, "attempts", st.attempts);
     set_number(L, "collisions", st.collisions);
+    set_number(L, "accepted", st.collisions); /* SPARTA: collision attempts vs collisions */
     set_number(L, "attempts_per_particle_per_step", st.attempts / st.particle_moves);
     set_number(L, "collisions_per_particle_per_step", st.collisions / st.particle_moves);
     set_number(L, "acceptance", st.collisions / st.attempts);
@@ -842,7 +843,7 @@ void bind_open_dsmc(lua_State *L)
          "nx, ny, nz, extent. histogram {bins = 40, range = {lo, hi}, quantity = 'component'|"
          "'speed'}: centers, counts, pdf, outside, kurtosis (about the mean velocity; default "
          "range 5 sqrt(T/m)). stats (SPARTA's vocabulary, since s:reset_stats()): steps, "
-         "particle_moves, particle_moves_per_cpu_s, attempts, collisions, "
+         "particle_moves, particle_moves_per_cpu_s, attempts, collisions (= accepted), "
          "attempts_per_particle_per_step, collisions_per_particle_per_step, acceptance, "
          "wall_hits, vmax_raised, collision_frequency (measured: 2 collisions / (N t)) and "
          "collision_frequency_theory. profile {axis = dim, bins = cells}: position, count, "

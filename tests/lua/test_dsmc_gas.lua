@@ -74,4 +74,19 @@ local dense = dsmc.scene{ dim = 2, size = { 0.1, 0.1 }, cells = { 5, 5 }, radius
 dense:fill{ n = 500, temperature = 1e-6 }
 local vd = dense:measure("validity", { dt = 1 })
 check.is_true(not vd.cells_ok and not vd.dt_ok, "a dense gas with coarse cells and a huge dt violates ii and iii")
+
+-- ... and s:run warns each violated condition with its numbers (on stderr, so run a child)
+local exe = arg[-1]
+for i = -2, -10, -1 do if arg[i] then exe = arg[i] else break end end
+local chunk = "local d = dsmc.scene{ dim = 2, size = { 0.1, 0.1 }, cells = { 5, 5 }, radius = 1e-3 }; " ..
+              "d:fill{ n = 500, temperature = 1e-6 }; d:run{ steps = 1, dt = 1 }; " ..
+              "local q = dsmc.scene{ dim = 2, size = { 0.1, 0.1 }, cells = { 5, 5 }, radius = 1e-3 }; " ..
+              "q:fill{ n = 500, temperature = 1e-6 }; q:run{ steps = 1, dt = 1, warn = false }"
+local pipe = io.popen(exe .. " -e '" .. chunk .. "' 2>&1")
+local out = pipe:read("a")
+pipe:close()
+check.contains(out, "dsmc run: warning: cells larger than the mean free path (condition ii): cell side 0.02 m >= mean free path 0.00", "warning ii")
+check.contains(out, "dsmc run: warning: time step above the mean collision time (condition iii): dt 1 s >= 1/omega = ", "warning iii")
+local _, count = out:gsub("%(condition ii%)", "")
+check.eq(count, 1, "warn = false silences the warnings")
 check.done()
