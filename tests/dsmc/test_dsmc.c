@@ -232,6 +232,43 @@ static void test_walls(void **state)
     dsmc_destroy(s);
 }
 
+/* 3D: a closed box with specular walls on every side at e = 1 keeps the energy and the
+ * particles. */
+static void test_walls_3d(void **state)
+{
+    (void)state;
+    dsmc_scene_def d = dsmc_default_scene_def();
+    d.dim = 3;
+    d.radius = 1e-3;
+    for (int k = 0; k < 3; k++) {
+        d.lo[k] = 0;
+        d.hi[k] = 0.1;
+        d.cells[k] = 8;
+        d.periodic[k] = false;
+    }
+    dsmc_scene *s;
+    core_error err;
+    assert_int_equal(dsmc_create(&d, &s, &err), CORE_OK);
+    dsmc_fill_def f = dsmc_default_fill_def();
+    f.n = 3000;
+    f.temperature = dsmc_mass(s) * 1.0;
+    assert_int_equal(dsmc_fill(s, &f, &err), CORE_OK);
+    dsmc_moments m0, m;
+    dsmc_measure_moments(s, &m0);
+    run(s, 300, 2e-3);
+    dsmc_measure_moments(s, &m);
+    assert_true(fabs(m.kinetic_energy / m0.kinetic_energy - 1) < 1e-12);
+    dsmc_particles p;
+    dsmc_get_particles(s, &p);
+    for (size_t i = 0; i < dsmc_count(s); i++)
+        for (int k = 0; k < 3; k++)
+            assert_true(p.x[k][i] >= 0 && p.x[k][i] <= 0.1);
+    dsmc_stats st;
+    dsmc_get_stats(s, &st);
+    assert_true(st.wall_hits > 3000);
+    dsmc_destroy(s);
+}
+
 /* The same seed gives the same bits on 1 and 2 threads: every cell has its own stream. */
 static void test_threads(void **state)
 {
@@ -314,7 +351,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_elastic_2d), cmocka_unit_test(test_elastic_3d),
         cmocka_unit_test(test_haff_count), cmocka_unit_test(test_walls),
-        cmocka_unit_test(test_threads),    cmocka_unit_test(test_bad_input),
+        cmocka_unit_test(test_walls_3d), cmocka_unit_test(test_threads),    cmocka_unit_test(test_bad_input),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -35,6 +35,19 @@ check.near(st.collisions_per_particle_per_step, omega(t1.t_over_m) * dt / 2, 0.0
 check.near(st.particle_moves, 400 * N, 1e-12, "particle moves")
 check.is_true(st.attempts >= st.collisions and st.acceptance > 0.2 and st.acceptance <= 1, "acceptance")
 
+-- Enskog's chi in 2D (Henderson): (1 - 7 nu/16)/(1 - nu)^2 multiplies Eq. 1 per cell
+local en = dsmc.scene{ dim = 2, size = { L, L }, cells = { 14, 14 }, radius = R, seed = 4, excluded_volume = "enskog" }
+en:fill{ n = N, temperature = m, seed = 6 }
+local chi_e = (1 - 7 * nu / 16) / (1 - nu)^2
+check.near(en:info().chi, chi_e, 1e-12, "Enskog chi")
+local t_e = en:measure("temperature")
+en:run{ steps = 50, dt = dt, warn = false }
+en:reset_stats()
+en:run{ steps = 300, dt = dt, warn = false }
+local w_e = omega(en:measure("temperature").t_over_m) / chi * chi_e
+check.near(en:measure("stats").collision_frequency, w_e, 0.02, "collision frequency with Enskog's chi")
+check.near(t_e.collision_frequency, omega(t_e.t_over_m) / chi * chi_e, 1e-12, "kinetic-theory omega with Enskog's chi")
+
 -- fields, histogram, profile add up
 local f = s:measure("fields")
 local cnt, ux = 0, 0
