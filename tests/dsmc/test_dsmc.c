@@ -219,7 +219,7 @@ static void test_walls(void **state)
     wd.temperature = dsmc_mass(w) * 4.0; /* T/m = 4 m^2/s^2, four times the gas */
     for (int side = 0; side < 4; side++)
         assert_int_equal(dsmc_set_wall(w, side, &wd, &err), CORE_OK);
-    run(w, 2000, 0.02 * L);
+    run(w, 800, 0.02 * L);
     double T = 0;
     for (int k = 0; k < 20; k++) {
         run(w, 20, 0.02 * L);
