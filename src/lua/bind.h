@@ -117,6 +117,9 @@ struct dem_scene *bind_check_dem_scene(lua_State *L, int idx, const char *call);
 /* Registers the global `mpm` module (lua_mpm.c). */
 void bind_open_mpm(lua_State *L);
 
+/* Registers the global `dsmc` module (lua_dsmc.c). */
+void bind_open_dsmc(lua_State *L);
+
 /* Registers the global `render` module (lua_render.c). */
 void bind_open_render(lua_State *L);
 

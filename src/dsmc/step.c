@@ -1,0 +1,505 @@
+/* The DSMC step (paper Sec. 4): free flight with gravity and walls, the in-place counting sort
+ * into cells, and the collisions of Eq. 1 in every cell. Threads split particles (flight) and
+ * cells (collisions); every cell and every wall hit draws from its own random stream, so the
+ * result does not depend on the number of threads. */
+#include <math.h>
+#include <string.h>
+
+#include "core/clock.h"
+#include "core/interrupt.h"
+#include "dsmc/dsmc_internal.h"
+
+enum { STREAM_COLLIDE = 1, STREAM_WALL = 2 };
+
+/* Below this many particles a step is a few hundred microseconds and threads cost more than they
+ * bring (barriers; on a loaded machine, a descheduled thread stalls every step). */
+#define DSMC_PARALLEL_MIN 50000
+
+dsmc_run_def dsmc_default_run_def(void)
+{
+    return (dsmc_run_def){.steps = 0, .dt = 0, .time_end = -1};
+}
+
+/* ---- sorting --------------------------------------------------------------------------------
+ * Counting sort in place (American flag sort): count, prefix-sum, then swap every particle into
+ * the next free slot of its bucket. Particles that stay in their cell (most of them, when the
+ * step is below the collision time) are never moved, and no second particle buffer is needed.
+ * Two passes so that threads can share the work and the result still does not depend on their
+ * number: first a serial partition into DSMC_SORT_BLOCKS fixed ranges of cells (only the few
+ * particles that crossed a range boundary move), then every range is sorted by cell on its own,
+ * ranges in parallel. Measured on the 10^6-particle benchmark: the single serial sort took 60% of
+ * a step (perf), and bound two threads to 1.3x at best. */
+#define DSMC_SORT_BLOCKS 64
+
+static void swap_particles(dsmc_scene *s, size_t i, size_t j)
+{
+    for (int k = 0; k < s->D; k++) {
+        double t = s->x[k][i];
+        s->x[k][i] = s->x[k][j];
+        s->x[k][j] = t;
+        t = s->v[k][i];
+        s->v[k][i] = s->v[k][j];
+        s->v[k][j] = t;
+    }
+    uint32_t c = s->cell[i];
+    s->cell[i] = s->cell[j];
+    s->cell[j] = c;
+}
+
+/* Sorts particles [lo, hi) by key(cell) into buckets [0, nb), key(c) = (c - c0) >> shift (the
+ * counts per bucket given, or counted here when counts is NULL); writes the buckets' start offsets (absolute) to start[0 .. nb - 1] only
+ * (the last bucket ends at hi), so ranges sorted side by side never write the same entry; next[]
+ * is scratch of nb entries. Each swap puts one misplaced particle in place: the slots of the
+ * target bucket that already hold its particles are skipped, instead of shifting them along. */
+static void flag_sort(dsmc_scene *s, size_t lo, size_t hi, size_t *start, size_t *next,
+                      size_t nb, uint32_t c0, int shift, const size_t *counts)
+{
+    uint32_t *cl = s->cell;
+#define KEY(c) (((c) - c0) >> shift)
+    if (counts) {
+        memcpy(next, counts, nb * sizeof *next);
+    } else {
+        memset(next, 0, nb * sizeof *next);
+        for (size_t i = lo; i < hi; i++)
+            next[KEY(cl[i])]++;
+    }
+    size_t acc = lo;
+    for (size_t b = 0; b < nb; b++) {
+        size_t cnt = next[b];
+        start[b] = next[b] = acc;
+        acc += cnt;
+    }
+    for (size_t b = 0; b < nb; b++) {
+        size_t end = b + 1 < nb ? start[b + 1] : hi;
+        while (next[b] < end) {
+            size_t i = next[b];
+            size_t k = KEY(cl[i]);
+            if (k == b) {
+                next[b]++;
+                continue;
+            }
+            size_t j = next[k];
+            while (KEY(cl[j]) == k)
+                j++;
+            next[k] = j + 1;
+            swap_particles(s, i, j);
+        }
+    }
+#undef KEY
+}
+
+/* Cells per sort range: a power of two (a shift, not a division, per particle) giving at most
+ * DSMC_SORT_BLOCKS ranges. */
+static int block_shift(size_t nc)
+{
+    int sh = 0;
+    while ((nc + ((size_t)1 << sh) - 1) >> sh > DSMC_SORT_BLOCKS)
+        sh++;
+    return sh;
+}
+
+static void sort_counted(dsmc_scene *s, const size_t *bcount)
+{
+    size_t nc = s->ncells;
+    int sh = block_shift(nc);
+    size_t width = (size_t)1 << sh, nb = (nc + width - 1) >> sh;
+    size_t bstart[DSMC_SORT_BLOCKS + 1], bnext[DSMC_SORT_BLOCKS];
+    flag_sort(s, 0, s->n, bstart, bnext, nb, 0, sh, bcount);
+    bstart[nb] = s->n;
+    size_t *start = s->start, *next = s->next;
+    const long nbl = (long)nb;
+#pragma omp parallel for schedule(dynamic, 1) if (s->n >= DSMC_PARALLEL_MIN)
+    for (long b = 0; b < nbl; b++) {
+        size_t c0 = (size_t)b * width, c1 = c0 + width < nc ? c0 + width : nc;
+        flag_sort(s, bstart[b], bstart[b + 1], start + c0, next + c0, c1 - c0, (uint32_t)c0, 0,
+                  NULL);
+    }
+    start[nc] = s->n;
+}
+
+void dsmc_sort(dsmc_scene *s) { sort_counted(s, NULL); }
+
+/* ---- free flight ------------------------------------------------------------------------------ */
+typedef struct wall_state {
+    bool active;
+    double pos, vel; /* along the axis, at the end of the step */
+} wall_state;
+
+/* Reflects component k of particle i off the wall of `side` that it has crossed. The crossing
+ * happened a time tr ago, estimated from the normal speed relative to the wall; the particle
+ * leaves with its new normal velocity for that time. */
+static void reflect(const dsmc_scene *s, int side, const wall_state *ws, double dt, double *x,
+                    double v[3], rng *r)
+{
+    const dsmc_wall_def *w = &s->walls[side];
+    int axis = side / 2;
+    double sign = side % 2 == 0 ? 1 : -1; /* inward normal along the axis */
+    double rel = sign * (ws->vel - v[axis]); /* approach speed in the wall frame, > 0 */
+    double depth = sign * (ws->pos - x[axis]); /* how far behind the wall, > 0 */
+    double tr = rel > 0 ? fmin(depth / rel, dt) : 0;
+    double vn; /* outgoing normal speed relative to the wall, > 0 */
+    if (w->kind == DSMC_WALL_DIFFUSE) {
+        double sd = sqrt(w->temperature / s->mass);
+        double u = rng_uniform(r);
+        vn = sd * sqrt(-2 * log(1 - u)); /* flux-weighted: Rayleigh */
+        for (int k = 0; k < s->D; k++)
+            if (k != axis)
+                v[k] = w->velocity[k] + sd * rng_normal(r);
+    } else {
+        vn = w->restitution * (rel > 0 ? rel : -rel);
+    }
+    v[axis] = ws->vel + sign * vn;
+    x[axis] = ws->pos + sign * vn * tr;
+}
+
+typedef struct flight_totals {
+    long wall_hits;
+    int bad;
+} flight_totals;
+
+/* The constants of one flight step, read once: stores into the particle arrays could alias the
+ * scene, so the loop must not read them through it. */
+typedef struct flight_consts {
+    double dt, hdt2, g[3], lo[3], hi[3], L[3], inv_h[3];
+    int cells[3], sh;
+    bool per[3];
+    wall_state ws[6];
+    uint64_t seed, step;
+} flight_consts;
+
+/* Walls for one particle that is outside the walls on a non-periodic axis (the slow path). */
+static __attribute__((noinline)) long walls_one(const dsmc_scene *s, const flight_consts *fc,
+                                                int D, long i, double x[3], double v[3])
+{
+    long hits = 0;
+    for (int k = 0; k < D; k++) {
+        if (fc->per[k])
+            continue;
+        const wall_state *ws = fc->ws;
+        /* A fast particle may cross both walls of a thin box: a few reflections at most. */
+        for (int bounce = 0; bounce < 4; bounce++) {
+            int side = x[k] < ws[2 * k].pos ? 2 * k : x[k] > ws[2 * k + 1].pos ? 2 * k + 1 : -1;
+            if (side < 0)
+                break;
+            rng r = {{0, 0, 0, 0}};
+            if (s->walls[side].kind == DSMC_WALL_DIFFUSE)
+                dsmc_stream(&r, fc->seed, STREAM_WALL, fc->step, (uint64_t)i * 8 + (uint64_t)bounce);
+            reflect(s, side, &ws[side], fc->dt, x, v, &r);
+            hits++;
+        }
+        if (x[k] < ws[2 * k].pos)
+            x[k] = ws[2 * k].pos;
+        if (x[k] > ws[2 * k + 1].pos)
+            x[k] = ws[2 * k + 1].pos;
+    }
+    return hits;
+}
+
+/* The flight loop for a dimension D known at compile time (called with 2 and 3). */
+static inline __attribute__((always_inline)) flight_totals
+flight_dim(dsmc_scene *s, const flight_consts *fc, size_t bcount[DSMC_SORT_BLOCKS], const int D)
+{
+    const long n = (long)s->n;
+    double *const X[3] = {s->x[0], s->x[1], s->x[2]}, *const V[3] = {s->v[0], s->v[1], s->v[2]};
+    uint32_t *const cell = s->cell;
+    const double dt = fc->dt, hdt2 = fc->hdt2;
+    double g[3], lo[3], hi[3], L[3], ih[3], wlo[3], whi[3];
+    int nc[3];
+    bool per[3], any_wall = false;
+    for (int k = 0; k < 3; k++) {
+        g[k] = fc->g[k];
+        lo[k] = fc->lo[k];
+        hi[k] = fc->hi[k];
+        L[k] = fc->L[k];
+        ih[k] = fc->inv_h[k];
+        nc[k] = fc->cells[k];
+        per[k] = fc->per[k];
+        wlo[k] = per[k] ? -INFINITY : fc->ws[2 * k].pos;
+        whi[k] = per[k] ? INFINITY : fc->ws[2 * k + 1].pos;
+        any_wall = any_wall || (k < D && !per[k]);
+    }
+    const int sh = fc->sh;
+    long hits = 0;
+    int bad = 0;
+    for (int b = 0; b < DSMC_SORT_BLOCKS; b++)
+        bcount[b] = 0;
+#pragma omp parallel for schedule(dynamic, 8192) reduction(+ : hits, bcount[:DSMC_SORT_BLOCKS]) \
+    reduction(| : bad) if (n >= DSMC_PARALLEL_MIN)
+    for (long i = 0; i < n; i++) {
+        double x[3], v[3];
+        int out = 0;
+        for (int k = 0; k < D; k++) {
+            x[k] = X[k][i] + V[k][i] * dt + g[k] * hdt2;
+            v[k] = V[k][i] + g[k] * dt;
+            if (per[k]) {
+                if (x[k] < lo[k])
+                    x[k] += L[k];
+                else if (x[k] >= hi[k])
+                    x[k] -= L[k];
+                if (!(x[k] >= lo[k] && x[k] < hi[k])) /* more than a box in one step */
+                    x[k] -= L[k] * floor((x[k] - lo[k]) / L[k]);
+            } else {
+                out |= x[k] < wlo[k] || x[k] > whi[k];
+            }
+        }
+        if (any_wall && out)
+            hits += walls_one(s, fc, D, i, x, v);
+        size_t c = 0;
+        double chk = 0;
+        for (int k = D - 1; k >= 0; k--) {
+            X[k][i] = x[k];
+            V[k][i] = v[k];
+            chk += x[k] + v[k];
+            double f = (x[k] - lo[k]) * ih[k];
+            int ci = f < 0 ? 0 : f >= nc[k] ? nc[k] - 1 : (int)f;
+            c = c * (size_t)nc[k] + (size_t)ci;
+        }
+        bad |= !isfinite(chk);
+        cell[i] = (uint32_t)c;
+        bcount[c >> sh]++;
+    }
+    return (flight_totals){hits, bad};
+}
+
+/* Moves every particle, finds its cell and counts the particles per sort range (bcount). */
+static flight_totals flight(dsmc_scene *s, double dt, size_t bcount[DSMC_SORT_BLOCKS])
+{
+    flight_consts fc;
+    memset(&fc, 0, sizeof fc);
+    fc.dt = dt;
+    fc.hdt2 = 0.5 * dt * dt;
+    for (int k = 0; k < 3; k++) {
+        fc.g[k] = s->def.gravity[k];
+        fc.lo[k] = s->def.lo[k];
+        fc.hi[k] = s->def.hi[k];
+        fc.L[k] = fc.hi[k] - fc.lo[k];
+        fc.inv_h[k] = s->inv_h[k];
+        fc.cells[k] = s->def.cells[k];
+        fc.per[k] = s->def.periodic[k];
+    }
+    for (int side = 0; side < 6; side++) {
+        fc.ws[side].active = side < 2 * s->D && !s->def.periodic[side / 2];
+        if (fc.ws[side].active)
+            dsmc_wall_motion(s, side, s->t + dt, &fc.ws[side].pos, &fc.ws[side].vel);
+    }
+    fc.sh = block_shift(s->ncells);
+    fc.seed = s->def.seed;
+    fc.step = (uint64_t)s->steps;
+    return s->D == 2 ? flight_dim(s, &fc, bcount, 2) : flight_dim(s, &fc, bcount, 3);
+}
+
+/* ---- collisions (Eq. 1) ----------------------------------------------------------------------- */
+typedef struct collide_totals {
+    long attempts, collisions, raised, overpacked;
+} collide_totals;
+
+/* Post-collision velocities: the normal component of g = v_i - v_j reversed and scaled by e, the
+ * tangential one kept; n from the random impact parameter b (|b| < 2R): sin(theta) = b / 2R is
+ * the angle between g and n. 2D: b uniform in [-2R, 2R]. */
+static inline void collide_2d(double *vi, double *vj, double gx, double gy, double g, double e1h,
+                              rng *r)
+{
+    double sn = 2 * rng_uniform(r) - 1, cs = sqrt(1 - sn * sn);
+    double nx = (cs * gx - sn * gy) / g, ny = (cs * gy + sn * gx) / g;
+    double f = e1h * g * cs; /* (1 + e)/2 (g . n) */
+    vi[0] -= f * nx;
+    vi[1] -= f * ny;
+    vj[0] += f * nx;
+    vj[1] += f * ny;
+}
+
+/* 3D: b uniform over the disk of radius 2R: (a, b) uniform in the unit disk (rejection), so
+ * sin^2(theta) = a^2 + b^2 is uniform in [0, 1]. */
+static inline void collide_3d(double *vi, double *vj, const double gv[3], double g, double e1h,
+                              rng *r)
+{
+    double u[3] = {gv[0] / g, gv[1] / g, gv[2] / g}, e1[3];
+    if (fabs(u[0]) < 0.6) { /* u x (1, 0, 0) */
+        e1[0] = 0;
+        e1[1] = u[2];
+        e1[2] = -u[1];
+    } else { /* u x (0, 1, 0) */
+        e1[0] = -u[2];
+        e1[1] = 0;
+        e1[2] = u[0];
+    }
+    double l = 1 / sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
+    e1[0] *= l;
+    e1[1] *= l;
+    e1[2] *= l;
+    double e2[3] = {u[1] * e1[2] - u[2] * e1[1], u[2] * e1[0] - u[0] * e1[2],
+                    u[0] * e1[1] - u[1] * e1[0]};
+    double a, b, s2;
+    do {
+        a = 2 * rng_uniform(r) - 1;
+        b = 2 * rng_uniform(r) - 1;
+        s2 = a * a + b * b;
+    } while (s2 >= 1);
+    double cs = sqrt(1 - s2), f = e1h * g * cs;
+    for (int k = 0; k < 3; k++) {
+        double nk = cs * u[k] + a * e1[k] + b * e2[k];
+        vi[k] -= f * nk;
+        vj[k] += f * nk;
+    }
+}
+
+static collide_totals collide(dsmc_scene *s, double dt)
+{
+    const int D = s->D;
+    const long nc = (long)s->ncells;
+    const size_t *start = s->start;
+    double *rem = s->remainder;
+    double *V[3] = {s->v[0], s->v[1], s->v[2]};
+    const double e1h = 0.5 * (1 + s->def.restitution);
+    const double base = s->sigma * dt / 2, Vc = s->cell_volume;
+    const double vb = s->vpart, rcp = s->def.packing_limit;
+    const dsmc_excluded excl = s->def.excluded;
+    const uint64_t seed = s->def.seed, step = (uint64_t)s->steps;
+    long attempts = 0, collisions = 0, raised = 0, overpacked = 0;
+#pragma omp parallel for schedule(dynamic, 64) \
+    reduction(+ : attempts, collisions, raised, overpacked) if (s->n >= DSMC_PARALLEL_MIN)
+    for (long c = 0; c < nc; c++) {
+        size_t a = start[c], N = start[c + 1] - a;
+        if (N < 2)
+            continue;
+        /* v_max: twice the largest speed about the cell's mean velocity bounds every pair's
+         * relative speed at the start of the step; raised when a collision exceeds it. */
+        double u[3] = {0, 0, 0};
+        for (int k = 0; k < D; k++) {
+            const double *vk = V[k] + a;
+            double sum = 0;
+            for (size_t i = 0; i < N; i++)
+                sum += vk[i];
+            u[k] = sum / (double)N;
+        }
+        double m2 = 0;
+        for (size_t i = 0; i < N; i++) {
+            double q = 0;
+            for (int k = 0; k < D; k++) {
+                double d = V[k][a + i] - u[k];
+                q += d * d;
+            }
+            m2 = q > m2 ? q : m2;
+        }
+        double vmax = 2 * sqrt(m2);
+        if (vmax == 0)
+            continue;
+        double Nd = (double)N, Veff = Vc, chi = 1;
+        if (excl == DSMC_EXCLUDED_FREE_VOLUME) {
+            Veff = Vc - Nd * vb / rcp;
+            if (Veff < 0.01 * Vc) {
+                Veff = 0.01 * Vc;
+                overpacked++;
+            }
+        } else if (excl == DSMC_EXCLUDED_ENSKOG) {
+            double nu = Nd * vb / Vc;
+            if (nu > 0.99 * rcp) {
+                nu = 0.99 * rcp;
+                overpacked++;
+            }
+            chi = D == 2 ? (1 - 7 * nu / 16) / ((1 - nu) * (1 - nu))
+                         : (1 - nu / 2) / ((1 - nu) * (1 - nu) * (1 - nu));
+        }
+        double M = Nd * (Nd - 1) * base * vmax * chi / Veff + rem[c];
+        double Mi = floor(M);
+        rem[c] = M - Mi;
+        long m = (long)Mi;
+        if (m == 0)
+            continue;
+        rng r;
+        dsmc_stream(&r, seed, STREAM_COLLIDE, step, (uint64_t)c);
+        attempts += m;
+        for (long t = 0; t < m; t++) {
+            size_t i = a + rng_below(&r, N), j = a + rng_below(&r, N - 1);
+            if (j >= i)
+                j++;
+            double gv[3] = {0, 0, 0}, g2 = 0;
+            for (int k = 0; k < D; k++) {
+                gv[k] = V[k][i] - V[k][j];
+                g2 += gv[k] * gv[k];
+            }
+            if (g2 > vmax * vmax) {
+                vmax = sqrt(g2);
+                raised++;
+            }
+            double z = rng_uniform(&r) * vmax;
+            if (z * z >= g2 || g2 == 0)
+                continue;
+            collisions++;
+            double g = sqrt(g2);
+            if (D == 2) {
+                double vi[2] = {V[0][i], V[1][i]}, vj[2] = {V[0][j], V[1][j]};
+                collide_2d(vi, vj, gv[0], gv[1], g, e1h, &r);
+                V[0][i] = vi[0];
+                V[1][i] = vi[1];
+                V[0][j] = vj[0];
+                V[1][j] = vj[1];
+            } else {
+                double vi[3], vj[3];
+                for (int k = 0; k < 3; k++) {
+                    vi[k] = V[k][i];
+                    vj[k] = V[k][j];
+                }
+                collide_3d(vi, vj, gv, g, e1h, &r);
+                for (int k = 0; k < 3; k++) {
+                    V[k][i] = vi[k];
+                    V[k][j] = vj[k];
+                }
+            }
+        }
+    }
+    return (collide_totals){attempts, collisions, raised, overpacked};
+}
+
+/* ---- the run ---------------------------------------------------------------------------------- */
+core_status dsmc_run(dsmc_scene *s, const dsmc_run_def *run, long *done, core_error *err)
+{
+    *done = 0;
+    if (!(run->dt > 0) || !isfinite(run->dt))
+        return core_fail(err, CORE_ERR_ARG, "dt must be positive, got %g", run->dt);
+    if (run->steps < 0)
+        return core_fail(err, CORE_ERR_ARG, "steps must be >= 0, got %ld", run->steps);
+    double c0 = clock_cpu(), w0 = clock_wall();
+    core_status st = CORE_OK;
+    while (*done < run->steps) {
+        if (run->time_end >= 0 && s->t >= run->time_end * (1 - 1e-14))
+            break;
+        if (interrupt_pending()) {
+            st = core_fail(err, CORE_ERR_INTERRUPTED,
+                           "interrupted at step %ld (t = %.6g s); the scene is intact", s->steps,
+                           s->t);
+            break;
+        }
+        double dt = run->dt;
+        if (run->time_end >= 0 && s->t + dt > run->time_end)
+            dt = run->time_end - s->t;
+        size_t bcount[DSMC_SORT_BLOCKS];
+        flight_totals ft = flight(s, dt, bcount);
+        if (ft.bad) {
+            st = core_fail(err, CORE_ERR_UNSTABLE,
+                           "step %ld (t = %.6g s): a particle's position or velocity is not "
+                           "finite", s->steps, s->t);
+            break;
+        }
+        sort_counted(s, bcount);
+        collide_totals ct = collide(s, dt);
+        s->t += dt;
+        s->steps++;
+        ++*done;
+        s->stats.steps++;
+        s->stats.particle_moves += (double)s->n;
+        s->stats.wall_hits += (double)ft.wall_hits;
+        s->stats.attempts += (double)ct.attempts;
+        s->stats.collisions += (double)ct.collisions;
+        s->stats.vmax_raised += (double)ct.raised;
+        s->stats.cells_overpacked += (double)ct.overpacked;
+        s->stats.time += dt;
+        s->total_collisions += (double)ct.collisions;
+    }
+    s->stats.cpu_s += clock_cpu() - c0;
+    s->stats.wall_s += clock_wall() - w0;
+    return st;
+}
+
+void dsmc_get_stats(const dsmc_scene *s, dsmc_stats *out) { *out = s->stats; }
+void dsmc_reset_stats(dsmc_scene *s) { memset(&s->stats, 0, sizeof s->stats); }
