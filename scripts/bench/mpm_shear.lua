@@ -31,7 +31,7 @@ for i = 1, #pk.x do
   local g = m:add_disk{ center = { pk.x[i], pk.y[i] }, radius = pk.r[i], material = hmx, points_per_cell = 2, clip = true }
   if pk.x[i] - pk.r[i] < h then m:prescribe(g, { 0, 0 }) elseif pk.x[i] + pk.r[i] > L - h then m:prescribe(g, { 0, v }) end
 end
-if model == "friction" then m:contact{ model = "friction", mu = 0.3 } end
+if model == "friction" then m:contact{ model = "friction", mu = 0.3, normals = params.normals } end
 local np = m:info().points
 grainlab.threads(params.prep_threads or 1)
 m:run{ steps = warm, dt = dt, progress = false }

@@ -35,24 +35,26 @@ double mpm_wave_speed(const mpm_material *m)
     return sqrt((m->bulk + 4.0 / 3.0 * m->shear) / m->density);
 }
 
-/* Principal directions of the in-plane block [a b; b c]: eigenvalues l1 >= l2, angle of the
- * first eigenvector. */
-static void eig2(double a, double b, double c, double *l1, double *l2, double *cs, double *sn)
+/* The in-plane block [a b; b c]: eigenvalues l1 >= l2 and, for the first eigenvector at angle
+ * th, dir = {cos^2 th, sin^2 th, cos th sin th}, from cos 2th = (a - c) / 2r, sin 2th = b / r
+ * (no trigonometric calls). */
+static void eig2(double a, double b, double c, double *l1, double *l2, double dir[3])
 {
     double mean = 0.5 * (a + c), half = 0.5 * (a - c);
     double r = sqrt(half * half + b * b);
     *l1 = mean + r;
     *l2 = mean - r;
-    double th = 0.5 * atan2(2 * b, a - c);
-    *cs = cos(th);
-    *sn = sin(th);
+    double c2t = r > 0 ? half / r : 1, s2t = r > 0 ? b / r : 0;
+    dir[0] = 0.5 * (1 + c2t);
+    dir[1] = 0.5 * (1 - c2t);
+    dir[2] = 0.5 * s2t;
 }
 
 /* Principal log strains of b_e (eps_i = ln(lambda_i) / 2) and the principal directions. */
-static bool log_strains(const double be[4], double eps[3], double *cs, double *sn)
+static bool log_strains(const double be[4], double eps[3], double dir[3])
 {
     double l1, l2;
-    eig2(be[0], be[1], be[2], &l1, &l2, cs, sn);
+    eig2(be[0], be[1], be[2], &l1, &l2, dir);
     if (!(l2 > 0) || !(be[3] > 0))
         return false;
     eps[0] = 0.5 * log(l1);
@@ -63,8 +65,8 @@ static bool log_strains(const double be[4], double eps[3], double *cs, double *s
 
 double mpm_elastic_energy_density(const mpm_material *m, const double be[4])
 {
-    double eps[3], cs, sn;
-    if (!log_strains(be, eps, &cs, &sn))
+    double eps[3], dir[3];
+    if (!log_strains(be, eps, dir))
         return NAN;
     double ev = eps[0] + eps[1] + eps[2], e2 = 0;
     for (int i = 0; i < 3; i++) {
@@ -85,8 +87,8 @@ bool mpm_material_update(const mpm_material *m, const double f[4], double be[4],
     double t10 = f[2] * b00 + f[3] * b01, t11 = f[2] * b01 + f[3] * b11;
     double tr[4] = {t00 * f[0] + t01 * f[1], t00 * f[2] + t01 * f[3], t10 * f[2] + t11 * f[3],
                     be[3]};
-    double eps[3], cs, sn;
-    if (!log_strains(tr, eps, &cs, &sn))
+    double eps[3], dir[3];
+    if (!log_strains(tr, eps, dir))
         return false;
     const double K = m->bulk, G = m->shear;
     double ev = eps[0] + eps[1] + eps[2], e[3], en = 0;
@@ -95,6 +97,7 @@ bool mpm_material_update(const mpm_material *m, const double f[4], double be[4],
         en += e[i] * e[i];
     }
     en = sqrt(en);
+    bool plastic = false;
     if (m->model == MPM_VONMISES && en > 0) {
         /* Radial return: f = |s| - sqrt(2/3) (yield + H eps_p) with s = 2 G e. */
         const double k23 = sqrt(2.0 / 3.0);
@@ -105,6 +108,7 @@ bool mpm_material_update(const mpm_material *m, const double f[4], double be[4],
             for (int i = 0; i < 3; i++)
                 e[i] *= scale;
             *eps_p += k23 * dgamma;
+            plastic = true;
         }
     }
     double tau[3];
@@ -112,13 +116,20 @@ bool mpm_material_update(const mpm_material *m, const double f[4], double be[4],
         eps[i] = e[i] + ev / 3;
         tau[i] = K * ev + 2 * G * e[i];
     }
-    /* Back to tensors: b_e = sum exp(2 eps_i) n_i n_i, tau likewise; sigma = tau / J. */
-    double l1 = exp(2 * eps[0]), l2 = exp(2 * eps[1]);
-    double c2 = cs * cs, s2 = sn * sn, csn = cs * sn;
-    be[0] = l1 * c2 + l2 * s2;
-    be[1] = (l1 - l2) * csn;
-    be[2] = l1 * s2 + l2 * c2;
-    be[3] = exp(2 * eps[2]);
+    /* Back to tensors: b_e = sum exp(2 eps_i) n_i n_i (the trial itself when elastic), tau
+     * likewise; sigma = tau / J. */
+    const double c2 = dir[0], s2 = dir[1], csn = dir[2];
+    if (plastic) {
+        double l1 = exp(2 * eps[0]), l2 = exp(2 * eps[1]);
+        be[0] = l1 * c2 + l2 * s2;
+        be[1] = (l1 - l2) * csn;
+        be[2] = l1 * s2 + l2 * c2;
+        be[3] = exp(2 * eps[2]);
+    } else {
+        be[0] = tr[0];
+        be[1] = tr[1];
+        be[2] = tr[2];
+    }
     double inv_j = 1 / J;
     sigma[0] = (tau[0] * c2 + tau[1] * s2) * inv_j;
     sigma[1] = (tau[0] * s2 + tau[1] * c2) * inv_j;
