@@ -574,16 +574,25 @@ grainlab.doc(pack, { name = "grainlab.pack", doc = [[Packing generators (reprodu
     ramp_stages factors of ramp_steps steps (default: a period of the slowest mode) with the drag
     kept critical (slower and less robust for Hertz piles; kept for comparison).
     Returns {steps, time, drag, dt, t_peak, v_rms, v_max, z, z_no_rattlers (after the final
-    steps), v_rms_settled, v_max_settled, z_settled (before them)}.]] })
--- pack.slab{ size = L, n = 369, diameter = {d_min, d_mean, d_max}, seed = 5, width = 1.8 }
+    steps), v_rms_settled, v_max_settled, z_settled (before them)}.
+  pack.slab{ size = L, n = 369, diameter = {31e-6, 57e-6, 250e-6}, seed = 5, width = 1.8, margin = 0 }
+    a dense polydisperse disk packing of an L x L square periodic in y, for MPM grains (the
+    shear test of Bardenhagen et al., Fig. 5): random placement in a wider slab, compacted with
+    the DEM module by a wall; with margin > 0 the disks overlapping [0, L] of a packing of
+    [-margin, L + margin], cut by the edges. Returns {x, y, r, area_fraction, shrink,
+    mean_radius}.]] })
+-- pack.slab{ size = L, n = 369, diameter = {d_min, d_mean, d_max}, seed = 5, width = 1.8, margin = 0 }
 -- Diameters d_min + an exponential of mean 26/57 d_mean (the shape of the paper's HMX sizes),
--- truncated at min(d_max, 0.45 L) and rescaled so the mean is exactly d_mean; placed at random,
--- largest first, in a slab width x L wide (periodic in y); compacted with the DEM module
+-- truncated at min(d_max, L / 4) (the DEM periodic axis needs 3 neighbour cut-offs) and
+-- rescaled so the mean is exactly d_mean; placed at random, largest first, in a slab width x L wide (periodic in y); compacted with the DEM module
 -- (frictionless soft Hertz disks with drag, the right wall pushed in to x = L); then every radius
--- shrinks by the largest relative overlap left, so no two disks overlap. Returns {x, y, r,
+-- shrinks by the largest relative overlap left, so no two disks overlap, and x is stretched so
+-- the outermost disks touch x = 0 and x = L. With margin > 0 the packing spans [-margin,
+-- L + margin] and only the disks overlapping [0, L] are returned (those across an edge are cut by
+-- it, as in the paper's Fig. 5). Returns {x, y, r,
 -- area_fraction (of the L x L square), shrink, mean_radius}.
 function pack.slab(opts)
-  check_opts("slab", opts, { size = true, n = true, diameter = true, seed = true, width = true })
+  check_opts("slab", opts, { size = true, n = true, diameter = true, seed = true, width = true, margin = true })
   local L = opts.size
   if type(L) ~= "number" or not (L > 0) then fail("slab", "size", "positive number", L) end
   local n = positive_int("slab", opts, "n", 369)
@@ -591,10 +600,13 @@ function pack.slab(opts)
   if type(dd) ~= "table" or #dd ~= 3 or not (dd[1] > 0 and dd[1] < dd[2] and dd[2] < dd[3]) then
     fail("slab", "diameter", "{d_min, d_mean, d_max} with 0 < d_min < d_mean < d_max", dd)
   end
-  local d_min, d_mean, d_max = dd[1], dd[2], math.min(dd[3], 0.45 * L)
+  local d_min, d_mean, d_max = dd[1], dd[2], math.min(dd[3], 0.25 * L)
   local W0 = opts.width or 1.8
   if type(W0) ~= "number" or not (W0 > 1) then fail("slab", "width", "number > 1", W0) end
-  W0 = W0 * L
+  local margin = opts.margin or 0
+  if type(margin) ~= "number" or not (margin >= 0) then fail("slab", "margin", "non-negative number", margin) end
+  local Lp = L + 2 * margin -- packed width; the disks are shifted by -margin at the end
+  W0 = W0 * Lp
   local rng = grainlab.rng{ seed = opts.seed or 5 }
   local d = {}
   for i = 1, n do
@@ -624,7 +636,7 @@ function pack.slab(opts)
     if not ok then error("slab: no room for the disks in the initial slab; use fewer or smaller disks", 2) end
   end
   local soft = grainlab.material{ density = 1900, young = 2e8, poisson = 0.3, friction = 0, restitution = 0.3 }
-  local ds = dem.scene{ box = { { -0.1 * L, 0 }, { W0 + 0.1 * L, L } }, gravity = { 0, 0 }, periodic = { false, true } }
+  local ds = dem.scene{ box = { { -0.1 * Lp, 0 }, { W0 + 0.1 * Lp, L } }, gravity = { 0, 0 }, periodic = { false, true } }
   ds:contact{ normal = "hertz", damping = "viscous" }
   ds:add_wall{ point = { 0, 0 }, normal = { 1, 0 } }
   local right = ds:add_wall{ point = { W0, 0 }, normal = { -1, 0 } }
@@ -632,7 +644,7 @@ function pack.slab(opts)
   local v_wall = 2
   ds:wall_velocity(right, { -v_wall, 0 })
   ds:drag(2e4)
-  ds:run{ time = (W0 - L) / v_wall }
+  ds:run{ time = (W0 - Lp) / v_wall }
   ds:wall_velocity(right, { 0, 0 })
   ds:run{ time = 2e-4 }
   local P = ds:particles()
@@ -645,12 +657,30 @@ function pack.slab(opts)
       if ov > 0 then worst = math.max(worst, ov / (r[i] + r[j])) end
     end
   end
-  local area, rsum = 0, 0
+  -- stretch x so the outermost disks touch x = 0 and x = L (the soft wall contacts and the
+  -- shrink leave a small gap; a stretch >= 1 only moves disks apart)
+  local lo, hi = math.huge, -math.huge
   for i = 1, n do
     r[i] = r[i] * (1 - worst - 1e-3)
-    area, rsum = area + math.pi * r[i] ^ 2, rsum + r[i]
+    lo, hi = math.min(lo, x[i] - r[i]), math.max(hi, x[i] + r[i])
   end
-  return { x = x, y = y, r = r, area_fraction = area / (L * L), shrink = worst + 1e-3, mean_radius = rsum / n }
+  local k = Lp / (hi - lo)
+  if k < 1 then -- the walls were overrun: scale the whole packing (radii too) into [0, Lp]
+    for i = 1, n do r[i] = r[i] * k end
+  end
+  -- keep the disks overlapping [0, L] (with a margin, those across the edges are cut there)
+  local ox, oy, or_, area, rsum = {}, {}, {}, 0, 0
+  for i = 1, n do
+    local xi = (x[i] - lo) * k - margin
+    if xi + r[i] > 0 and xi - r[i] < L then
+      ox[#ox + 1], oy[#oy + 1], or_[#or_ + 1] = xi, y[i], r[i]
+      local a, b = math.max(0, xi - r[i]) - xi, math.min(L, xi + r[i]) - xi -- chord limits
+      local function F(u) u = math.max(-r[i], math.min(r[i], u)); return u * math.sqrt(r[i] ^ 2 - u * u) + r[i] ^ 2 * math.asin(u / r[i]) end
+      area = area + (F(b) - F(a)) -- area of the disk between the edges
+      rsum = rsum + r[i]
+    end
+  end
+  return { x = ox, y = oy, r = or_, area_fraction = area / (L * L), shrink = worst + 1e-3, mean_radius = rsum / #ox }
 end
 
 return pack
