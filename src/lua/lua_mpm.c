@@ -328,12 +328,38 @@ static int add_grain(lua_State *L, const char *call, mpm_shape shape)
                                               "velocity", "omega", "clip", "hydrostatic", NULL};
     static const char *const rect_fields[] = {"lo", "hi", "material", "points_per_cell",
                                               "velocity", "omega", "clip", "hydrostatic", NULL};
+    static const char *const poly_fields[] = {"vertices", "material", "points_per_cell",
+                                              "velocity", "omega", "clip", "hydrostatic", NULL};
     mpm_scene *s = check_scene(L, 1);
     bind_check_table(L, 2, call);
-    bind_check_fields(L, 2, call, shape == MPM_DISK ? disk_fields : rect_fields);
+    bind_check_fields(L, 2, call, shape == MPM_DISK ? disk_fields
+                                  : shape == MPM_RECT ? rect_fields : poly_fields);
     mpm_grain_def g = mpm_default_grain_def();
     g.shape = shape;
-    if (shape == MPM_DISK) {
+    if (shape == MPM_POLYGON) {
+        const char *expected = "array of at least 3 vertices {x, y}";
+        if (lua_getfield(L, 2, "vertices") != LUA_TTABLE || luaL_len(L, -1) < 3)
+            return bind_field_error(L, 2, call, "vertices", expected);
+        int nv = (int)luaL_len(L, -1);
+        double *v = lua_newuserdatauv(L, (size_t)nv * 2 * sizeof *v, 0); /* freed by the GC */
+        for (int i = 0; i < nv; i++) {
+            int ok = lua_rawgeti(L, -2, i + 1) == LUA_TTABLE && luaL_len(L, -1) == 2;
+            for (int a = 0; ok && a < 2; a++) {
+                lua_rawgeti(L, -1, a + 1);
+                v[2 * i + a] = lua_tonumberx(L, -1, &ok);
+                ok = ok && isfinite(v[2 * i + a]);
+                lua_pop(L, 1);
+            }
+            if (!ok)
+                return luaL_error(L, "bad field 'vertices' in argument #1 to '%s' (%s expected, "
+                                  "vertex %d is not a pair of finite numbers)", call, expected,
+                                  i + 1);
+            lua_pop(L, 1);
+        }
+        g.vertices = v;
+        g.nvertices = nv;
+        lua_replace(L, -2); /* keep v on the stack while the grain is added */
+    } else if (shape == MPM_DISK) {
         bind_field_vector(L, 2, call, "center", 2, g.center, BIND_REQUIRED);
         g.radius = bind_field_number(L, 2, call, "radius", 0, BIND_REQUIRED | BIND_POSITIVE);
     } else {
@@ -364,6 +390,7 @@ static int add_grain(lua_State *L, const char *call, mpm_shape shape)
 
 static int l_add_disk(lua_State *L) { return add_grain(L, "add_disk", MPM_DISK); }
 static int l_add_rect(lua_State *L) { return add_grain(L, "add_rect", MPM_RECT); }
+static int l_add_polygon(lua_State *L) { return add_grain(L, "add_polygon", MPM_POLYGON); }
 
 /* ---- contact --------------------------------------------------------------------------------- */
 static int l_contact(lua_State *L)
@@ -815,6 +842,11 @@ void bind_open_mpm(lua_State *L)
          "Both take clip = true (keep only the points inside the grid: grains cut by an edge) "
          "and hydrostatic = true (initial static pressure with grad p = rho g, p = 0 at the "
          "grain's top, the paper's incline)."},
+        {"add_polygon", l_add_polygon,
+         "m:add_polygon{ vertices = {{x1, y1}, {x2, y2}, ...}, material = mat, points_per_cell = 2, "
+         "velocity =, omega =, clip =, hydrostatic = }",
+         "Fills a simple polygon (either orientation, at least 3 vertices) with points like "
+         "add_disk (angular grains); returns the grain id."},
         {"prescribe", l_prescribe, "m:prescribe(grain, {vx, vy})",
          "The grain moves rigidly at {vx, vy} from now on: every node its points touch takes "
          "that velocity, so its neighbours meet a moving rigid body through the contact rule "

@@ -114,12 +114,15 @@ bool mpm_material_update(const mpm_material *m, const double f[4], double be[4],
 double mpm_elastic_energy_density(const mpm_material *m, const double be[4]);
 
 /* ---- grains ---------------------------------------------------------------------------------- */
-typedef enum mpm_shape { MPM_DISK, MPM_RECT } mpm_shape;
+typedef enum mpm_shape { MPM_DISK, MPM_RECT, MPM_POLYGON } mpm_shape;
 
 typedef struct mpm_grain_def {
     mpm_shape shape;
     double center[2], radius; /* MPM_DISK */
     double lo[2], hi[2];      /* MPM_RECT */
+    const double *vertices;   /* MPM_POLYGON: x0, y0, x1, y1, ... (a simple polygon, either
+                               * orientation; read during mpm_add_grain only) */
+    int nvertices;
     int material;
     int points_per_cell;      /* n: the cell is split into n x n sub-cells, a point at the centre
                                * of each sub-cell inside the shape (paper: n = 2 or 3) */

@@ -313,6 +313,16 @@ static bool inside(const mpm_grain_def *g, double x, double y)
         double dx = x - g->center[0], dy = y - g->center[1];
         return dx * dx + dy * dy <= g->radius * g->radius;
     }
+    if (g->shape == MPM_POLYGON) { /* crossing number */
+        bool in = false;
+        const double *v = g->vertices;
+        for (int i = 0, j = g->nvertices - 1; i < g->nvertices; j = i++) {
+            const double xi = v[2 * i], yi = v[2 * i + 1], xj = v[2 * j], yj = v[2 * j + 1];
+            if ((yi > y) != (yj > y) && x < xi + (y - yi) * (xj - xi) / (yj - yi))
+                in = !in;
+        }
+        return in;
+    }
     return x >= g->lo[0] && x <= g->hi[0] && y >= g->lo[1] && y <= g->hi[1];
 }
 
@@ -329,7 +339,32 @@ long mpm_add_grain(mpm_scene *s, const mpm_grain_def *g, core_error *err)
         return -1;
     }
     double lo[2], hi[2];
-    if (g->shape == MPM_DISK) {
+    if (g->shape == MPM_POLYGON) {
+        if (g->nvertices < 3 || !g->vertices) {
+            core_fail(err, CORE_ERR_ARG, "a polygon needs at least 3 vertices, got %d",
+                      g->nvertices);
+            return -1;
+        }
+        double area = 0;
+        lo[0] = lo[1] = INFINITY;
+        hi[0] = hi[1] = -INFINITY;
+        for (int i = 0, j = g->nvertices - 1; i < g->nvertices; j = i++) {
+            const double *v = g->vertices;
+            if (!isfinite(v[2 * i]) || !isfinite(v[2 * i + 1])) {
+                core_fail(err, CORE_ERR_ARG, "vertex %d of the polygon is not finite", i + 1);
+                return -1;
+            }
+            area += v[2 * j] * v[2 * i + 1] - v[2 * i] * v[2 * j + 1];
+            for (int a = 0; a < 2; a++) {
+                lo[a] = fmin(lo[a], v[2 * i + a]);
+                hi[a] = fmax(hi[a], v[2 * i + a]);
+            }
+        }
+        if (!(fabs(area) > 0)) {
+            core_fail(err, CORE_ERR_ARG, "the polygon has zero area (collinear vertices)");
+            return -1;
+        }
+    } else if (g->shape == MPM_DISK) {
         if (!(g->radius > 0) || !isfinite(g->radius)) {
             core_fail(err, CORE_ERR_ARG, "radius must be > 0, got %g", g->radius);
             return -1;
@@ -465,6 +500,14 @@ long mpm_add_grain(mpm_scene *s, const mpm_grain_def *g, core_error *err)
             p++;
         }
     s->gdef[s->ngrains] = *g;
+    if (g->shape == MPM_POLYGON) { /* keep the bounding box, not the caller's vertices */
+        s->gdef[s->ngrains].shape = MPM_RECT;
+        for (int a = 0; a < 2; a++) {
+            s->gdef[s->ngrains].lo[a] = lo[a];
+            s->gdef[s->ngrains].hi[a] = hi[a];
+        }
+        s->gdef[s->ngrains].vertices = NULL;
+    }
     s->gstart[s->ngrains] = s->np;
     s->gcount[s->ngrains] = count;
     s->np = p;

@@ -68,6 +68,22 @@ do
   check.eq(#f.values, 100, "field: one value per cell")
 end
 
+-- polygons: a triangle's mass and centroid (16 points per cell: within 0.2% and 2e-4 m), bad vertices
+do
+  local pm = mpm.scene{ cells = { 20, 20 }, size = { 2, 2 } }
+  local mt = mpm.material{ density = 1000, shear = 1e5, bulk = 1e5 }
+  local t = pm:add_polygon{ vertices = { { 0.5, 0.5 }, { 1.5, 0.5 }, { 1.0, 1.366 } }, material = mt, points_per_cell = 4 }
+  local gi = pm:grain(t)
+  check.near(gi.mass, 1000 * 0.5 * 0.866, 0.002, "triangle mass")
+  check.near_abs(gi.center[2], (0.5 + 0.5 + 1.366) / 3, 2e-4, "triangle centroid")
+  check.errors(function() pm:add_polygon{ vertices = { { 0, 0 }, { 1, 1 }, { 2, 2 } }, material = mt } end,
+    "add_polygon: the polygon has zero area (collinear vertices)", "collinear polygon")
+  check.errors(function() pm:add_polygon{ vertices = { { 0, 0 }, { 1, 1 } }, material = mt } end,
+    "bad field 'vertices' in argument #1 to 'add_polygon' (array of at least 3 vertices {x, y} expected", "two vertices")
+  check.errors(function() pm:add_polygon{ vertices = { { 0, 0 }, { 1, 1 }, { 1, 0 / 0 } }, material = mt } end,
+    "vertex 3 is not a pair of finite numbers", "NaN vertex")
+end
+
 -- grains
 check.errors(function() m:add_disk{ center = { 0.5, 0.5 }, radius = 0.2, material = mat, points_per_cell = 0 } end,
   "bad field 'points_per_cell' in argument #1 to 'add_disk' (integer in [1, 64] expected, got 0)", "points per cell < 1")
