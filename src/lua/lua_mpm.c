@@ -120,7 +120,7 @@ static int material_tostring(lua_State *L)
 static const char *const WALL_NAMES[] = {"noslip", "slip", "none", "friction", NULL};
 static const char *const SHAPE_NAMES[] = {"linear", "bspline", NULL};
 static const char *const NORMAL_NAMES[] = {"averaged", "own", "linear", NULL};
-static const char *const UPDATE_NAMES[] = {"usl", "musl", NULL};
+static const char *const UPDATE_NAMES[] = {"usl", "musl", "usf", NULL};
 
 static void read_pair(lua_State *L, int arg, const char *field, const char *expected, int *is_int,
                       double out[2], int required)
@@ -935,7 +935,7 @@ void bind_open_mpm(lua_State *L)
         {"scene", l_scene,
          "mpm.scene{ cells = {nx, ny}, size = {Lx, Ly}, origin = {0, 0}, periodic = {false, "
          "false}, gravity = {0, 0}, walls = 'noslip'|'slip'|'none'|{kind =, mu =, velocity =}|"
-         "{left =, right =, bottom =, top =}, update = 'musl'|'usl', pic = 0, "
+         "{left =, right =, bottom =, top =}, update = 'musl'|'usl'|'usf', pic = 0, "
          "shape = 'linear'|'bspline' }",
          "A new 2D (plane strain) MPM scene on a uniform grid of nx x ny cells. walls: the grid's "
          "boundary nodes on axes that are not periodic — 'noslip' fixes them (default), 'slip' "

@@ -101,6 +101,8 @@ core_status mpm_create(const mpm_scene_def *def, mpm_scene **out, core_error *er
         if ((unsigned)def->walls[k] > MPM_WALL_FRICTION)
             return core_fail(err, CORE_ERR_ARG, "unknown wall kind %d", (int)def->walls[k]);
     }
+    if ((unsigned)def->update > MPM_USF)
+        return core_fail(err, CORE_ERR_ARG, "unknown update order %d", (int)def->update);
     if (!(def->wall_gap >= 0) || !isfinite(def->wall_gap))
         return core_fail(err, CORE_ERR_ARG, "wall_gap must be finite and >= 0, got %g",
                          def->wall_gap);

@@ -828,9 +828,75 @@ static void remap(mpm_scene *s, double dt, int t)
     }
 }
 
+/* USF, before the stress update: v_i^n = p_i / m_i on the centre-of-mass nodes and the grain
+ * entries, the walls, and the contact rule on it (Eq. 12 decided here; the momentum update
+ * decides again). The result goes to nax, nay, which the stress update reads. */
+static void usf_velocity(mpm_scene *s, double dt)
+{
+    const size_t ne = s->nnodes + s->npairs;
+#pragma omp for schedule(static)
+    for (size_t i = 0; i < ne; i++) {
+        const double m = s->nm[i];
+        s->nax[i] = m > 0 ? s->npx[i] / m : 0;
+        s->nay[i] = m > 0 ? s->npy[i] / m : 0;
+    }
+    apply_walls(s, s->nax, s->nay, true);
+    if (s->npairs) {
+        apply_walls_pairs(s, s->nax, s->nay, true);
+#pragma omp master
+        contact_correct(s, s->nax, s->nay, true, dt);
+#pragma omp barrier
+    }
+}
+
+/* USF, after the stress update: the internal force (Eq. 7) and gravity again, from the new
+ * stress, into the entries each point feeds (sf); at shared nodes the centre of mass takes the
+ * sum of the grains' forces. Noslip scatters into thread buffers. */
+static void usf_forces(mpm_scene *s, int t)
+{
+    const size_t nn = s->nnodes, ne = s->nnodes + s->npairs;
+    const int ns = s->ns;
+    const bool friction = s->contact == MPM_CONTACT_FRICTION;
+    const double gx0 = s->def.gravity[0], gy0 = s->def.gravity[1];
+    double *const main[2] = {s->nfx, s->nfy};
+    double *f[2] = {s->nfx, s->nfy};
+    if (friction) {
+#pragma omp for schedule(static)
+        for (size_t i = 0; i < ne; i++)
+            s->nfx[i] = s->nfy[i] = 0;
+    } else {
+        thread_arrays(s, t, main, 2, f);
+        memset(f[0], 0, nn * sizeof(double));
+        memset(f[1], 0, nn * sizeof(double));
+    }
+    for (size_t p = s->tp[t]; p < s->tp[t + 1]; p++) {
+        const double m = s->m[p];
+        const double V = s->v0[p] * (s->F[0][p] * s->F[3][p] - s->F[1][p] * s->F[2][p]);
+        const double sxx = V * s->sig[0][p], syy = V * s->sig[1][p], sxy = V * s->sig[2][p];
+        const int *n = &s->sf[ns * p];
+        const double *w = &s->sw[ns * p], *gx = &s->sgx[ns * p], *gy = &s->sgy[ns * p];
+        for (int k = 0; k < ns; k++) {
+            f[0][n[k]] += w[k] * m * gx0 - (sxx * gx[k] + sxy * gy[k]);
+            f[1][n[k]] += w[k] * m * gy0 - (sxy * gx[k] + syy * gy[k]);
+        }
+    }
+    if (friction) {
+#pragma omp barrier
+#pragma omp master
+        for (size_t q = 0; q < s->npairs; q++)
+            if (s->ngr[s->pnode[q]] > 1) {
+                s->nfx[s->pnode[q]] += s->nfx[nn + q];
+                s->nfy[s->pnode[q]] += s->nfy[nn + q];
+            }
+#pragma omp barrier
+    } else {
+        reduce_buffers(s, main, 2);
+    }
+}
+
 /* Step 3, continued: velocity gradient L = sum_i v_i G_pi, F <- (I + dt L) F, stress update.
  * Returns the first point that inverts, or (size_t)-1. */
-static size_t constitutive(mpm_scene *s, double dt, int t)
+static size_t constitutive(mpm_scene *s, double dt, int t, const double *vx, const double *vy)
 {
     size_t bad = (size_t)-1;
     const int ns = s->ns;
@@ -840,10 +906,10 @@ static size_t constitutive(mpm_scene *s, double dt, int t)
         double L[4] = {0, 0, 0, 0};
         for (int k = 0; k < ns; k++) {
             const int i = n[k];
-            L[0] += s->nax[i] * gx[k];
-            L[1] += s->nax[i] * gy[k];
-            L[2] += s->nay[i] * gx[k];
-            L[3] += s->nay[i] * gy[k];
+            L[0] += vx[i] * gx[k];
+            L[1] += vx[i] * gy[k];
+            L[2] += vy[i] * gx[k];
+            L[3] += vy[i] * gy[k];
         }
         double f[4] = {1 + dt * L[0], dt * L[1], dt * L[2], 1 + dt * L[3]};
         double F0 = s->F[0][p], F1 = s->F[1][p], F2 = s->F[2][p], F3 = s->F[3][p];
@@ -936,7 +1002,7 @@ core_status mpm_run(mpm_scene *s, const mpm_run_def *run, long *done, core_error
     mpm_timestep ts;
     if ((st = mpm_timestep_info(s, run->cfl > 0 && run->cfl <= 1 ? run->cfl : 1, &ts, err)))
         return st;
-    const bool musl = s->def.update == MPM_MUSL;
+    const bool musl = s->def.update == MPM_MUSL, usf = s->def.update == MPM_USF;
     size_t tbad[64];
     while (*done < run->steps) {
         if (run->time_end >= 0 && s->time >= run->time_end * (1 - 1e-14))
@@ -965,6 +1031,13 @@ core_status mpm_run(mpm_scene *s, const mpm_run_def *run, long *done, core_error
             if (s->nmx)
                 moments(s);
 #pragma omp barrier
+            tbad[t] = (size_t)-1;
+            if (usf) {
+                usf_velocity(s, dt);
+                tbad[t] = constitutive(s, dt, t, s->nax, s->nay);
+#pragma omp barrier
+                usf_forces(s, t);
+            }
             grid_update(s, dt);
             if (friction)
                 contact_update(s, dt);
@@ -972,7 +1045,8 @@ core_status mpm_run(mpm_scene *s, const mpm_run_def *run, long *done, core_error
 #pragma omp barrier
             if (musl)
                 remap(s, dt, t);
-            tbad[t] = constitutive(s, dt, t);
+            if (!usf)
+                tbad[t] = constitutive(s, dt, t, s->nax, s->nay);
         }
         for (int t = 0; t < s->nt; t++)
             if (tbad[t] != (size_t)-1)
