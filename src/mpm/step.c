@@ -762,76 +762,17 @@ static void to_points(mpm_scene *s, double dt, int t)
         }
 }
 
-/* MUSL: the updated point momenta mapped back (Eq. 5 with v_p^{n+1}) give the nodal velocities
- * the strain increment is taken from; with friction each grain's own field at shared nodes.
- * Inside the parallel region. With friction every entry a point feeds (its grain's pair, or a
- * node only its grain touches) belongs to its thread; noslip scatters into thread buffers. */
-static void remap(mpm_scene *s, double dt, int t)
-{
-    const size_t nn = s->nnodes, ne = s->nnodes + s->npairs;
-    const int ns = s->ns;
-    const bool friction = s->contact == MPM_CONTACT_FRICTION;
-    double *const main[2] = {s->npx, s->npy};
-    double *f[2] = {s->npx, s->npy};
-    if (friction) {
-#pragma omp for schedule(static)
-        for (size_t i = 0; i < ne; i++)
-            s->npx[i] = s->npy[i] = 0;
-    } else {
-        thread_arrays(s, t, main, 2, f);
-        memset(f[0], 0, nn * sizeof(double));
-        memset(f[1], 0, nn * sizeof(double));
-    }
-    for (size_t p = s->tp[t]; p < s->tp[t + 1]; p++) {
-        const double px = s->m[p] * s->vx[p], py = s->m[p] * s->vy[p];
-        const int *n = &s->sf[ns * p];
-        const double *w = &s->sw[ns * p];
-        for (int k = 0; k < ns; k++) {
-            f[0][n[k]] += w[k] * px;
-            f[1][n[k]] += w[k] * py;
-        }
-    }
-    if (friction) {
-#pragma omp barrier
-#pragma omp master
-        /* At shared nodes the points fed their grains' entries; the centre-of-mass momentum is
-         * their sum. */
-        for (size_t q = 0; q < s->npairs; q++)
-            if (s->ngr[s->pnode[q]] > 1) {
-                s->npx[s->pnode[q]] += s->npx[nn + q];
-                s->npy[s->pnode[q]] += s->npy[nn + q];
-            }
-#pragma omp barrier
-    } else {
-        reduce_buffers(s, main, 2);
-    }
-#pragma omp for schedule(static)
-    for (size_t i = 0; i < ne; i++) {
-        double m = s->nm[i];
-        s->nax[i] = m > 0 ? s->npx[i] / m : 0;
-        s->nay[i] = m > 0 ? s->npy[i] / m : 0;
-    }
-    apply_walls(s, s->nax, s->nay, false);
-    if (s->npairs) {
-        apply_walls_pairs(s, s->nax, s->nay, false);
-        /* The point velocities carry the grid-update correction only in part (each point gets a
-         * weighted share), so the remapped grain fields still approach at contacts and are
-         * corrected again, at the pairs that Eq. 12 put in contact at the momentum update. Both
-         * choices were measured on two elastic disks (R = 4 cells) meeting head-on at 0.5 m/s
-         * each, noslip ending with (kinetic + elastic) / initial kinetic = 1.01: no remap
-         * correction: 1.64; remap correction re-deciding Eq. 12 on the remapped field (contact
-         * switching on and off every other step): 1.58; the marks of the momentum update:
-         * 1.03. */
-#pragma omp master
-        contact_correct(s, s->nax, s->nay, false, dt);
-#pragma omp barrier
-    }
-}
-
-/* USF, before the stress update: v_i^n = p_i / m_i on the centre-of-mass nodes and the grain
- * entries, the walls, and the contact rule on it (Eq. 12 decided here; the momentum update
- * decides again). The result goes to nax, nay, which the stress update reads. */
-static void usf_velocity(mpm_scene *s, double dt)
+/* v = p / m on the centre-of-mass nodes and the grain entries, then the walls and the contact
+ * rule: for the MUSL remap with the contact marks of the momentum update (decide = false), for
+ * USF before the stress update with contacts decided on it (the momentum update decides again).
+ * The point velocities carry the grid-update correction only in part (each point gets a weighted
+ * share), so the remapped grain fields still approach at contacts and are corrected again, at
+ * the pairs that Eq. 12 put in contact at the momentum update. Both choices were measured on two
+ * elastic disks (R = 4 cells) meeting head-on at 0.5 m/s each, noslip ending with (kinetic +
+ * elastic) / initial kinetic = 1.01: no remap correction: 1.64; remap correction re-deciding
+ * Eq. 12 on the remapped field (contact switching on and off every other step): 1.58; the marks
+ * of the momentum update: 1.03. */
+static void nodal_velocity(mpm_scene *s, double dt, bool decide)
 {
     const size_t ne = s->nnodes + s->npairs;
 #pragma omp for schedule(static)
@@ -840,30 +781,33 @@ static void usf_velocity(mpm_scene *s, double dt)
         s->nax[i] = m > 0 ? s->npx[i] / m : 0;
         s->nay[i] = m > 0 ? s->npy[i] / m : 0;
     }
-    apply_walls(s, s->nax, s->nay, true);
+    apply_walls(s, s->nax, s->nay, decide);
     if (s->npairs) {
-        apply_walls_pairs(s, s->nax, s->nay, true);
+        apply_walls_pairs(s, s->nax, s->nay, decide);
 #pragma omp master
-        contact_correct(s, s->nax, s->nay, true, dt);
+        contact_correct(s, s->nax, s->nay, decide, dt);
 #pragma omp barrier
     }
 }
 
-/* USF, after the stress update: the internal force (Eq. 7) and gravity again, from the new
- * stress, into the entries each point feeds (sf); at shared nodes the centre of mass takes the
- * sum of the grains' forces. Noslip scatters into thread buffers. */
-static void usf_forces(mpm_scene *s, int t)
+/* Scatters a per-point vector into the entries each point feeds (sf: its grain's entry at shared
+ * nodes, the centre of mass elsewhere) of the arrays a, b: momentum m_p v_p (force = false) or
+ * the internal force and gravity (Eq. 7) from the current stress (force = true); at shared nodes
+ * the centre of mass then takes the sum of the grains' entries. Inside the parallel region. With
+ * friction every entry a point feeds belongs to its thread (its grain's, or a node only its grain
+ * touches); noslip scatters into thread buffers. */
+static void scatter_sf(mpm_scene *s, int t, double *a, double *b, bool force)
 {
     const size_t nn = s->nnodes, ne = s->nnodes + s->npairs;
     const int ns = s->ns;
     const bool friction = s->contact == MPM_CONTACT_FRICTION;
     const double gx0 = s->def.gravity[0], gy0 = s->def.gravity[1];
-    double *const main[2] = {s->nfx, s->nfy};
-    double *f[2] = {s->nfx, s->nfy};
+    double *const main[2] = {a, b};
+    double *f[2] = {a, b};
     if (friction) {
 #pragma omp for schedule(static)
         for (size_t i = 0; i < ne; i++)
-            s->nfx[i] = s->nfy[i] = 0;
+            a[i] = b[i] = 0;
     } else {
         thread_arrays(s, t, main, 2, f);
         memset(f[0], 0, nn * sizeof(double));
@@ -871,27 +815,47 @@ static void usf_forces(mpm_scene *s, int t)
     }
     for (size_t p = s->tp[t]; p < s->tp[t + 1]; p++) {
         const double m = s->m[p];
-        const double V = s->v0[p] * (s->F[0][p] * s->F[3][p] - s->F[1][p] * s->F[2][p]);
-        const double sxx = V * s->sig[0][p], syy = V * s->sig[1][p], sxy = V * s->sig[2][p];
+        double A = m * s->vx[p], B = m * s->vy[p], sxx = 0, syy = 0, sxy = 0;
+        if (force) {
+            const double V = s->v0[p] * (s->F[0][p] * s->F[3][p] - s->F[1][p] * s->F[2][p]);
+            A = m * gx0;
+            B = m * gy0;
+            sxx = V * s->sig[0][p];
+            syy = V * s->sig[1][p];
+            sxy = V * s->sig[2][p];
+        }
         const int *n = &s->sf[ns * p];
         const double *w = &s->sw[ns * p], *gx = &s->sgx[ns * p], *gy = &s->sgy[ns * p];
         for (int k = 0; k < ns; k++) {
-            f[0][n[k]] += w[k] * m * gx0 - (sxx * gx[k] + sxy * gy[k]);
-            f[1][n[k]] += w[k] * m * gy0 - (sxy * gx[k] + syy * gy[k]);
+            f[0][n[k]] += w[k] * A;
+            f[1][n[k]] += w[k] * B;
         }
+        if (force)
+            for (int k = 0; k < ns; k++) {
+                f[0][n[k]] -= sxx * gx[k] + sxy * gy[k];
+                f[1][n[k]] -= sxy * gx[k] + syy * gy[k];
+            }
     }
     if (friction) {
 #pragma omp barrier
 #pragma omp master
         for (size_t q = 0; q < s->npairs; q++)
             if (s->ngr[s->pnode[q]] > 1) {
-                s->nfx[s->pnode[q]] += s->nfx[nn + q];
-                s->nfy[s->pnode[q]] += s->nfy[nn + q];
+                a[s->pnode[q]] += a[nn + q];
+                b[s->pnode[q]] += b[nn + q];
             }
 #pragma omp barrier
     } else {
         reduce_buffers(s, main, 2);
     }
+}
+
+/* MUSL: the updated point momenta mapped back (Eq. 5 with v_p^{n+1}) give the nodal velocities
+ * the strain increment is taken from; with friction each grain's own field at shared nodes. */
+static void remap(mpm_scene *s, double dt, int t)
+{
+    scatter_sf(s, t, s->npx, s->npy, false);
+    nodal_velocity(s, dt, false);
 }
 
 /* Step 3, continued: velocity gradient L = sum_i v_i G_pi, F <- (I + dt L) F, stress update.
@@ -1033,10 +997,10 @@ core_status mpm_run(mpm_scene *s, const mpm_run_def *run, long *done, core_error
 #pragma omp barrier
             tbad[t] = (size_t)-1;
             if (usf) {
-                usf_velocity(s, dt);
+                nodal_velocity(s, dt, true); /* v_i^n, for the stress update */
                 tbad[t] = constitutive(s, dt, t, s->nax, s->nay);
 #pragma omp barrier
-                usf_forces(s, t);
+                scatter_sf(s, t, s->nfx, s->nfy, true); /* forces from the new stress */
             }
             grid_update(s, dt);
             if (friction)
