@@ -128,7 +128,7 @@ for _, model in ipairs(run_models) do
         local f = m:field("psd")
         render.field{ file = string.format("%s_psd_%s.png", out, tag), width = 800, height = 800,
                       values = f.values, nx = f.nx, ny = f.ny, extent = { { 0, 0 }, { L, L } },
-                      colormap = "gray", background = { 0, 0, 0 }, label = "sigma_1 - sigma_2 (Pa)",
+                      colormap = "gray", background = { 0, 0, 0 }, label = "sigma_1 - sigma_2 (Pa)", interpolation = "bilinear",
                       title = string.format("Principal stress difference, %d%% shear (Fig. 7)", math.floor(gamma * 100 + 0.5)) }
       end
     end
