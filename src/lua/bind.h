@@ -117,6 +117,10 @@ struct dem_scene *bind_check_dem_scene(lua_State *L, int idx, const char *call);
 /* Registers the global `mpm` module (lua_mpm.c). */
 void bind_open_mpm(lua_State *L);
 
+/* Registers the global `analysis` module and the boundary-condition methods of dem.scene
+ * (lua_analysis.c); after bind_open_dem. */
+void bind_open_analysis(lua_State *L);
+
 /* Registers the global `render` module (lua_render.c). */
 void bind_open_render(lua_State *L);
 

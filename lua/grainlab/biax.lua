@@ -1,0 +1,278 @@
+-- The biaxial laboratory of Padbidri Ch. 3 (dem-network-cell-framework): sample preparation and
+-- the three boundary conditions over dem.scene:boundary (src/dem/boundary.c) and the Delaunay
+-- continuum (analysis.delaunay).
+--   biax.defaults            Table 3.1 (E 30 GPa, nu 0.3, p 100 kPa, density x 1e5, mu 0.45,
+--                            rate 5e-3/s, dt 1e-5 s, membrane 10 N/mm) and App. A/B laws
+--   biax.prepare{…}          a confined sample: Jodrey-Tory deposition (grainlab.pack.deposit) or
+--                            random addition, copied into a gravity-free, mass-scaled scene, the
+--                            pressure ramped on the Delaunay boundary (all sides) with frictionless
+--                            contacts and drag, then friction on and a drag-free rest
+--   biax.scene(state, cfg)   a scene from a saved state (positions, radii)
+--   biax.setup(state, bc, cfg) a scene with one boundary condition: "pressure" (plates + direct
+--                            pressure on the lateral Delaunay edges), "membrane" (plates + chains
+--                            of frictionless membrane disks on springs carrying the pressure),
+--                            "mbc" (pressure on all sides + minimal-boundary penalty)
+local biax = {}
+
+biax.defaults = {
+  young = 30e9, poisson = 0.3, pressure = 1e5, density = 2650, mass_scale = 1e5,
+  friction = 0.45, rate = 5e-3, dt = 1e-5, rmin = 0.5e-3, rmax = 1e-3, thickness = 1.5e-3,
+  damping_time = 0.002, exponent = 10, membrane_k = 1e4, membrane_radius = 1.2e-3,
+  every = 250, alpha = 1.5, kappa = 20,
+}
+
+local function cfg_of(opts)
+  local c = {}
+  for k, v in pairs(biax.defaults) do c[k] = v end
+  for k, v in pairs(opts or {}) do c[k] = v end
+  c.v_r = 2 * 0.5 * (c.rmin + c.rmax) * c.rate -- Eq. 3.A2: v_R = d eps_rate
+  return c
+end
+biax.config = cfg_of
+
+local function materials(c)
+  local grain = grainlab.material{ density = c.density, young = c.young, poisson = c.poisson,
+                                   friction = c.friction }
+  local membrane = grainlab.material{ density = c.density, young = c.young, poisson = c.poisson,
+                                      friction = 0 }
+  return grain, membrane
+end
+
+-- A gravity-free, mass-scaled scene holding the state's disks (and nothing else).
+function biax.scene(state, c)
+  c = cfg_of(c)
+  local xlo, xhi, ylo, yhi = math.huge, -math.huge, math.huge, -math.huge
+  for i = 1, #state.x do
+    xlo, xhi = math.min(xlo, state.x[i]), math.max(xhi, state.x[i])
+    ylo, yhi = math.min(ylo, state.y[i]), math.max(yhi, state.y[i])
+  end
+  local pad = math.max(xhi - xlo, yhi - ylo)
+  local s = dem.scene{ box = { { xlo - pad, ylo - pad }, { xhi + pad, yhi + pad } },
+                       gravity = { 0, 0 }, thickness = c.thickness }
+  local grain, membrane = materials(c)
+  for i = 1, #state.x do
+    s:add_disk{ pos = { state.x[i], state.y[i] }, radius = state.r[i],
+                material = (state.membrane and state.membrane[i]) and membrane or grain }
+  end
+  s:scale_mass(c.mass_scale)
+  return s, grain, membrane
+end
+
+-- Contact laws: App. A (Hertz, Brilliantov damping, regularised Coulomb with v_R = d rate).
+function biax.contact(s, c, frictionless)
+  c = cfg_of(c)
+  if frictionless then
+    s:contact{ normal = "hertz", damping = "brilliantov", damping_time = c.damping_time }
+  else
+    s:contact{ normal = "hertz", damping = "brilliantov", damping_time = c.damping_time,
+               tangential = "coulomb_regularized", v_r = c.v_r, exponent = c.exponent }
+  end
+end
+
+local function save(s)
+  local P = s:particles()
+  local st = { x = {}, y = {}, r = {} }
+  for i = 1, P.count do st.x[i], st.y[i], st.r[i] = P.x[i], P.y[i], P.radius[i] end
+  return st
+end
+biax.save = save
+
+-- Runs `steps` steps at dt in chunks (the boundary is rebuilt inside the engine every c.every).
+local function run(s, steps, c)
+  return s:run{ steps = steps, dt = c.dt, impact_velocity = 1e-3, progress = false }
+end
+
+-- Deposited (or randomly placed) disks, consolidated under the confining pressure.
+--   n, seed, method = "deposit"|"random", width (m), ramp_steps, rest_steps, and any of
+--   biax.defaults. Returns the state {x, y, r} and a report table.
+function biax.prepare(opts)
+  local c = cfg_of(opts)
+  local n, seed = c.n or 400, c.seed or 1
+  local t0 = grainlab.clock()
+  local rm = 0.5 * (c.rmin + c.rmax)
+  local W = c.width or math.sqrt(n * math.pi * rm * rm / 0.82) -- about square
+  local st
+  if (c.method or "deposit") == "deposit" then
+    local H = 2.5 * W
+    local g = dem.scene{ box = { { -0.01, -0.01 }, { W + 0.01, H } }, gravity = { 0, -9.81 },
+                         thickness = c.thickness }
+    g:contact{ normal = "hertz" }
+    g:add_wall{ point = { 0, 0 }, normal = { 0, 1 } }
+    g:add_wall{ point = { 0, 0 }, normal = { 1, 0 } }
+    g:add_wall{ point = { W, 0 }, normal = { -1, 0 } }
+    local grain = materials(c)
+    -- Jodrey-Tory drops, 8% extra kept off the top (a flat top), no relaxation: the
+    -- consolidation below does it.
+    grainlab.pack.deposit(g, { n = math.ceil(1.08 * n), radius = { c.rmin, c.rmax }, seed = seed,
+                               material = grain, region = { { 0, 0 }, { W, H } }, relax_steps = 0 })
+    local P = g:particles()
+    local order = {}
+    for i = 1, P.count do order[i] = i end
+    table.sort(order, function(a, b) return P.y[a] < P.y[b] end)
+    st = { x = {}, y = {}, r = {} }
+    for k = 1, n do
+      local i = order[k]
+      st.x[k], st.y[k], st.r[k] = P.x[i], P.y[i], P.radius[i]
+    end
+  else
+    local g = dem.scene{ box = { { 0, 0 }, { W * 1.5, W * 1.5 } }, gravity = { 0, 0 },
+                         thickness = c.thickness }
+    grainlab.pack.random(g, { n = n, radius = { c.rmin, c.rmax }, seed = seed })
+    st = save(g)
+  end
+  local s = biax.scene(st, c)
+  biax.contact(s, c, true)
+  -- Pressure ramp on the Delaunay boundary (all sides), frictionless, with drag.
+  s:drag(c.prep_drag or 30)
+  local stages = c.ramp_stages or 10
+  local per = (c.ramp_steps or 20000) // stages
+  for k = 1, stages do
+    s:boundary{ pressure = c.pressure * k / stages, every = c.every, alpha = c.alpha }
+    run(s, per, c)
+  end
+  run(s, c.hold_steps or 10000, c)
+  biax.contact(s, c, false)
+  run(s, c.friction_steps or 5000, c)
+  s:drag(0)
+  run(s, c.rest_steps or 5000, c)
+  local out = save(s)
+  local ke = s:measure("energy").kinetic
+  local mesh = analysis.delaunay(s, { alpha = c.alpha })
+  local stress = mesh:stress(s)
+  local qs = s:quasistatic{ pressure = c.pressure, strain_rate = c.rate }
+  return out, { seconds = grainlab.clock() - t0, kinetic = ke, pressure = stress.mean_pressure,
+                phi = qs.phi, psi = qs.psi, n = n, width = W,
+                coordination = s:measure("coordination").z }
+end
+
+local function bounds(st, ids)
+  local ylo, yhi, xlo, xhi = math.huge, -math.huge, math.huge, -math.huge
+  for _, i in ipairs(ids) do
+    ylo, yhi = math.min(ylo, st.y[i] - st.r[i]), math.max(yhi, st.y[i] + st.r[i])
+    xlo, xhi = math.min(xlo, st.x[i] - st.r[i]), math.max(xhi, st.x[i] + st.r[i])
+  end
+  return xlo, xhi, ylo, yhi
+end
+
+-- Membrane chains left and right, touching the sample, from plate to plate: returns the
+-- extended state and the membrane particle ids (left chain top to bottom, right bottom to top).
+local function add_membrane(st, c, ylo, yhi)
+  local n0, rm = #st.x, c.membrane_radius
+  local new = { x = {}, y = {}, r = {}, membrane = {} }
+  for i = 1, n0 do new.x[i], new.y[i], new.r[i] = st.x[i], st.y[i], st.r[i] end
+  local count = math.max(2, math.floor((yhi - ylo) / (2 * rm) + 0.5))
+  local gap = (yhi - ylo - 2 * rm) / (count - 1)
+  local left, right = {}, {}
+  for side = 1, 2 do
+    for k = 1, count do
+      local y = side == 1 and (yhi - rm - (k - 1) * gap) or (ylo + rm + (k - 1) * gap)
+      local best = side == 1 and math.huge or -math.huge
+      for i = 1, n0 do
+        local dy, R = y - st.y[i], st.r[i] + rm
+        if math.abs(dy) < R then
+          local dx = math.sqrt(R * R - dy * dy) + 1e-9
+          if side == 1 then best = math.min(best, st.x[i] - dx) else best = math.max(best, st.x[i] + dx) end
+        end
+      end
+      local id = #new.x + 1
+      new.x[id], new.y[id], new.r[id], new.membrane[id] = best, y, rm, true
+      if side == 1 then left[#left + 1] = id else right[#right + 1] = id end
+    end
+  end
+  return new, left, right
+end
+
+-- A scene from the prepared state with boundary condition bc. Returns the scene and a table
+-- with: ids (sample particles), plates (wall ids or nil), membrane ids, H0 (plate gap), info.
+function biax.setup(st, bc, opts)
+  local c = cfg_of(opts)
+  local n0 = #st.x
+  local ids = {}
+  for i = 1, n0 do ids[i] = i end
+  local xlo, xhi, ylo, yhi = bounds(st, ids)
+  local lab = { ids = ids, bc = bc, cfg = c }
+  local s
+  if bc == "membrane" then
+    local left, right
+    st, left, right = add_membrane(st, c, ylo, yhi)
+    s = biax.scene(st, c)
+    lab.membrane = {}
+    for _, i in ipairs(left) do lab.membrane[#lab.membrane + 1] = i end
+    for _, i in ipairs(right) do lab.membrane[#lab.membrane + 1] = i end
+    lab.left, lab.right = left, right
+  else
+    s = biax.scene(st, c)
+  end
+  biax.contact(s, c, false)
+  lab.scene = s
+  if bc == "pressure" or bc == "membrane" then
+    local yl, yh = ylo, yhi
+    if bc == "membrane" then -- the membrane disks reach the plates too
+      for _, i in ipairs(lab.membrane) do
+        yl, yh = math.min(yl, st.y[i] - st.r[i]), math.max(yh, st.y[i] + st.r[i])
+      end
+    end
+    lab.plates = { s:add_wall{ point = { 0, yl }, normal = { 0, 1 } },
+                   s:add_wall{ point = { 0, yh }, normal = { 0, -1 } } }
+    lab.H0 = yh - yl
+  end
+  if bc == "pressure" then
+    lab.info = s:boundary{ pressure = c.pressure, every = c.every, alpha = c.alpha, sides = "lateral" }
+  elseif bc == "membrane" then
+    local a, b = {}, {}
+    local si, sj = {}, {}
+    for _, chain in ipairs{ lab.left, lab.right } do
+      for k = 1, #chain - 1 do
+        a[#a + 1], b[#b + 1] = chain[k], chain[k + 1]
+        si[#si + 1], sj[#sj + 1] = chain[k], chain[k + 1]
+      end
+    end
+    lab.info = s:boundary{ mode = "edges", pressure = c.pressure, edges = { a = a, b = b } }
+    s:springs{ i = si, j = sj, k = c.membrane_k }
+    local bottom, top = {}, {}
+    for _, chain in ipairs{ lab.left, lab.right } do
+      local first, last = chain[1], chain[#chain]
+      if st.y[first] < st.y[last] then first, last = last, first end
+      top[#top + 1], bottom[#bottom + 1] = first, last
+    end
+    s:tie{ ids = bottom, wall = lab.plates[1], axis = 2 }
+    s:tie{ ids = top, wall = lab.plates[2], axis = 2 }
+  elseif bc == "mbc" then
+    lab.info = s:boundary{ pressure = c.pressure, every = c.every, alpha = c.alpha,
+                           mbc = { strain_rate = { { 0, 0 }, { 0, -c.rate } },
+                                   mask = { { 0, 1 }, { 1, 1 } }, kappa = c.kappa } }
+    lab.H0 = yhi - ylo
+  else
+    error("biax.setup: bc must be 'pressure', 'membrane' or 'mbc', got " .. tostring(bc), 2)
+  end
+  return s, lab
+end
+
+-- Plates: settle them onto the sample (at rest, with drag) so that they carry p W depth, then
+-- move them at the imposed strain rate. No-op for MBC (its penalty drives the strain).
+function biax.start(lab, settle_steps)
+  local s, c = lab.scene, lab.cfg
+  if lab.plates then
+    s:drag(30)
+    run(s, settle_steps or 2000, c)
+    s:drag(0)
+    local H = s:wall_point(lab.plates[2])[2] - s:wall_point(lab.plates[1])[2]
+    lab.H0 = H
+    local v = 0.5 * c.rate * H
+    s:wall_velocity(lab.plates[1], { 0, v })
+    s:wall_velocity(lab.plates[2], { 0, -v })
+  end
+  lab.t0 = s:info().time
+end
+
+-- Imposed axial strain now (plate gap, or rate x time for MBC), compression positive.
+function biax.axial(lab)
+  local s = lab.scene
+  if lab.plates then
+    local H = s:wall_point(lab.plates[2])[2] - s:wall_point(lab.plates[1])[2]
+    return 1 - H / lab.H0
+  end
+  return lab.cfg.rate * (s:info().time - lab.t0)
+end
+
+return biax
