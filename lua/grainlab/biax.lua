@@ -145,6 +145,41 @@ function biax.prepare(opts)
                 coordination = s:measure("coordination").z }
 end
 
+-- biax.prepare, cached in a file: the same n, seed and preparation give the same sample, so
+-- scripts share it (out/biax_<n>_<seed>.lua by default; cache = false to always prepare).
+function biax.prepared(opts)
+  local c = cfg_of(opts)
+  local path = c.cache
+  if path == nil then path = string.format("out/biax_%d_%d.lua", c.n or 400, c.seed or 1) end
+  if path then
+    local f = io.open(path, "r")
+    if f then
+      f:close()
+      local ok, st = pcall(dofile, path)
+      if ok and type(st) == "table" and st.x and #st.x == (c.n or 400) then
+        return st, st.report or {}, true
+      end
+    end
+  end
+  local st, rep = biax.prepare(opts)
+  if path then
+    local parts = { "return {\n" }
+    for _, k in ipairs{ "x", "y", "r" } do
+      local v = {}
+      for i = 1, #st[k] do v[i] = string.format("%.17g", st[k][i]) end
+      parts[#parts + 1] = k .. " = {" .. table.concat(v, ",") .. "},\n"
+    end
+    parts[#parts + 1] = "report = {"
+    for k, v in pairs(rep) do parts[#parts + 1] = string.format("%s = %.17g, ", k, v) end
+    parts[#parts + 1] = "} }\n"
+    local dir = path:match("^(.*)/[^/]*$")
+    if dir then os.execute("mkdir -p '" .. dir .. "'") end
+    grainlab.write_file(path, table.concat(parts))
+  end
+  st.report = rep
+  return st, rep, false
+end
+
 local function bounds(st, ids)
   local ylo, yhi, xlo, xhi = math.huge, -math.huge, math.huge, -math.huge
   for _, i in ipairs(ids) do
@@ -240,7 +275,8 @@ function biax.setup(st, bc, opts)
   elseif bc == "mbc" then
     lab.info = s:boundary{ pressure = c.pressure, every = c.every, alpha = c.alpha,
                            mbc = { strain_rate = { { 0, 0 }, { 0, -c.rate } },
-                                   mask = { { 0, 1 }, { 1, 1 } }, kappa = c.kappa } }
+                                   mask = { { 0, 1 }, { 1, 1 } }, kappa = c.kappa,
+                                   dt = c.dt } }
     lab.H0 = yhi - ylo
   else
     error("biax.setup: bc must be 'pressure', 'membrane' or 'mbc', got " .. tostring(bc), 2)

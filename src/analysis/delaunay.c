@@ -27,18 +27,8 @@ void analysis_mesh_destroy(analysis_mesh *m)
     free(m);
 }
 
-static const double *sort_x, *sort_y;
-static int by_position(const void *pa, const void *pb)
-{
-    size_t a = *(const size_t *)pa, b = *(const size_t *)pb;
-    if (sort_x[a] != sort_x[b])
-        return sort_x[a] < sort_x[b] ? -1 : 1;
-    if (sort_y[a] != sort_y[b])
-        return sort_y[a] < sort_y[b] ? -1 : 1;
-    return a < b ? -1 : a > b;
-}
-
-/* Refusals before qhull sees the points: non-finite values, exact duplicates, collinearity. */
+/* Refusals before qhull sees the points: non-finite values, collinearity. (Duplicates show up
+ * as points that are no vertex; see duplicate_error.) */
 static core_status check_points(const double *x, const double *y, size_t np, core_error *err)
 {
     if (np < 3)
@@ -48,25 +38,6 @@ static core_status check_points(const double *x, const double *y, size_t np, cor
         if (!isfinite(x[i]) || !isfinite(y[i]))
             return core_fail(err, CORE_ERR_ARG, "particle %zu has a non-finite position (%g, %g)",
                              i + 1, x[i], y[i]);
-    size_t *idx = malloc(np * sizeof *idx);
-    if (!idx)
-        return core_fail(err, CORE_ERR_NOMEM, "out of memory sorting %zu points", np);
-    for (size_t i = 0; i < np; i++)
-        idx[i] = i;
-    sort_x = x;
-    sort_y = y;
-    qsort(idx, np, sizeof *idx, by_position);
-    for (size_t k = 1; k < np; k++) {
-        size_t a = idx[k - 1], b = idx[k];
-        if (x[a] == x[b] && y[a] == y[b]) {
-            free(idx);
-            return core_fail(err, CORE_ERR_ARG,
-                             "particles %zu and %zu have the same position (%g, %g): the "
-                             "triangulation of centres needs distinct points",
-                             (a < b ? a : b) + 1, (a < b ? b : a) + 1, x[a], y[a]);
-        }
-    }
-    free(idx);
     /* Collinear: every point within a relative 1e-12 of the line through the first point and the
      * farthest from it. */
     size_t far = 0;
@@ -202,22 +173,6 @@ static core_status run_qhull(const double *x, const double *y, size_t np, long *
     return CORE_OK;
 }
 
-typedef struct edge_rec {
-    long a, b; /* a < b */
-    long t;
-    int k;
-} edge_rec;
-
-static int by_edge(const void *pa, const void *pb)
-{
-    const edge_rec *a = pa, *b = pb;
-    if (a->a != b->a)
-        return a->a < b->a ? -1 : 1;
-    if (a->b != b->b)
-        return a->b < b->b ? -1 : 1;
-    return (a->t > b->t) - (a->t < b->t);
-}
-
 static int by_value(const void *pa, const void *pb)
 {
     double a = *(const double *)pa, b = *(const double *)pb;
@@ -241,6 +196,30 @@ static double median_edge(const double *x, const double *y, const long *tri, siz
     return m;
 }
 
+/* Particle i is no vertex of the triangulation: name its twin (exact, else the nearest). */
+static core_status duplicate_error(const double *x, const double *y, size_t np, size_t i,
+                                   core_error *err)
+{
+    size_t best = i;
+    double d2min = INFINITY;
+    for (size_t j = 0; j < np; j++) {
+        double dx = x[j] - x[i], dy = y[j] - y[i], d2 = dx * dx + dy * dy;
+        if (j != i && d2 < d2min) {
+            d2min = d2;
+            best = j;
+        }
+    }
+    size_t a = i < best ? i : best, b = i < best ? best : i;
+    if (d2min == 0)
+        return core_fail(err, CORE_ERR_ARG,
+                         "particles %zu and %zu have the same position (%g, %g): the "
+                         "triangulation of centres needs distinct points", a + 1, b + 1, x[i], y[i]);
+    return core_fail(err, CORE_ERR_ARG,
+                     "particle %zu at (%g, %g) is not a vertex of the triangulation: it nearly "
+                     "coincides with particle %zu (%.3g apart)", i + 1, x[i], y[i], best + 1,
+                     sqrt(d2min));
+}
+
 core_status analysis_delaunay(const double *x, const double *y, size_t np,
                               const analysis_delaunay_def *def, analysis_mesh **out,
                               core_error *err)
@@ -261,12 +240,13 @@ core_status analysis_delaunay(const double *x, const double *y, size_t np,
      * of another. */
     unsigned char *used = calloc(np, 1);
     long *bcount = calloc(np, sizeof *bcount);
-    edge_rec *e = malloc(3 * nt * sizeof *e);
+    size_t *inc_start = calloc(np + 1, sizeof *inc_start), *fill = calloc(np, sizeof *fill);
+    long *inc = malloc(3 * nt * sizeof *inc);
     long *nb = malloc(3 * nt * sizeof *nb);
     unsigned char *alive = malloc(nt);
     long *stack = malloc(nt * sizeof *stack);
     analysis_mesh *m = calloc(1, sizeof *m);
-    if (!used || !bcount || !e || !nb || !alive || !stack || !m) {
+    if (!used || !bcount || !inc_start || !fill || !inc || !nb || !alive || !stack || !m) {
         st = core_fail(err, CORE_ERR_NOMEM, "out of memory for the mesh of %zu particles", np);
         goto done;
     }
@@ -274,27 +254,30 @@ core_status analysis_delaunay(const double *x, const double *y, size_t np,
         used[tri[k]] = 1;
     for (size_t i = 0; i < np; i++)
         if (!used[i]) {
-            st = core_fail(err, CORE_ERR_ARG,
-                           "particle %zu at (%g, %g) is not a vertex of the triangulation: it "
-                           "nearly coincides with another particle", i + 1, x[i], y[i]);
+            st = duplicate_error(x, y, np, i, err);
             goto done;
         }
 
-    /* Neighbours across each edge k = (v[k], v[k+1]). */
+    /* Neighbours across each edge k = (v[k], v[k+1]): the other triangle at vertex a that
+     * also has b (triangles per vertex in CSR lists; a vertex has about 6). */
+    for (size_t q = 0; q < 3 * nt; q++)
+        inc_start[tri[q] + 1]++;
+    for (size_t i = 0; i < np; i++)
+        inc_start[i + 1] += inc_start[i];
+    for (size_t q = 0; q < 3 * nt; q++)
+        inc[fill[tri[q]]++ + inc_start[tri[q]]] = (long)(q / 3);
     for (size_t t = 0; t < nt; t++) {
         alive[t] = 1;
         for (int k = 0; k < 3; k++) {
-            long a = tri[3 * t + k], b = tri[3 * t + (k + 1) % 3];
-            e[3 * t + k] = (edge_rec){a < b ? a : b, a < b ? b : a, (long)t, k};
-            nb[3 * t + k] = -1;
+            long a = tri[3 * t + k], b = tri[3 * t + (k + 1) % 3], o = -1;
+            for (size_t q = inc_start[a]; q < inc_start[a + 1] && o < 0; q++) {
+                long u = inc[q];
+                if (u != (long)t && (tri[3 * u] == b || tri[3 * u + 1] == b || tri[3 * u + 2] == b))
+                    o = u;
+            }
+            nb[3 * t + k] = o;
         }
     }
-    qsort(e, 3 * nt, sizeof *e, by_edge);
-    for (size_t q = 0; q + 1 < 3 * nt; q++)
-        if (e[q].a == e[q + 1].a && e[q].b == e[q + 1].b) {
-            nb[3 * e[q].t + e[q].k] = e[q + 1].t;
-            nb[3 * e[q + 1].t + e[q + 1].k] = e[q].t;
-        }
     for (size_t t = 0; t < nt; t++)
         for (int k = 0; k < 3; k++)
             if (nb[3 * t + k] < 0) {
@@ -422,7 +405,9 @@ done:
     free(tri);
     free(used);
     free(bcount);
-    free(e);
+    free(inc_start);
+    free(fill);
+    free(inc);
     free(nb);
     free(alive);
     free(stack);

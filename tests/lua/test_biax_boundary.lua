@@ -57,6 +57,14 @@ do
     max_pen = math.max(max_pen, bi.penalty_max)
     mesh, t = analysis.delaunay(s), now
   end
+  -- The band triangulation used by the boundary updates finds the loop of the full one.
+  s:run{ steps = 250, dt = c.dt, impact_velocity = 1e-3, progress = false }
+  local E, loop = s:boundary_edges(), analysis.delaunay(s):boundary()
+  local same = #E.a == #loop
+  local start
+  for k = 1, #loop do if loop[k] == E.a[1] then start = k end end
+  for k = 1, #E.a do same = same and start and E.a[k] == loop[(start + k - 2) % #loop + 1] end
+  check.is_true(same, "band triangulation gives the full triangulation's boundary loop")
   local rxx, ryy = sum_xx / (eps * T), sum_yy / (-eps * T)
   print(string.format("MBC pure shear: K = %.3g, actual/imposed xx %.4f yy %.4f; penalty sum %.2e N, max %.3g N",
                       info.K, rxx, ryy, worst_sum, max_pen))
