@@ -46,8 +46,9 @@ function biax.scene(state, c)
     xlo, xhi = math.min(xlo, state.x[i]), math.max(xhi, state.x[i])
     ylo, yhi = math.min(ylo, state.y[i]), math.max(yhi, state.y[i])
   end
-  local pad = math.max(xhi - xlo, yhi - ylo)
-  local s = dem.scene{ box = { { xlo - pad, ylo - pad }, { xhi + pad, yhi + pad } },
+  -- room to bulge sideways (and for MBC to shorten), small enough for readable images
+  local px, py = 0.35 * (xhi - xlo) + 0.01, 0.12 * (yhi - ylo) + 0.005
+  local s = dem.scene{ box = { { xlo - px, ylo - py }, { xhi + px, yhi + py } },
                        gravity = { 0, 0 }, thickness = c.thickness }
   local grain, membrane = materials(c)
   for i = 1, #state.x do
@@ -195,7 +196,8 @@ local function add_membrane(st, c, ylo, yhi)
   local n0, rm = #st.x, c.membrane_radius
   local new = { x = {}, y = {}, r = {}, membrane = {} }
   for i = 1, n0 do new.x[i], new.y[i], new.r[i] = st.x[i], st.y[i], st.r[i] end
-  local count = math.max(2, math.floor((yhi - ylo) / (2 * rm) + 0.5))
+  -- touching neighbours at most: the gap between centres is >= 2 rm
+  local count = math.max(2, math.floor((yhi - ylo - 2 * rm) / (2 * rm)) + 1)
   local gap = (yhi - ylo - 2 * rm) / (count - 1)
   local left, right = {}, {}
   for side = 1, 2 do
@@ -284,21 +286,84 @@ function biax.setup(st, bc, opts)
   return s, lab
 end
 
--- Plates: settle them onto the sample (at rest, with drag) so that they carry p W depth, then
--- move them at the imposed strain rate. No-op for MBC (its penalty drives the strain).
-function biax.start(lab, settle_steps)
+-- Plate forces (sum of normal contact forces on walls 1 and 2 of the lab).
+function biax.plate_forces(lab)
+  local C = lab.scene:measure("contacts")
+  local fb, ft = 0, 0
+  local wb, wt = -lab.plates[1], -lab.plates[2]
+  for k = 1, #C.j do
+    if C.j[k] == wb then fb = fb + C.fn[k] elseif C.j[k] == wt then ft = ft + C.fn[k] end
+  end
+  return fb, ft
+end
+
+-- Width of the sample particles (lateral extent) now.
+local function sample_width(lab)
+  local P = lab.scene:particles()
+  local xlo, xhi = math.huge, -math.huge
+  for _, i in ipairs(lab.ids) do
+    xlo, xhi = math.min(xlo, P.x[i] - P.radius[i]), math.max(xhi, P.x[i] + P.radius[i])
+  end
+  return xhi - xlo
+end
+
+-- Plates: servo them onto the sample (with drag) until each carries p W depth within `tol`,
+-- at most `max_steps`; then drag off and the plates move at the imposed strain rate. Replacing
+-- the all-round pressure by plates placed at the highest and lowest particle would otherwise
+-- let the sample unload vertically and spend the first percent of strain taking up the slack.
+-- No-op for MBC (its penalty drives the strain). Returns the plate stress / p (bottom, top).
+function biax.start(lab, max_steps, tol)
   local s, c = lab.scene, lab.cfg
+  local ratio_b, ratio_t = 1, 1
   if lab.plates then
-    s:drag(30)
-    run(s, settle_steps or 2000, c)
+    -- Frictionless while the plates take the load (as in the consolidation): with the
+    -- regularised friction an anisotropically loaded sample creeps, and the servo would chase it.
+    biax.contact(s, c, true)
+    s:drag(lab.servo_drag or 5) -- enough to damp, little enough not to hold the plates back
+    tol = tol or 0.05
+    max_steps = max_steps or 30000
+    -- Approach at vmax until each plate carries half the load, then a proportional servo slow
+    -- enough for the mass-scaled sample (its stiffness k ~ 5e5 N/m against a plate; a servo
+    -- time 1/(gain k) ~ 0.02 s, a few wave transits).
+    local vmax, gain, done, stable = 1e-3, lab.servo_gain or 1e-4, 0, 0
+    local approach_b, approach_t = true, true
+    while done < max_steps do
+      local target = c.pressure * sample_width(lab) * c.thickness
+      local fb, ft = biax.plate_forces(lab)
+      ratio_b, ratio_t = fb / target, ft / target
+      if math.abs(ratio_b - 1) < tol and math.abs(ratio_t - 1) < tol then
+        stable = stable + 1
+        if stable >= 4 then break end
+      else
+        stable = 0
+      end
+      approach_b = approach_b and ratio_b < 0.5
+      approach_t = approach_t and ratio_t < 0.5
+      local function v(app, f)
+        if app then return vmax end
+        return math.max(-vmax, math.min(vmax, gain * (target - f)))
+      end
+      s:wall_velocity(lab.plates[1], { 0, v(approach_b, fb) })
+      s:wall_velocity(lab.plates[2], { 0, -v(approach_t, ft) })
+      run(s, 250, c)
+      done = done + 250
+      if lab.verbose then print(done, ratio_b, ratio_t) end
+    end
+    s:wall_velocity(lab.plates[1], { 0, 0 })
+    s:wall_velocity(lab.plates[2], { 0, 0 })
+    biax.contact(s, c, false)
+    run(s, 2000, c)
     s:drag(0)
+    run(s, 1000, c)
     local H = s:wall_point(lab.plates[2])[2] - s:wall_point(lab.plates[1])[2]
     lab.H0 = H
     local v = 0.5 * c.rate * H
     s:wall_velocity(lab.plates[1], { 0, v })
     s:wall_velocity(lab.plates[2], { 0, -v })
+    lab.servo_steps = done
   end
   lab.t0 = s:info().time
+  return ratio_b, ratio_t
 end
 
 -- Imposed axial strain now (plate gap, or rate x time for MBC), compression positive.

@@ -32,9 +32,10 @@ typedef struct analysis_mesh {
 } analysis_mesh;
 
 typedef struct analysis_delaunay_def {
-    /* Alpha rule: a triangle on the boundary is peeled off while its outer edge (a, b) is longer
-     * than alpha (r_a + r_b), unless that would pinch the outline (its third particle is already
-     * on the boundary and the triangle has only one boundary edge). 0 = keep the convex hull. */
+    /* Alpha rule: a triangle with one edge (a, b) on the boundary is peeled off while that edge
+     * is longer than alpha (r_a + r_b) and its third particle is not on the boundary yet (so the
+     * outline never pinches and no particle ever leaves the mesh: every particle stays a vertex).
+     * 0 = keep the convex hull. */
     double alpha;
     const double *radius; /* np radii; NULL: every radius is half the median Delaunay edge */
 } analysis_delaunay_def;

@@ -311,10 +311,11 @@ core_status analysis_delaunay(const double *x, const double *y, size_t np,
                         longk = k;
                 }
             }
-            if (longk < 0 || nbnd == 3)
+            /* Only a triangle with one boundary edge and its third particle inside: peeling it
+             * neither pinches the outline nor drops a particle from the mesh (a stray particle
+             * stays attached by long edges, so pressure on them pulls it back). */
+            if (longk < 0 || nbnd != 1 || bcount[tri[3 * t + (longk + 2) % 3]] > 0)
                 continue;
-            if (nbnd == 1 && bcount[tri[3 * t + (longk + 2) % 3]] > 0)
-                continue; /* would pinch the outline */
             alive[t] = 0;
             peeled++;
             for (int k = 0; k < 3; k++) {

@@ -37,6 +37,7 @@ struct dem_boundary {
     long updates;
     double update_s, apply_s;
     double pen_sum[2], pen_max, pres_max, stiffness;
+    double eint[4]; /* integral of the rate error (tau > 0) */
 };
 
 dem_boundary_def dem_default_boundary_def(void)
@@ -117,6 +118,8 @@ core_status dem_set_boundary(dem_scene *s, const dem_boundary_def *def, core_err
         return core_fail(err, CORE_ERR_ARG, "every must be >= 0 steps, got %ld", def->every);
     if (!(def->penalty >= 0) || !isfinite(def->penalty))
         return core_fail(err, CORE_ERR_ARG, "penalty K must be >= 0, got %g", def->penalty);
+    if (!(def->tau >= 0) || !isfinite(def->tau))
+        return core_fail(err, CORE_ERR_ARG, "tau must be >= 0 (s), got %g", def->tau);
     for (int q = 0; q < 4; q++)
         if (!isfinite(def->target[q]) || !(def->mask[q] >= 0) || !isfinite(def->mask[q]))
             return core_fail(err, CORE_ERR_ARG, "target and mask must be finite (mask >= 0)");
@@ -131,6 +134,7 @@ core_status dem_set_boundary(dem_scene *s, const dem_boundary_def *def, core_err
         b->def.free_ctx(b->def.ctx);
     b->def = *def;
     b->has_def = 1;
+    memset(b->eint, 0, sizeof b->eint);
     b->last_update = s->steps;
     dem_invalidate(s, 0);
     return CORE_OK;
@@ -384,6 +388,11 @@ core_status dem_boundary_apply(dem_scene *s, double dt, core_error *err)
                 d[1] = d[2] = off - b->def.target[1];
                 d[3] = H[3] - b->def.target[3];
             }
+            if (b->def.tau > 0)
+                for (int q = 0; q < 4; q++) {
+                    b->eint[q] += d[q] * dt;
+                    d[q] += b->eint[q] / b->def.tau;
+                }
             for (int q = 0; q < 4; q++)
                 W[q] = b->def.mask[q] * d[q];
             const double KV = b->def.penalty / V;

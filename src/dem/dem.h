@@ -262,6 +262,10 @@ typedef struct dem_boundary_def {
     int gradient;      /* 0: penalise sym(H) - target (strain rate); 1: H - target */
     double target[4];  /* xx, xy, yx, yy, 1/s */
     double mask[4];    /* component weights (0 or 1); symmetric when !gradient */
+    /* > 0: the error penalised is dE + (integral of dE dt) / tau, so that the accumulated strain
+     * error is driven back too (a proportional-integral penalty; with an explicit step, K is
+     * limited, and the rate penalty alone then lags under load); 0: the rate only (Eq. 3.4). */
+    double tau;
 } dem_boundary_def;
 
 dem_boundary_def dem_default_boundary_def(void); /* no pressure, every 250, no penalty */

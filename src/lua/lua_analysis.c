@@ -547,8 +547,7 @@ static int l_mesh_tostring(lua_State *L)
 /* ---- boundary conditions on dem.scene --------------------------------------------------------- */
 /* The coupling: every `every` steps the DEM calls this, which triangulates the centres (all
  * particles, or the listed ones) and hands the boundary loop back as the pressure edges.
- * lateral: edges whose two particles both touch a wall (within 10% of their radius) carry no
- * pressure (the plates carry the load there). */
+ * lateral: edges facing a wall (plate_edge) carry no pressure: the plates carry the load there. */
 typedef struct delaunay_ctx {
     double alpha;
     int lateral;
@@ -627,17 +626,27 @@ static size_t band_particles(delaunay_ctx *c, dem_scene *s)
     return m < 3 ? 0 : m;
 }
 
-static int touches_wall(dem_scene *s, size_t i)
+/* An edge a -> b faces a plate when its outward normal points against the wall's (n . w < -1/2)
+ * and both particles lie within their radius plus two mean diameters dm of the wall (the top
+ * layer, with the valleys between its grains, up to 4 radii deep in a deposited sample): the
+ * plate carries the load there, the edge gets no pressure. */
+static int plate_edge(dem_scene *s, long a, long b, double dm)
 {
     const double *x = dem_positions(s, 0), *y = dem_positions(s, 1), *r = dem_radii(s);
+    double nx = y[b] - y[a], ny = -(x[b] - x[a]), L = hypot(nx, ny);
+    if (!(L > 0))
+        return 0;
     for (int w = 0; w < dem_wall_count(s); w++) {
         double pt[3], nrm[3];
         int active;
         if (dem_wall_geometry(s, w, pt, nrm, &active, NULL) || !active)
             continue;
+        if ((nx * nrm[0] + ny * nrm[1]) / L > -0.5)
+            continue;
         dem_wall_point(s, w, pt, NULL);
-        double d = (x[i] - pt[0]) * nrm[0] + (y[i] - pt[1]) * nrm[1];
-        if (d < 1.1 * r[i])
+        double da = (x[a] - pt[0]) * nrm[0] + (y[a] - pt[1]) * nrm[1];
+        double db = (x[b] - pt[0]) * nrm[0] + (y[b] - pt[1]) * nrm[1];
+        if (da < r[a] + 2 * dm && db < r[b] + 2 * dm)
             return 1;
     }
     return 0;
@@ -668,6 +677,9 @@ static core_status delaunay_update(void *ctxp, dem_scene *s, core_error *err)
         y = buf + n;
         r = buf + 2 * n;
     }
+    double dmean = 0; /* the triangulated particles' mean diameter */
+    for (size_t k = 0; k < n; k++)
+        dmean += 2 * r[k] / (double)n;
     analysis_delaunay_def def = analysis_default_delaunay_def();
     def.alpha = c->alpha;
     def.radius = r;
@@ -698,7 +710,7 @@ static core_status delaunay_update(void *ctxp, dem_scene *s, core_error *err)
         c->nloop = nl;
     }
     for (size_t k = 0; k < nl; k++)
-        loaded[k] = !(c->lateral && touches_wall(s, (size_t)a[k]) && touches_wall(s, (size_t)b[k]));
+        loaded[k] = !(c->lateral && plate_edge(s, a[k], b[k], dmean));
     st = dem_set_boundary_edges(s, nl, a, b, loaded, 1, err);
     free(a);
     free(loaded);
@@ -786,7 +798,7 @@ static int l_boundary(lua_State *L)
     static const char *const fields[] = {"mode", "pressure", "depth", "every", "alpha", "sides",
                                          "ids", "edges", "closed", "mbc", "band", NULL};
     static const char *const mfields[] = {"strain_rate", "gradient", "mask", "K", "kappa", "rate",
-                                          "dt", NULL};
+                                          "dt", "tau", NULL};
     dem_scene *s = bind_check_dem_scene(L, 1, call);
     bind_check_table(L, 2, call);
     bind_check_fields(L, 2, call, fields);
@@ -827,6 +839,7 @@ static int l_boundary(lua_State *L)
         kappa = bind_field_number(L, mbc, call, "kappa", 20, BIND_POSITIVE);
         rate = bind_field_number(L, mbc, call, "rate", 0, BIND_POSITIVE);
         mdt = bind_field_number(L, mbc, call, "dt", 0, BIND_POSITIVE);
+        def.tau = bind_field_number(L, mbc, call, "tau", mdt > 0 ? 1000 * mdt : 0, BIND_NONNEG);
         if (rate == 0)
             for (int q = 0; q < 4; q++)
                 rate = fmax(rate, fabs(def.target[q]) * (def.mask[q] != 0));
@@ -1061,9 +1074,9 @@ void bind_open_analysis(lua_State *L)
         {"delaunay", l_delaunay,
          "analysis.delaunay(scene | { x =, y =, radius = }, { alpha = 1.5, ids = {...} })",
          "Delaunay triangulation of 2D particle centres (qhull), with the boundary triangles "
-         "peeled while their outer edge (a, b) is longer than alpha (r_a + r_b) and peeling does "
-         "not pinch the outline (alpha = 0: the convex hull; without radii, r is half the median "
-         "edge). ids: triangulate only these particles. Refuses fewer than 3 particles, "
+         "peeled while their outer edge (a, b) is longer than alpha (r_a + r_b) and their third "
+         "particle is inside (so the outline never pinches and every particle stays in the mesh; "
+         "alpha = 0: the convex hull; without radii, r is half the median edge). ids: triangulate only these particles. Refuses fewer than 3 particles, "
          "collinear centres and duplicate positions. Returns an analysis.mesh."},
         {NULL, NULL, NULL, NULL}};
     lua_newtable(L);
@@ -1080,21 +1093,25 @@ void bind_open_analysis(lua_State *L)
          "= 250, alpha = 1.5, sides = 'all'|'lateral', ids =, band = true, edges = {a =, b =}, "
          "closed = false, "
          "mbc = { strain_rate = {{xx, xy}, {yx, yy}} | gradient = {{..}, {..}}, mask = {{1, 1}, "
-         "{1, 1}}, K =, kappa = 20, rate =, dt = } }",
+         "{1, 1}}, K =, kappa = 20, rate =, dt =, tau = 1000 dt } }",
          "Boundary conditions of the biaxial laboratory (Padbidri Ch. 3, 2D). Pressure p acts as "
          "tractions p depth L on boundary edges, split between their two particles. mode "
          "delaunay: the edges are the boundary loop of analysis.delaunay of the centres (or of "
          "`ids`) with `alpha`, rebuilt every `every` steps during runs (band = true: after the "
          "first, only the particles within about 3-6 mean diameters of the previous loop are "
          "triangulated, 4-5 times cheaper); sides = 'lateral' unloads "
-         "the edges whose two particles touch a wall (the plates). mode edges: fixed edges a -> b "
+         "the edges that face a wall (outward normal against the wall's within 60 degrees) with "
+         "both particles within their radius plus two mean diameters of it: the plates carry the "
+         "load there. mode edges: fixed edges a -> b "
          "(outward normal (dy, -dx)), e.g. a membrane chain; closed = true for a loop. mbc: "
          "minimal boundary conditions, the penalty force F_a = -(K/V) (mask o dE) g_a (Eqs. "
          "3.2-3.5) driving the coarse strain rate (or velocity gradient) to the target on the "
          "masked components; K defaults to kappa p depth V / rate, so that a rate error equal to "
          "the imposed rate gives forces kappa times the typical contact force p d depth, and, "
-         "given dt, at most half the explicit stability limit 1/(dt sum|g_a|^2/(V^2 m_min)). A run "
-         "stops with an error when K is too stiff for its dt. mode none removes the boundary, "
+         "given dt, at most half the explicit stability limit 1/(dt sum|g_a|^2/(V^2 m_min)). "
+         "tau > 0 (default 1000 dt when dt is given, else 0) adds the integral of the error over "
+         "tau, so that the capped K does not let the strain lag (a proportional-integral "
+         "penalty; tau = 0 is the paper's rate penalty alone). A run stops with an error when K is too stiff for its dt. mode none removes the boundary, "
          "springs and ties. Returns s:boundary_info() plus K."},
         {"boundary_info", l_boundary_info, "s:boundary_info()",
          "edges, loaded, nodes, closed, area (inside the loop), gradient and strain_rate (coarse, "
