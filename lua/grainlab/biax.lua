@@ -25,7 +25,7 @@ local function cfg_of(opts)
   local c = {}
   for k, v in pairs(biax.defaults) do c[k] = v end
   for k, v in pairs(opts or {}) do c[k] = v end
-  c.v_r = 2 * 0.5 * (c.rmin + c.rmax) * c.rate -- Eq. 3.A2: v_R = d eps_rate
+  c.v_r = (opts and opts.v_r) or (c.rmin + c.rmax) * c.rate -- Eq. 3.A2: v_R = d eps_rate
   return c
 end
 biax.config = cfg_of
@@ -84,14 +84,18 @@ local function run(s, steps, c)
 end
 
 -- Deposited (or randomly placed) disks, consolidated under the confining pressure.
---   n, seed, method = "deposit"|"random", width (m), ramp_steps, rest_steps, and any of
+--   n, seed, method = "deposit"|"random", shape = "square"|"circle", width (m), ramp_steps,
+--   rest_steps, and any of
 --   biax.defaults. Returns the state {x, y, r} and a report table.
 function biax.prepare(opts)
   local c = cfg_of(opts)
   local n, seed = c.n or 400, c.seed or 1
   local t0 = grainlab.clock()
   local rm = 0.5 * (c.rmin + c.rmax)
-  local W = c.width or math.sqrt(n * math.pi * rm * rm / 0.82) -- about square
+  local circle = c.shape == "circle"
+  -- a circle of n is cut from the middle of a square deposit of 1.6 n
+  local n_dep = circle and math.ceil(1.6 * n) or math.ceil(1.08 * n)
+  local W = c.width or math.sqrt((circle and n_dep or n) * math.pi * rm * rm / 0.82) -- about square
   local st
   if (c.method or "deposit") == "deposit" then
     local H = 2.5 * W
@@ -104,12 +108,20 @@ function biax.prepare(opts)
     local grain = materials(c)
     -- Jodrey-Tory drops, 8% extra kept off the top (a flat top), no relaxation: the
     -- consolidation below does it.
-    grainlab.pack.deposit(g, { n = math.ceil(1.08 * n), radius = { c.rmin, c.rmax }, seed = seed,
+    grainlab.pack.deposit(g, { n = n_dep, radius = { c.rmin, c.rmax }, seed = seed,
                                material = grain, region = { { 0, 0 }, { W, H } }, relax_steps = 0 })
     local P = g:particles()
     local order = {}
     for i = 1, P.count do order[i] = i end
-    table.sort(order, function(a, b) return P.y[a] < P.y[b] end)
+    if circle then -- the n nearest to the centre of the deposit
+      local cx, cy = 0, 0
+      for i = 1, P.count do cx, cy = cx + P.x[i] / P.count, cy + P.y[i] / P.count end
+      local d2 = {}
+      for i = 1, P.count do d2[i] = (P.x[i] - cx) ^ 2 + (P.y[i] - cy) ^ 2 end
+      table.sort(order, function(a, b) return d2[a] < d2[b] end)
+    else
+      table.sort(order, function(a, b) return P.y[a] < P.y[b] end)
+    end
     st = { x = {}, y = {}, r = {} }
     for k = 1, n do
       local i = order[k]
@@ -151,7 +163,9 @@ end
 function biax.prepared(opts)
   local c = cfg_of(opts)
   local path = c.cache
-  if path == nil then path = string.format("out/biax_%d_%d.lua", c.n or 400, c.seed or 1) end
+  if path == nil then
+    path = string.format("out/biax_%s%d_%d.lua", c.shape == "circle" and "circle_" or "", c.n or 400, c.seed or 1)
+  end
   if path then
     local f = io.open(path, "r")
     if f then

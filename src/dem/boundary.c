@@ -32,6 +32,9 @@ struct dem_boundary {
     size_t nt, cap_t;
     long *ti;
     int *tw, *ta;
+    size_t nspin;      /* prescribed spins (few: a linear search is fine) */
+    long spin_i[8];
+    double spin_w[8];
     /* bookkeeping */
     long last_update;
     long updates;
@@ -307,6 +310,33 @@ core_status dem_tie_to_wall(dem_scene *s, size_t i, int wall, int axis, core_err
     return CORE_OK;
 }
 
+core_status dem_set_spin(dem_scene *s, size_t i, double omega, core_error *err)
+{
+    if (i >= s->n)
+        return core_fail(err, CORE_ERR_ARG, "particle %zu does not exist (1..%zu)", i + 1, s->n);
+    if (!isfinite(omega))
+        return core_fail(err, CORE_ERR_ARG, "omega must be finite, got %g", omega);
+    if (!s->rot)
+        return core_fail(err, CORE_ERR_STATE, "the scene has no rotations: set a tangential law "
+                         "(or rolling = true) first");
+    core_status st = ensure(s, err);
+    if (st)
+        return st;
+    dem_boundary *b = s->bnd;
+    size_t k = 0;
+    while (k < b->nspin && b->spin_i[k] != (long)i)
+        k++;
+    if (k == b->nspin) {
+        if (b->nspin == sizeof b->spin_i / sizeof b->spin_i[0])
+            return core_fail(err, CORE_ERR_ARG, "at most %zu particles can have a prescribed spin",
+                             sizeof b->spin_i / sizeof b->spin_i[0]);
+        b->spin_i[b->nspin++] = (long)i;
+    }
+    b->spin_w[k] = omega;
+    s->w[2][i] = omega;
+    return CORE_OK;
+}
+
 /* g_a (Eq. 3.3: half the outward L n of each edge at a) and the enclosed area. */
 static double node_vectors(dem_boundary *b, const double *x, const double *y)
 {
@@ -427,6 +457,10 @@ core_status dem_boundary_apply(dem_scene *s, double dt, core_error *err)
         int ax = b->ta[q];
         s->v[ax][i] = s->walls[b->tw[q]].velocity[ax];
         s->f[ax][i] = 0;
+    }
+    for (size_t q = 0; q < b->nspin; q++) { /* prescribed spins */
+        s->w[2][b->spin_i[q]] = b->spin_w[q];
+        s->tq[2][b->spin_i[q]] = 0;
     }
     b->apply_s += clock_wall() - t0;
     return CORE_OK;

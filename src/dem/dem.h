@@ -288,6 +288,11 @@ core_status dem_add_springs(dem_scene *s, size_t n, const long *i, const long *j
  * plates): that component of its velocity is the wall's and its force is zeroed. */
 core_status dem_tie_to_wall(dem_scene *s, size_t i, int wall, int axis, core_error *err);
 
+/* Prescribes particle i's spin (2D angular velocity, rad/s): omega is set and the torque zeroed
+ * at every evaluation; its translation stays free (Padbidri Ch. 4, the forced particle). Calling
+ * again updates omega (a ramp). Needs rotations (a tangential law or rolling). */
+core_status dem_set_spin(dem_scene *s, size_t i, double omega, core_error *err);
+
 typedef struct dem_boundary_info {
     size_t edges, loaded, nodes;
     int closed;

@@ -1033,6 +1033,22 @@ static int l_tie(lua_State *L)
     return 0;
 }
 
+static int l_spin(lua_State *L)
+{
+    const char *call = "spin";
+    static const char *const fields[] = {"id", "omega", NULL};
+    dem_scene *s = bind_check_dem_scene(L, 1, call);
+    bind_check_table(L, 2, call);
+    bind_check_fields(L, 2, call, fields);
+    lua_Integer id = bind_field_integer(L, 2, call, "id", 0, 1, (lua_Integer)dem_count(s),
+                                        BIND_REQUIRED);
+    double w = bind_field_number(L, 2, call, "omega", 0, BIND_REQUIRED);
+    core_error err;
+    if (dem_set_spin(s, (size_t)id - 1, w, &err))
+        return bind_raise(L, call, &err);
+    return 0;
+}
+
 void bind_open_analysis(lua_State *L)
 {
     static const bind_fn methods[] = {
@@ -1123,6 +1139,9 @@ void bind_open_analysis(lua_State *L)
         {"springs", l_springs, "s:springs{ i = {...}, j = {...}, k = N_per_m, rest = {...} }",
          "Linear springs between particle pairs (membrane chains; Padbidri Table 3.1: 10 N/mm), "
          "rest lengths default to the current distances."},
+        {"spin", l_spin, "s:spin{ id = i, omega = w }",
+         "Prescribes particle i's angular velocity (rad/s; its torque is ignored, its translation "
+         "stays free); call again to change it (a ramp). The forced particle of Padbidri Ch. 4."},
         {"tie", l_tie, "s:tie{ ids = {...}, wall = id, axis = 2 }",
          "Ties the particles' velocity component `axis` to the wall's (membrane ends move "
          "vertically with the plates)."},

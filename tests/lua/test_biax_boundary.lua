@@ -37,13 +37,14 @@ do
 end
 
 -- ---- MBC: pure shear at eps = 0.05/s to 1% ----------------------------------------------------
-do
+-- The default penalty (dt given: K capped at half the explicit limit, integral term tau = 1000
+-- dt) is checked; the paper's rate penalty alone (tau = 0) is printed for comparison.
+local function pure_shear(tau)
   local eps = 0.05
   local s = biax.scene(st, c)
   biax.contact(s, c, false)
   local info = s:boundary{ pressure = c.pressure,
-                           mbc = { strain_rate = { { eps, 0 }, { 0, -eps } } } }
-  check.gt(info.K, 0, "automatic K")
+                           mbc = { strain_rate = { { eps, 0 }, { 0, -eps } }, dt = c.dt, tau = tau } }
   local sum_xx, sum_yy, T, worst_sum, max_pen = 0, 0, 0, 0, 0
   local mesh, t = analysis.delaunay(s), s:info().time
   for k = 1, 20 do
@@ -57,6 +58,17 @@ do
     max_pen = math.max(max_pen, bi.penalty_max)
     mesh, t = analysis.delaunay(s), now
   end
+  return s, info, sum_xx / (eps * T), sum_yy / (-eps * T), worst_sum, max_pen
+end
+do
+  local s, info, rxx, ryy, worst_sum, max_pen = pure_shear(nil)
+  check.gt(info.K, 0, "automatic K")
+  print(string.format("MBC pure shear: K = %.3g, actual/imposed xx %.4f yy %.4f; penalty sum %.2e N, max %.3g N",
+                      info.K, rxx, ryy, worst_sum, max_pen))
+  check.near(rxx, 1, 0.05, "MBC strain rate xx / imposed")
+  check.near(ryy, 1, 0.05, "MBC strain rate yy / imposed")
+  check.gt(max_pen, 0, "the penalty acts")
+  check.le(worst_sum, 1e-12 * max_pen, "penalty forces sum to zero")
   -- The band triangulation used by the boundary updates finds the loop of the full one.
   s:run{ steps = 250, dt = c.dt, impact_velocity = 1e-3, progress = false }
   local E, loop = s:boundary_edges(), analysis.delaunay(s):boundary()
@@ -65,17 +77,12 @@ do
   for k = 1, #loop do if loop[k] == E.a[1] then start = k end end
   for k = 1, #E.a do same = same and start and E.a[k] == loop[(start + k - 2) % #loop + 1] end
   check.is_true(same, "band triangulation gives the full triangulation's boundary loop")
-  local rxx, ryy = sum_xx / (eps * T), sum_yy / (-eps * T)
-  print(string.format("MBC pure shear: K = %.3g, actual/imposed xx %.4f yy %.4f; penalty sum %.2e N, max %.3g N",
-                      info.K, rxx, ryy, worst_sum, max_pen))
-  check.near(rxx, 1, 0.05, "MBC strain rate xx / imposed")
-  check.near(ryy, 1, 0.05, "MBC strain rate yy / imposed")
-  check.gt(max_pen, 0, "the penalty acts")
-  check.le(worst_sum, 1e-12 * max_pen, "penalty forces sum to zero")
   -- Too stiff a penalty for the step is refused, naming the limit.
-  s:boundary{ pressure = c.pressure, mbc = { strain_rate = { { eps, 0 }, { 0, -eps } }, K = info.K * 10 } }
+  s:boundary{ pressure = c.pressure, mbc = { strain_rate = { { 0.05, 0 }, { 0, -0.05 } }, K = info.K * 10 } }
   check.errors(function() s:run{ steps = 10, dt = c.dt, impact_velocity = 1e-3, progress = false } end,
                "is too stiff for dt", "stiff penalty")
+  local _, info0, r0xx, r0yy = pure_shear(0)
+  print(string.format("  rate penalty alone (tau = 0, same K %.3g): xx %.4f yy %.4f", info0.K, r0xx, r0yy))
 end
 
 -- ---- bad input ---------------------------------------------------------------------------------
@@ -105,6 +112,19 @@ check.errors(function() s:springs{ i = { 1 }, j = { 2 }, k = 0 } end,
 check.errors(function() s:tie{ ids = { 1 }, wall = 3 } end, "wall 3 does not exist", "tie to no wall")
 check.errors(function() s:boundary{ mode = "edges", pressure = 1, edges = { a = { 1, 2, 3 }, b = { 2, 3, 5 } }, closed = true } end,
   "closed boundary needs the edges in loop order", "open loop")
+-- A prescribed spin holds its value through a run; the translation stays free.
+do
+  local sp = biax.scene(st, c)
+  biax.contact(sp, c, false)
+  sp:boundary{ pressure = c.pressure }
+  sp:spin{ id = 7, omega = 0.03 }
+  sp:run{ steps = 200, dt = c.dt, impact_velocity = 1e-3, progress = false }
+  check.near(sp:particles().omega[7], 0.03, 1e-12, "prescribed spin")
+  check.errors(function() sp:spin{ id = 0, omega = 1 } end, "bad field 'id' in argument #1 to 'spin'", "spin id")
+  local bare = biax.scene(st, c)
+  bare:contact{ normal = "hertz" }
+  check.errors(function() bare:spin{ id = 1, omega = 1 } end, "no rotations", "spin without rotations")
+end
 local s3 = dem.scene{ dim = 3, box = { { 0, 0, 0 }, { 1, 1, 1 } } }
 check.errors(function() s3:boundary{ pressure = 1 } end, "2D only", "3D scene")
 check.done()
