@@ -304,8 +304,8 @@ typedef struct dem_boundary_info {
     double pressure_max;      /* largest pressure force on a particle, N */
     double stiffness;         /* K sum_a |g_a|^2 / (V^2 m_min): the penalty's rate, 1/s */
     long updates;             /* calls of update */
-    double update_seconds;    /* wall time spent in update */
-    double apply_seconds;     /* wall time spent applying pressure, penalty, springs, ties */
+    double update_seconds;    /* CPU time (process) spent in update */
+    double apply_seconds;     /* CPU time spent applying pressure, penalty, springs, ties */
     size_t springs, ties;
 } dem_boundary_info;
 core_status dem_boundary_info_get(dem_scene *s, dem_boundary_info *out, core_error *err);

@@ -1132,8 +1132,8 @@ void bind_open_analysis(lua_State *L)
         {"boundary_info", l_boundary_info, "s:boundary_info()",
          "edges, loaded, nodes, closed, area (inside the loop), gradient and strain_rate (coarse, "
          "Eq. 3.2, from the velocities now), penalty_sum {fx, fy} and penalty_max (N, last "
-         "evaluation), pressure_max, penalty_rate (1/s), updates, update_seconds (time in the "
-         "triangulation), apply_seconds, springs, ties."},
+         "evaluation), pressure_max, penalty_rate (1/s), updates, update_seconds (process CPU time in the "
+         "triangulation), apply_seconds (CPU time applying the forces), springs, ties."},
         {"boundary_edges", l_boundary_edges, "s:boundary_edges()",
          "The pressure edges now: arrays a, b (particle ids) and loaded (booleans)."},
         {"springs", l_springs, "s:springs{ i = {...}, j = {...}, k = N_per_m, rest = {...} }",
