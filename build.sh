@@ -10,7 +10,7 @@ cd "$(dirname "$0")"
 # Debian packages: compiler and build tools, the libraries grainlab links, and jq (tests read
 # report JSON with it).
 packages=(build-essential cmake pkg-config liblua5.4-dev libreadline-dev libosmesa6-dev
-          libpng-dev libfreetype-dev fonts-dejavu-core libcmocka-dev jq)
+          libpng-dev libfreetype-dev fonts-dejavu-core libcmocka-dev jq libqhull-dev)
 
 install_packages() {
     local missing=()

@@ -209,6 +209,7 @@ typedef struct dem_contact_info {
     double normal[3];      /* from j to i */
     double point[3];
     double overlap;
+    double force[3];       /* the force on i (pairs: normal + tangential; walls: normal only) */
 } dem_contact_info;
 /* Calls fn for each contact (pairs and walls) in a fixed order. */
 void dem_each_contact(dem_scene *s, void (*visit)(const dem_contact_info *c, void *ctx),
@@ -237,5 +238,81 @@ core_status dem_brilliantov_time(double e, double m_eff, double K, double v, dou
 /* The same for the scene's mean pair (mean radius and mass, the first particle's material). */
 core_status dem_damping_time_for(const dem_scene *s, double e, double v, double *T,
                                  core_error *err);
+
+/* ---- boundary conditions of the biaxial laboratory (Padbidri Ch. 3) ----------------------- *
+ * 2D only. A pressure boundary is a list of directed edges a -> b between particles, outward
+ * normal (dy, -dx)/L: every force evaluation, each loaded edge pushes both its particles inward
+ * with p depth L / 2 (tractions on the boundary of the Delaunay continuum, Fig. 2.2). When the
+ * edges form one closed counter-clockwise loop they also give the coarse velocity gradient of the
+ * enclosed assembly, H = (1/V) sum_a v_a (x) g_a with g_a = sum of (L n)/2 of a's edges (Eq.
+ * 3.2-3.3), and carry the penalty of the minimal boundary conditions: Phi = K/2 sum_ij
+ * mask_ij dE_ij^2 (Eq. 3.4), dE = sym(H) - target (or H - target when `gradient`), so that
+ * F_a = -dPhi/dv_a = -(K/V) (mask o dE) g_a (Eq. 3.5). sum_a g_a = 0 on a closed loop: the
+ * penalty forces have zero sum (and zero moment for a symmetric dE). The edges come from the
+ * caller (dem_set_boundary_edges), or from `update`, called every `every` steps inside dem_run
+ * (e.g. a Delaunay triangulation of the centres; src/dem knows nothing of how). */
+typedef struct dem_boundary_def {
+    double pressure;   /* Pa on the loaded edges; 0 = none */
+    double depth;      /* m, out of plane: a traction p on an edge of length L is the force p depth L */
+    long every;        /* steps between calls of update (0: never) */
+    core_status (*update)(void *ctx, dem_scene *s, core_error *err);
+    void *ctx;
+    void (*free_ctx)(void *ctx); /* called when the boundary is replaced or the scene destroyed */
+    double penalty;    /* K (N s m) of the minimal boundary conditions; 0 = off */
+    int gradient;      /* 0: penalise sym(H) - target (strain rate); 1: H - target */
+    double target[4];  /* xx, xy, yx, yy, 1/s */
+    double mask[4];    /* component weights (0 or 1); symmetric when !gradient */
+    /* > 0: the error penalised is dE + (integral of dE dt) / tau, so that the accumulated strain
+     * error is driven back too (a proportional-integral penalty; with an explicit step, K is
+     * limited, and the rate penalty alone then lags under load); 0: the rate only (Eq. 3.4). */
+    double tau;
+} dem_boundary_def;
+
+dem_boundary_def dem_default_boundary_def(void); /* no pressure, every 250, no penalty */
+/* Replaces the boundary definition (the edges are kept; the old ctx is freed). */
+core_status dem_set_boundary(dem_scene *s, const dem_boundary_def *def, core_error *err);
+/* Removes the boundary, its edges, springs and ties. */
+void dem_clear_boundary(dem_scene *s);
+/* Sets the edges (copied). loaded: per edge, NULL = all loaded. closed: the edges form one
+ * counter-clockwise loop (needed for the penalty and the coarse gradient). */
+core_status dem_set_boundary_edges(dem_scene *s, size_t n, const long *a, const long *b,
+                                   const unsigned char *loaded, int closed, core_error *err);
+/* Calls the update now (also done by dem_run every `every` steps). */
+core_status dem_update_boundary(dem_scene *s, core_error *err);
+
+/* Linear springs between particle pairs (a membrane chain, Padbidri Sec. 3.2): f = k (d - rest)
+ * along the line of centres; rest NULL = the current distances. */
+core_status dem_add_springs(dem_scene *s, size_t n, const long *i, const long *j, double k,
+                            const double *rest, core_error *err);
+/* Ties particle i's velocity component `axis` to wall `wall`'s (membrane ends move with the
+ * plates): that component of its velocity is the wall's and its force is zeroed. */
+core_status dem_tie_to_wall(dem_scene *s, size_t i, int wall, int axis, core_error *err);
+
+/* Prescribes particle i's spin (2D angular velocity, rad/s): omega is set and the torque zeroed
+ * at every evaluation; its translation stays free (Padbidri Ch. 4, the forced particle). Calling
+ * again updates omega (a ramp). Needs rotations (a tangential law or rolling). */
+core_status dem_set_spin(dem_scene *s, size_t i, double omega, core_error *err);
+
+typedef struct dem_boundary_info {
+    size_t edges, loaded, nodes;
+    int closed;
+    double area;              /* inside the loop now (closed only), m^2 */
+    double grad[4];           /* coarse velocity gradient H now (Eq. 3.2), 1/s */
+    double strain_rate[4];    /* sym(H) */
+    double penalty_sum[2];    /* net penalty force of the last evaluation, N */
+    double penalty_max;       /* largest |F_a| of the last evaluation, N */
+    double pressure_max;      /* largest pressure force on a particle, N */
+    double stiffness;         /* K sum_a |g_a|^2 / (V^2 m_min): the penalty's rate, 1/s */
+    long updates;             /* calls of update */
+    double update_seconds;    /* CPU time (process) spent in update */
+    double apply_seconds;     /* CPU time spent applying pressure, penalty, springs, ties */
+    size_t springs, ties;
+} dem_boundary_info;
+core_status dem_boundary_info_get(dem_scene *s, dem_boundary_info *out, core_error *err);
+/* Edges now (pointers into the scene, valid until the edges change): a, b, loaded. */
+size_t dem_boundary_edges(const dem_scene *s, const long **a, const long **b,
+                          const unsigned char **loaded);
+/* The out-of-plane thickness given at creation (0 for spheres in the plane and in 3D). */
+double dem_thickness(const dem_scene *s);
 
 #endif

@@ -90,6 +90,8 @@ struct dem_scene {
     long force_evals;
     int last_integrator;
     long tt_phase;
+
+    struct dem_boundary *bnd; /* boundary conditions (boundary.c); NULL when none */
 };
 
 /* neighbor.c */
@@ -113,5 +115,11 @@ double dem_elastic_energy(const dem_contact_def *c, double k, double delta);
 void dem_invalidate(dem_scene *s, int list);
 core_status dem_ensure_rotation(dem_scene *s, core_error *err);
 core_status dem_alloc_array(double **a, size_t n, core_error *err);
+
+/* boundary.c: pressure tractions, the minimal-boundary penalty, springs and ties, added after
+ * the contact forces; the update of the edges every `every` steps (called by dem_run). */
+typedef struct dem_boundary dem_boundary;
+core_status dem_boundary_apply(dem_scene *s, double dt, core_error *err);
+core_status dem_boundary_due(dem_scene *s, core_error *err);
 
 #endif

@@ -144,6 +144,11 @@ static core_status forces(dem_scene *s, double dt, double disp2, core_error *err
     size_t t = dem_compute_forces(s, dt);
     if (t != (size_t)-1)
         return unstable(s, t, "went through a wall", err);
+    if (s->bnd) {
+        core_status st = dem_boundary_apply(s, dt, err);
+        if (st)
+            return st;
+    }
     s->forces_ready = 1;
     return CORE_OK;
 }
@@ -477,6 +482,10 @@ core_status dem_run(dem_scene *s, const dem_run_def *run, core_error *err)
             return core_fail(err, CORE_ERR_INTERRUPTED,
                              "interrupted at step %ld (t = %.6g s); the scene is intact",
                              s->steps, s->time);
+        if (s->bnd && (st = dem_boundary_due(s, err))) {
+            dem_invalidate(s, 1);
+            return st;
+        }
         double h = run->dt;
         long advance = 1;
         switch (run->integrator) {

@@ -169,6 +169,8 @@ void dem_each_contact(dem_scene *s, void (*visit)(const dem_contact_info *c, voi
         c.fn = fn;
         c.ft = sqrt(fmax(0, f2 - fn * fn));
         for (int d = 0; d < 3; d++)
+            c.force[d] = d < D ? p->f[d][q] : 0;
+        for (int d = 0; d < 3; d++)
             c.point[d] = d < D ? s->x[d][c.i] - (s->r[c.i] - 0.5 * c.overlap) * c.normal[d] : 0;
         visit(&c, ctx);
     }
@@ -191,6 +193,8 @@ void dem_each_contact(dem_scene *s, void (*visit)(const dem_contact_info *c, voi
                 vn += (s->v[d][i] - wl->velocity[d]) * wl->normal[d];
             c.fn = dem_normal_force(&s->contact, k, gamma, delta, -vn);
             c.ft = wall_tangential(s, wl, i, c.fn, k, mu, delta);
+            for (int d = 0; d < D; d++)
+                c.force[d] = c.fn * wl->normal[d];
             visit(&c, ctx);
         }
     }

@@ -85,6 +85,7 @@ void dem_destroy(dem_scene *s)
 {
     if (!s)
         return;
+    dem_clear_boundary(s);
     for (int d = 0; d < 3; d++) {
         free(s->x[d]), free(s->v[d]), free(s->f[d]), free(s->w[d]), free(s->tq[d]);
         free(s->x_build[d]), free(s->x_ref[d]), free(s->x_prev[d]), free(s->fext[d]);

@@ -1,0 +1,393 @@
+-- The biaxial laboratory of Padbidri Ch. 3 (dem-network-cell-framework): sample preparation and
+-- the three boundary conditions over dem.scene:boundary (src/dem/boundary.c) and the Delaunay
+-- continuum (analysis.delaunay).
+--   biax.defaults            Table 3.1 (E 30 GPa, nu 0.3, p 100 kPa, density x 1e5, mu 0.45,
+--                            rate 5e-3/s, dt 1e-5 s, membrane 10 N/mm) and App. A/B laws
+--   biax.prepare{…}          a confined sample: Jodrey-Tory deposition (grainlab.pack.deposit) or
+--                            random addition, copied into a gravity-free, mass-scaled scene, the
+--                            pressure ramped on the Delaunay boundary (all sides) with frictionless
+--                            contacts and drag, then friction on and a drag-free rest
+--   biax.scene(state, cfg)   a scene from a saved state (positions, radii)
+--   biax.setup(state, bc, cfg) a scene with one boundary condition: "pressure" (plates + direct
+--                            pressure on the lateral Delaunay edges), "membrane" (plates + chains
+--                            of frictionless membrane disks on springs carrying the pressure),
+--                            "mbc" (pressure on all sides + minimal-boundary penalty)
+local biax = {}
+
+biax.defaults = {
+  young = 30e9, poisson = 0.3, pressure = 1e5, density = 2650, mass_scale = 1e5,
+  friction = 0.45, rate = 5e-3, dt = 1e-5, rmin = 0.5e-3, rmax = 1e-3, thickness = 1.5e-3,
+  damping_time = 0.002, exponent = 10, membrane_k = 1e4, membrane_radius = 1.2e-3,
+  every = 250, alpha = 1.5, kappa = 20,
+}
+
+local function cfg_of(opts)
+  local c = {}
+  for k, v in pairs(biax.defaults) do c[k] = v end
+  for k, v in pairs(opts or {}) do c[k] = v end
+  c.v_r = (opts and opts.v_r) or (c.rmin + c.rmax) * c.rate -- Eq. 3.A2: v_R = d eps_rate
+  return c
+end
+biax.config = cfg_of
+
+local function materials(c)
+  local grain = grainlab.material{ density = c.density, young = c.young, poisson = c.poisson,
+                                   friction = c.friction }
+  local membrane = grainlab.material{ density = c.density, young = c.young, poisson = c.poisson,
+                                      friction = 0 }
+  return grain, membrane
+end
+
+-- A gravity-free, mass-scaled scene holding the state's disks (and nothing else).
+function biax.scene(state, c)
+  c = cfg_of(c)
+  local xlo, xhi, ylo, yhi = math.huge, -math.huge, math.huge, -math.huge
+  for i = 1, #state.x do
+    xlo, xhi = math.min(xlo, state.x[i]), math.max(xhi, state.x[i])
+    ylo, yhi = math.min(ylo, state.y[i]), math.max(yhi, state.y[i])
+  end
+  -- room to bulge sideways (and for MBC to shorten), small enough for readable images
+  local px, py = 0.35 * (xhi - xlo) + 0.01, 0.12 * (yhi - ylo) + 0.005
+  local s = dem.scene{ box = { { xlo - px, ylo - py }, { xhi + px, yhi + py } },
+                       gravity = { 0, 0 }, thickness = c.thickness }
+  local grain, membrane = materials(c)
+  for i = 1, #state.x do
+    s:add_disk{ pos = { state.x[i], state.y[i] }, radius = state.r[i],
+                material = (state.membrane and state.membrane[i]) and membrane or grain }
+  end
+  s:scale_mass(c.mass_scale)
+  return s, grain, membrane
+end
+
+-- Contact laws: App. A (Hertz, Brilliantov damping, regularised Coulomb with v_R = d rate).
+function biax.contact(s, c, frictionless)
+  c = cfg_of(c)
+  if frictionless then
+    s:contact{ normal = "hertz", damping = "brilliantov", damping_time = c.damping_time }
+  else
+    s:contact{ normal = "hertz", damping = "brilliantov", damping_time = c.damping_time,
+               tangential = "coulomb_regularized", v_r = c.v_r, exponent = c.exponent }
+  end
+end
+
+local function save(s)
+  local P = s:particles()
+  local st = { x = {}, y = {}, r = {} }
+  for i = 1, P.count do st.x[i], st.y[i], st.r[i] = P.x[i], P.y[i], P.radius[i] end
+  return st
+end
+biax.save = save
+
+-- Runs `steps` steps at dt in chunks (the boundary is rebuilt inside the engine every c.every).
+local function run(s, steps, c)
+  return s:run{ steps = steps, dt = c.dt, impact_velocity = 1e-3, progress = false }
+end
+
+-- Deposited (or randomly placed) disks, consolidated under the confining pressure.
+--   n, seed, method = "deposit"|"random", shape = "square"|"circle", width (m), ramp_steps,
+--   rest_steps, and any of
+--   biax.defaults. Returns the state {x, y, r} and a report table.
+function biax.prepare(opts)
+  local c = cfg_of(opts)
+  local n, seed = c.n or 400, c.seed or 1
+  local t0 = grainlab.clock()
+  local rm = 0.5 * (c.rmin + c.rmax)
+  local circle = c.shape == "circle"
+  -- a circle of n is cut from the middle of a square deposit of 1.6 n
+  local n_dep = circle and math.ceil(1.6 * n) or math.ceil(1.08 * n)
+  local W = c.width or math.sqrt((circle and n_dep or n) * math.pi * rm * rm / 0.82) -- about square
+  local st
+  if (c.method or "deposit") == "deposit" then
+    local H = 2.5 * W
+    local g = dem.scene{ box = { { -0.01, -0.01 }, { W + 0.01, H } }, gravity = { 0, -9.81 },
+                         thickness = c.thickness }
+    g:contact{ normal = "hertz" }
+    g:add_wall{ point = { 0, 0 }, normal = { 0, 1 } }
+    g:add_wall{ point = { 0, 0 }, normal = { 1, 0 } }
+    g:add_wall{ point = { W, 0 }, normal = { -1, 0 } }
+    local grain = materials(c)
+    -- Jodrey-Tory drops, 8% extra kept off the top (a flat top), no relaxation: the
+    -- consolidation below does it.
+    grainlab.pack.deposit(g, { n = n_dep, radius = { c.rmin, c.rmax }, seed = seed,
+                               material = grain, region = { { 0, 0 }, { W, H } }, relax_steps = 0 })
+    local P = g:particles()
+    local order = {}
+    for i = 1, P.count do order[i] = i end
+    if circle then -- the n nearest to the centre of the deposit
+      local cx, cy = 0, 0
+      for i = 1, P.count do cx, cy = cx + P.x[i] / P.count, cy + P.y[i] / P.count end
+      local d2 = {}
+      for i = 1, P.count do d2[i] = (P.x[i] - cx) ^ 2 + (P.y[i] - cy) ^ 2 end
+      table.sort(order, function(a, b) return d2[a] < d2[b] end)
+    else
+      table.sort(order, function(a, b) return P.y[a] < P.y[b] end)
+    end
+    st = { x = {}, y = {}, r = {} }
+    for k = 1, n do
+      local i = order[k]
+      st.x[k], st.y[k], st.r[k] = P.x[i], P.y[i], P.radius[i]
+    end
+  else
+    local g = dem.scene{ box = { { 0, 0 }, { W * 1.5, W * 1.5 } }, gravity = { 0, 0 },
+                         thickness = c.thickness }
+    grainlab.pack.random(g, { n = n, radius = { c.rmin, c.rmax }, seed = seed })
+    st = save(g)
+  end
+  local s = biax.scene(st, c)
+  biax.contact(s, c, true)
+  -- Pressure ramp on the Delaunay boundary (all sides), frictionless, with drag.
+  s:drag(c.prep_drag or 30)
+  local stages = c.ramp_stages or 10
+  local per = (c.ramp_steps or 20000) // stages
+  for k = 1, stages do
+    s:boundary{ pressure = c.pressure * k / stages, every = c.every, alpha = c.alpha }
+    run(s, per, c)
+  end
+  run(s, c.hold_steps or 10000, c)
+  biax.contact(s, c, false)
+  run(s, c.friction_steps or 5000, c)
+  s:drag(0)
+  run(s, c.rest_steps or 5000, c)
+  local out = save(s)
+  local ke = s:measure("energy").kinetic
+  local mesh = analysis.delaunay(s, { alpha = c.alpha })
+  local stress = mesh:stress(s)
+  local qs = s:quasistatic{ pressure = c.pressure, strain_rate = c.rate }
+  return out, { seconds = grainlab.clock() - t0, kinetic = ke, pressure = stress.mean_pressure,
+                phi = qs.phi, psi = qs.psi, n = n, width = W,
+                coordination = s:measure("coordination").z }
+end
+
+-- biax.prepare, cached in a file: the same n, seed and preparation give the same sample, so
+-- scripts share it (out/biax_<n>_<seed>.lua by default; cache = false to always prepare).
+function biax.prepared(opts)
+  local c = cfg_of(opts)
+  local path = c.cache
+  if path == nil then
+    path = string.format("out/biax_%s%d_%d.lua", c.shape == "circle" and "circle_" or "", c.n or 400, c.seed or 1)
+  end
+  if path then
+    local f = io.open(path, "r")
+    if f then
+      f:close()
+      local ok, st = pcall(dofile, path)
+      if ok and type(st) == "table" and st.x and #st.x == (c.n or 400) then
+        return st, st.report or {}, true
+      end
+    end
+  end
+  local st, rep = biax.prepare(opts)
+  if path then
+    local parts = { "return {\n" }
+    for _, k in ipairs{ "x", "y", "r" } do
+      local v = {}
+      for i = 1, #st[k] do v[i] = string.format("%.17g", st[k][i]) end
+      parts[#parts + 1] = k .. " = {" .. table.concat(v, ",") .. "},\n"
+    end
+    parts[#parts + 1] = "report = {"
+    for k, v in pairs(rep) do parts[#parts + 1] = string.format("%s = %.17g, ", k, v) end
+    parts[#parts + 1] = "} }\n"
+    local dir = path:match("^(.*)/[^/]*$")
+    if dir then os.execute("mkdir -p '" .. dir .. "'") end
+    grainlab.write_file(path, table.concat(parts))
+  end
+  st.report = rep
+  return st, rep, false
+end
+
+local function bounds(st, ids)
+  local ylo, yhi, xlo, xhi = math.huge, -math.huge, math.huge, -math.huge
+  for _, i in ipairs(ids) do
+    ylo, yhi = math.min(ylo, st.y[i] - st.r[i]), math.max(yhi, st.y[i] + st.r[i])
+    xlo, xhi = math.min(xlo, st.x[i] - st.r[i]), math.max(xhi, st.x[i] + st.r[i])
+  end
+  return xlo, xhi, ylo, yhi
+end
+
+-- Membrane chains left and right, touching the sample, from plate to plate: returns the
+-- extended state and the membrane particle ids (left chain top to bottom, right bottom to top).
+local function add_membrane(st, c, ylo, yhi)
+  local n0, rm = #st.x, c.membrane_radius
+  local new = { x = {}, y = {}, r = {}, membrane = {} }
+  for i = 1, n0 do new.x[i], new.y[i], new.r[i] = st.x[i], st.y[i], st.r[i] end
+  -- touching neighbours at most: the gap between centres is >= 2 rm
+  local count = math.max(2, math.floor((yhi - ylo - 2 * rm) / (2 * rm)) + 1)
+  local gap = (yhi - ylo - 2 * rm) / (count - 1)
+  local left, right = {}, {}
+  for side = 1, 2 do
+    for k = 1, count do
+      local y = side == 1 and (yhi - rm - (k - 1) * gap) or (ylo + rm + (k - 1) * gap)
+      local best = side == 1 and math.huge or -math.huge
+      for i = 1, n0 do
+        local dy, R = y - st.y[i], st.r[i] + rm
+        if math.abs(dy) < R then
+          local dx = math.sqrt(R * R - dy * dy) + 1e-9
+          if side == 1 then best = math.min(best, st.x[i] - dx) else best = math.max(best, st.x[i] + dx) end
+        end
+      end
+      local id = #new.x + 1
+      new.x[id], new.y[id], new.r[id], new.membrane[id] = best, y, rm, true
+      if side == 1 then left[#left + 1] = id else right[#right + 1] = id end
+    end
+  end
+  return new, left, right
+end
+
+-- A scene from the prepared state with boundary condition bc. Returns the scene and a table
+-- with: ids (sample particles), plates (wall ids or nil), membrane ids, H0 (plate gap), info.
+function biax.setup(st, bc, opts)
+  local c = cfg_of(opts)
+  local n0 = #st.x
+  local ids = {}
+  for i = 1, n0 do ids[i] = i end
+  local xlo, xhi, ylo, yhi = bounds(st, ids)
+  local lab = { ids = ids, bc = bc, cfg = c }
+  local s
+  if bc == "membrane" then
+    local left, right
+    st, left, right = add_membrane(st, c, ylo, yhi)
+    s = biax.scene(st, c)
+    lab.membrane = {}
+    for _, i in ipairs(left) do lab.membrane[#lab.membrane + 1] = i end
+    for _, i in ipairs(right) do lab.membrane[#lab.membrane + 1] = i end
+    lab.left, lab.right = left, right
+  else
+    s = biax.scene(st, c)
+  end
+  biax.contact(s, c, false)
+  lab.scene = s
+  if bc == "pressure" or bc == "membrane" then
+    local yl, yh = ylo, yhi
+    if bc == "membrane" then -- the membrane disks reach the plates too
+      for _, i in ipairs(lab.membrane) do
+        yl, yh = math.min(yl, st.y[i] - st.r[i]), math.max(yh, st.y[i] + st.r[i])
+      end
+    end
+    lab.plates = { s:add_wall{ point = { 0, yl }, normal = { 0, 1 } },
+                   s:add_wall{ point = { 0, yh }, normal = { 0, -1 } } }
+    lab.H0 = yh - yl
+  end
+  if bc == "pressure" then
+    lab.info = s:boundary{ pressure = c.pressure, every = c.every, alpha = c.alpha, sides = "lateral" }
+  elseif bc == "membrane" then
+    local a, b = {}, {}
+    local si, sj = {}, {}
+    for _, chain in ipairs{ lab.left, lab.right } do
+      for k = 1, #chain - 1 do
+        a[#a + 1], b[#b + 1] = chain[k], chain[k + 1]
+        si[#si + 1], sj[#sj + 1] = chain[k], chain[k + 1]
+      end
+    end
+    lab.info = s:boundary{ mode = "edges", pressure = c.pressure, edges = { a = a, b = b } }
+    s:springs{ i = si, j = sj, k = c.membrane_k }
+    local bottom, top = {}, {}
+    for _, chain in ipairs{ lab.left, lab.right } do
+      local first, last = chain[1], chain[#chain]
+      if st.y[first] < st.y[last] then first, last = last, first end
+      top[#top + 1], bottom[#bottom + 1] = first, last
+    end
+    s:tie{ ids = bottom, wall = lab.plates[1], axis = 2 }
+    s:tie{ ids = top, wall = lab.plates[2], axis = 2 }
+  elseif bc == "mbc" then
+    lab.info = s:boundary{ pressure = c.pressure, every = c.every, alpha = c.alpha,
+                           mbc = { strain_rate = { { 0, 0 }, { 0, -c.rate } },
+                                   mask = { { 0, 1 }, { 1, 1 } }, kappa = c.kappa,
+                                   dt = c.dt } }
+    lab.H0 = yhi - ylo
+  else
+    error("biax.setup: bc must be 'pressure', 'membrane' or 'mbc', got " .. tostring(bc), 2)
+  end
+  return s, lab
+end
+
+-- Plate forces (sum of normal contact forces on walls 1 and 2 of the lab).
+function biax.plate_forces(lab)
+  local C = lab.scene:measure("contacts")
+  local fb, ft = 0, 0
+  local wb, wt = -lab.plates[1], -lab.plates[2]
+  for k = 1, #C.j do
+    if C.j[k] == wb then fb = fb + C.fn[k] elseif C.j[k] == wt then ft = ft + C.fn[k] end
+  end
+  return fb, ft
+end
+
+-- Width of the sample particles (lateral extent) now.
+local function sample_width(lab)
+  local P = lab.scene:particles()
+  local xlo, xhi = math.huge, -math.huge
+  for _, i in ipairs(lab.ids) do
+    xlo, xhi = math.min(xlo, P.x[i] - P.radius[i]), math.max(xhi, P.x[i] + P.radius[i])
+  end
+  return xhi - xlo
+end
+
+-- Plates: servo them onto the sample (with drag) until each carries p W depth within `tol`,
+-- at most `max_steps`; then drag off and the plates move at the imposed strain rate. Replacing
+-- the all-round pressure by plates placed at the highest and lowest particle would otherwise
+-- let the sample unload vertically and spend the first percent of strain taking up the slack.
+-- No-op for MBC (its penalty drives the strain). Returns the plate stress / p (bottom, top).
+function biax.start(lab, max_steps, tol)
+  local s, c = lab.scene, lab.cfg
+  local ratio_b, ratio_t = 1, 1
+  if lab.plates then
+    -- Frictionless while the plates take the load (as in the consolidation): with the
+    -- regularised friction an anisotropically loaded sample creeps, and the servo would chase it.
+    biax.contact(s, c, true)
+    s:drag(lab.servo_drag or 5) -- enough to damp, little enough not to hold the plates back
+    tol = tol or 0.05
+    max_steps = max_steps or 30000
+    -- Approach at vmax until each plate carries half the load, then a proportional servo slow
+    -- enough for the mass-scaled sample (its stiffness k ~ 5e5 N/m against a plate; a servo
+    -- time 1/(gain k) ~ 0.02 s, a few wave transits).
+    local vmax, gain, done, stable = 1e-3, lab.servo_gain or 1e-4, 0, 0
+    local approach_b, approach_t = true, true
+    while done < max_steps do
+      local target = c.pressure * sample_width(lab) * c.thickness
+      local fb, ft = biax.plate_forces(lab)
+      ratio_b, ratio_t = fb / target, ft / target
+      if math.abs(ratio_b - 1) < tol and math.abs(ratio_t - 1) < tol then
+        stable = stable + 1
+        if stable >= 4 then break end
+      else
+        stable = 0
+      end
+      approach_b = approach_b and ratio_b < 0.5
+      approach_t = approach_t and ratio_t < 0.5
+      local function v(app, f)
+        if app then return vmax end
+        return math.max(-vmax, math.min(vmax, gain * (target - f)))
+      end
+      s:wall_velocity(lab.plates[1], { 0, v(approach_b, fb) })
+      s:wall_velocity(lab.plates[2], { 0, -v(approach_t, ft) })
+      run(s, 250, c)
+      done = done + 250
+      if lab.verbose then print(done, ratio_b, ratio_t) end
+    end
+    s:wall_velocity(lab.plates[1], { 0, 0 })
+    s:wall_velocity(lab.plates[2], { 0, 0 })
+    biax.contact(s, c, false)
+    run(s, 2000, c)
+    s:drag(0)
+    run(s, 1000, c)
+    local H = s:wall_point(lab.plates[2])[2] - s:wall_point(lab.plates[1])[2]
+    lab.H0 = H
+    local v = 0.5 * c.rate * H
+    s:wall_velocity(lab.plates[1], { 0, v })
+    s:wall_velocity(lab.plates[2], { 0, -v })
+    lab.servo_steps = done
+  end
+  lab.t0 = s:info().time
+  return ratio_b, ratio_t
+end
+
+-- Imposed axial strain now (plate gap, or rate x time for MBC), compression positive.
+function biax.axial(lab)
+  local s = lab.scene
+  if lab.plates then
+    local H = s:wall_point(lab.plates[2])[2] - s:wall_point(lab.plates[1])[2]
+    return 1 - H / lab.H0
+  end
+  return lab.cfg.rate * (s:info().time - lab.t0)
+end
+
+return biax
