@@ -79,6 +79,7 @@ struct mpm_scene {
     unsigned char *pin;     /* pair q in contact this step (Eq. 12 at the momentum update) */
     unsigned char *pwin;    /* pair q: bit k, friction plane k in contact (as nwin) */
     double *pvol;           /* sum_p N_ip V_p over the grain (the separation check) */
+    double *pcx, *pcy;      /* scratch: the contact correction of pair q this call */
     double *tvol;           /* the same over all grains (nnodes) */
     double *ndp;            /* scratch (3 nnodes): momentum change of the corrections at a node */
     mpm_contact_options opt;

@@ -211,6 +211,8 @@ void mpm_destroy(mpm_scene *s)
     free(s->nforce);
     free(s->pwin);
     free(s->pvol);
+    free(s->pcx);
+    free(s->pcy);
     free(s->tvol);
     free(s->ndp);
     free(s->pnode);
@@ -588,6 +590,8 @@ core_status mpm_contact_reserve(mpm_scene *s, core_error *err)
     GROW(s->pin, need);
     GROW(s->pwin, need);
     GROW(s->pvol, need);
+    GROW(s->pcx, need);
+    GROW(s->pcy, need);
     GROW(s->pnx, need);
     GROW(s->pny, need);
     GROW(s->sv, need);

@@ -627,10 +627,12 @@ static void contact_correct(mpm_scene *s, double *vx, double *vy, bool decide, d
     const double sep = s->opt.separation * s->hx * s->hy;
     const double cap = s->opt.strain_cap * (s->hx < s->hy ? s->hx : s->hy) / dt;
     double *dp = s->ndp; /* per node: momentum change x, y, and the corrected grains' mass */
-    bool any = false;
+    /* every pair on its own (threads split the pairs); the corrections are kept in pcx, pcy */
+#pragma omp for schedule(static)
     for (size_t q = 0; q < s->npairs; q++) {
         const int i = s->pnode[q];
         const size_t e = nn + q;
+        s->pcx[q] = s->pcy[q] = 0;
         if (decide)
             s->pin[q] = 0;
         if (s->ngr[i] < 2 || !(s->nm[e] > 0))
@@ -643,7 +645,7 @@ static void contact_correct(mpm_scene *s, double *vx, double *vy, bool decide, d
             gx = 2 * gx - s->tgx[i];
             gy = 2 * gy - s->tgy[i];
         }
-        const double len = hypot(gx, gy);
+        const double len = sqrt(gx * gx + gy * gy);
         if (!(len > 0))
             continue;
         const double nx = gx / len, ny = gy / len;
@@ -653,7 +655,7 @@ static void contact_correct(mpm_scene *s, double *vx, double *vy, bool decide, d
             s->pin[q] = dn > 0 && !(sep > 0 && s->tvol[i] < sep); /* Eq. 12, separation */
         if (!s->pin[q])
             continue;
-        const double tx = dvx - dn * nx, ty = dvy - dn * ny, t = hypot(tx, ty);
+        const double tx = dvx - dn * nx, ty = dvy - dn * ny, t = sqrt(tx * tx + ty * ty);
         /* Eq. 14: the normal velocity becomes the centre-of-mass one (the force of Eq. 15);
          * Eqs. 18-23: sticking would remove the whole relative tangential velocity t (Eq. 18);
          * Coulomb caps the removal at mu times the normal correction |dn|, i.e.
@@ -665,7 +667,7 @@ static void contact_correct(mpm_scene *s, double *vx, double *vy, bool decide, d
             cy -= c * ty;
         }
         if (cap > 0) {
-            const double c = hypot(cx, cy);
+            const double c = sqrt(cx * cx + cy * cy);
             if (c > cap) {
                 cx *= cap / c;
                 cy *= cap / c;
@@ -673,16 +675,29 @@ static void contact_correct(mpm_scene *s, double *vx, double *vy, bool decide, d
         }
         vx[e] += cx;
         vy[e] += cy;
-        if (!any) {
-            memset(dp, 0, 3 * nn * sizeof(double));
-            any = true;
-        }
-        dp[i] += s->nm[e] * cx;
-        dp[nn + i] += s->nm[e] * cy;
-        dp[2 * nn + i] += s->nm[e];
+        s->pcx[q] = cx;
+        s->pcy[q] = cy;
     }
-    if (!any || !s->opt.conserve)
+    if (!s->opt.conserve)
         return;
+#pragma omp master
+    {
+        for (size_t q = 0; q < s->npairs; q++)
+            if (s->pin[q]) {
+                const int i = s->pnode[q];
+                dp[i] = dp[nn + i] = dp[2 * nn + i] = 0;
+            }
+        for (size_t q = 0; q < s->npairs; q++)
+            if (s->pin[q]) {
+                const int i = s->pnode[q];
+                const double m = s->nm[nn + q];
+                dp[i] += m * s->pcx[q];
+                dp[nn + i] += m * s->pcy[q];
+                dp[2 * nn + i] += m;
+            }
+    }
+#pragma omp barrier
+#pragma omp for schedule(static)
     for (size_t q = 0; q < s->npairs; q++) {
         const int i = s->pnode[q];
         if (!s->pin[q] || s->nwall[i] || (s->npres && s->nforce[i]))
@@ -721,9 +736,7 @@ static void contact_update(mpm_scene *s, double dt)
         s->nay[e] = s->nvy[e] + k * s->nfy[e];
     }
     apply_walls_pairs(s, s->nax, s->nay, true);
-#pragma omp master
     contact_correct(s, s->nax, s->nay, true, dt);
-#pragma omp barrier
 }
 
 /* Step 3: positions (Eq. 10) and velocities (Eq. 11, blended with PIC) of thread t's points; a
@@ -784,9 +797,7 @@ static void nodal_velocity(mpm_scene *s, double dt, bool decide)
     apply_walls(s, s->nax, s->nay, decide);
     if (s->npairs) {
         apply_walls_pairs(s, s->nax, s->nay, decide);
-#pragma omp master
         contact_correct(s, s->nax, s->nay, decide, dt);
-#pragma omp barrier
     }
 }
 
