@@ -103,7 +103,7 @@ for _, model in ipairs(run_models) do
   metrics["prescribed_left_" .. model], metrics["prescribed_right_" .. model] = nl, nr
   local marks = { 0.25, 0.5, 0.63, 0.71, 0.75, shear_end }
   table.sort(marks)
-  local t0 = os.clock()
+  local t0, w0 = os.clock(), grainlab.clock()
   local steps = 0
   for _, gamma in ipairs(marks) do
     if gamma <= shear_end then
@@ -133,8 +133,9 @@ for _, model in ipairs(run_models) do
       end
     end
   end
-  timing[model] = os.clock() - t0
-  metrics["cpu_s_" .. model] = timing[model]
+  timing[model] = grainlab.clock() - w0
+  metrics["cpu_s_" .. model] = os.clock() - t0
+  metrics["wall_s_" .. model] = timing[model]
   metrics["steps_" .. model] = steps
   metrics["point_steps_per_s_" .. model] = metrics.points * steps / timing[model]
 end
