@@ -892,7 +892,7 @@ void bind_open_mpm(lua_State *L)
          "m:run{ steps = N | time = T, dt = 'auto', cfl = 0.4, force = false, every =, "
          "on_step = function(m) end, progress = nil }",
          "Advances the scene (MUSL by default; update = 'usl' in mpm.scene for the paper's "
-         "step order, which is unstable at nearly empty nodes). dt = 'auto' takes cfl x h / (c + max|v|), "
+         "step order, which is unstable at nearly empty nodes, or 'usf', stress first). dt = 'auto' takes cfl x h / (c + max|v|), "
          "re-evaluated every step; a fixed dt above the CFL limit is refused unless force = "
          "true. time = T lands exactly on T. on_step runs every `every` steps; returning false "
          "stops the run. Ctrl-C stops between steps with the scene intact; NaN, an inverted "
@@ -915,7 +915,7 @@ void bind_open_mpm(lua_State *L)
          "Sets every point's velocity from arrays in point order (as m:points() lists them)."},
         {"info", l_info, "m:info()",
          "cells, size, origin, cell_size, gravity, points, grains, time, steps, update, pic, "
-         "contact, mu (0 for noslip), shape, normals, separation, strain_cap."},
+         "contact, mu (0 for noslip), shape, normals, separation, strain_cap, conserve."},
         {NULL, NULL, NULL, NULL}};
     static const luaL_Reg meta[] = {
         {"__gc", l_gc}, {"__close", l_gc}, {"__tostring", l_tostring}, {NULL, NULL}};
