@@ -38,13 +38,14 @@ static void push_pair(lua_State *L, const double v[2])
     }
 }
 
-/* ---- mpm.material{...} ------------------------------------------------------------------------ */
+/* ---- mpm.material{...} ------------------------------------------------------------------------
+ */
 static const char *const MODEL_NAMES[] = {"elastic", "vonmises", NULL};
 
 static int l_material(lua_State *L)
 {
-    static const char *const fields[] = {"model", "density", "shear", "bulk", "yield", "hardening",
-                                         NULL};
+    static const char *const fields[] = {"model", "density",   "shear", "bulk",
+                                         "yield", "hardening", NULL};
     bind_check_table(L, 1, "material");
     bind_check_fields(L, 1, "material", fields);
     mpm_material m = mpm_default_material();
@@ -107,8 +108,10 @@ static int material_tostring(lua_State *L)
     const mpm_material *m = luaL_checkudata(L, 1, MATERIAL);
     char buf[256];
     if (m->model == MPM_VONMISES)
-        snprintf(buf, sizeof buf, "mpm.material vonmises (density %g, shear %g, bulk %g, yield %g, "
-                 "hardening %g)", m->density, m->shear, m->bulk, m->yield, m->hardening);
+        snprintf(buf, sizeof buf,
+                 "mpm.material vonmises (density %g, shear %g, bulk %g, yield %g, "
+                 "hardening %g)",
+                 m->density, m->shear, m->bulk, m->yield, m->hardening);
     else
         snprintf(buf, sizeof buf, "mpm.material elastic (density %g, shear %g, bulk %g)",
                  m->density, m->shear, m->bulk);
@@ -116,7 +119,8 @@ static int material_tostring(lua_State *L)
     return 1;
 }
 
-/* ---- mpm.scene{...} --------------------------------------------------------------------------- */
+/* ---- mpm.scene{...} ---------------------------------------------------------------------------
+ */
 static const char *const WALL_NAMES[] = {"noslip", "slip", "none", "friction", NULL};
 static const char *const SHAPE_NAMES[] = {"linear", "bspline", NULL};
 static const char *const NORMAL_NAMES[] = {"averaged", "own", "linear", NULL};
@@ -161,7 +165,8 @@ static void read_wall(lua_State *L, const char *field, mpm_wall *kind, double *m
             if (strcmp(lua_tostring(L, -1), WALL_NAMES[i]) == 0)
                 w = i;
         if (w == MPM_WALL_FRICTION)
-            bind_field_error(L, 1, "scene", field, "{kind = 'friction', mu = ...} (a friction "
+            bind_field_error(L, 1, "scene", field,
+                             "{kind = 'friction', mu = ...} (a friction "
                              "wall needs mu)");
         if (w < 0)
             bind_field_error(L, 1, "scene", field, expected);
@@ -250,8 +255,8 @@ static void read_walls(lua_State *L, mpm_scene_def *def)
 
 static int l_scene(lua_State *L)
 {
-    static const char *const fields[] = {"cells", "size", "origin", "periodic", "gravity", "walls",
-                                         "update", "pic", "shape", "wall_gap", NULL};
+    static const char *const fields[] = {"cells",  "size", "origin", "periodic", "gravity", "walls",
+                                         "update", "pic",  "shape",  "wall_gap", NULL};
     bind_check_table(L, 1, "scene");
     bind_check_fields(L, 1, "scene", fields);
     mpm_scene_def def = mpm_default_scene_def();
@@ -276,8 +281,8 @@ static int l_scene(lua_State *L)
     def.update = (mpm_update)bind_field_option(L, 1, "scene", "update", UPDATE_NAMES, MPM_MUSL, 0);
     def.pic = bind_field_number(L, 1, "scene", "pic", 0, BIND_NONNEG);
     def.wall_gap = bind_field_number(L, 1, "scene", "wall_gap", def.wall_gap, BIND_NONNEG);
-    def.shape = (mpm_shape_fn)bind_field_option(L, 1, "scene", "shape", SHAPE_NAMES,
-                                                MPM_SHAPE_LINEAR, 0);
+    def.shape =
+        (mpm_shape_fn)bind_field_option(L, 1, "scene", "shape", SHAPE_NAMES, MPM_SHAPE_LINEAR, 0);
     if (def.pic > 1) {
         lua_getfield(L, 1, "pic");
         return bind_field_error(L, 1, "scene", "pic", "number in [0, 1]");
@@ -324,16 +329,20 @@ static int material_of(lua_State *L, int scene, int arg, const char *call)
 /* ---- grains ---------------------------------------------------------------------------------- */
 static int add_grain(lua_State *L, const char *call, mpm_shape shape)
 {
-    static const char *const disk_fields[] = {"center", "radius", "material", "points_per_cell",
-                                              "velocity", "omega", "clip", "hydrostatic", NULL};
-    static const char *const rect_fields[] = {"lo", "hi", "material", "points_per_cell",
-                                              "velocity", "omega", "clip", "hydrostatic", NULL};
-    static const char *const poly_fields[] = {"vertices", "material", "points_per_cell",
-                                              "velocity", "omega", "clip", "hydrostatic", NULL};
+    static const char *const disk_fields[] = {"center",   "radius", "material", "points_per_cell",
+                                              "velocity", "omega",  "clip",     "hydrostatic",
+                                              NULL};
+    static const char *const rect_fields[] = {"lo",       "hi",    "material", "points_per_cell",
+                                              "velocity", "omega", "clip",     "hydrostatic",
+                                              NULL};
+    static const char *const poly_fields[] = {"vertices", "material", "points_per_cell", "velocity",
+                                              "omega",    "clip",     "hydrostatic",     NULL};
     mpm_scene *s = check_scene(L, 1);
     bind_check_table(L, 2, call);
-    bind_check_fields(L, 2, call, shape == MPM_DISK ? disk_fields
-                                  : shape == MPM_RECT ? rect_fields : poly_fields);
+    bind_check_fields(L, 2, call,
+                      shape == MPM_DISK   ? disk_fields
+                      : shape == MPM_RECT ? rect_fields
+                                          : poly_fields);
     mpm_grain_def g = mpm_default_grain_def();
     g.shape = shape;
     if (shape == MPM_POLYGON) {
@@ -351,9 +360,10 @@ static int add_grain(lua_State *L, const char *call, mpm_shape shape)
                 lua_pop(L, 1);
             }
             if (!ok)
-                return luaL_error(L, "bad field 'vertices' in argument #1 to '%s' (%s expected, "
-                                  "vertex %d is not a pair of finite numbers)", call, expected,
-                                  i + 1);
+                return luaL_error(L,
+                                  "bad field 'vertices' in argument #1 to '%s' (%s expected, "
+                                  "vertex %d is not a pair of finite numbers)",
+                                  call, expected, i + 1);
             lua_pop(L, 1);
         }
         g.vertices = v;
@@ -381,9 +391,11 @@ static int add_grain(lua_State *L, const char *call, mpm_shape shape)
     size_t other;
     double overlap = mpm_grain_overlap(s, (size_t)id, &other);
     if (overlap > 0)
-        fprintf(stderr, "grainlab: warning: %s: grain %ld overlaps grain %zu by %g m; overlapping "
+        fprintf(stderr,
+                "grainlab: warning: %s: grain %ld overlaps grain %zu by %g m; overlapping "
                 "grains share material points' cells from the start (with 'friction' they are "
-                "pushed apart, with 'noslip' glued)\n", call, id + 1, other + 1, overlap);
+                "pushed apart, with 'noslip' glued)\n",
+                call, id + 1, other + 1, overlap);
     lua_pushinteger(L, id + 1);
     return 1;
 }
@@ -395,8 +407,8 @@ static int l_add_polygon(lua_State *L) { return add_grain(L, "add_polygon", MPM_
 /* ---- contact --------------------------------------------------------------------------------- */
 static int l_contact(lua_State *L)
 {
-    static const char *const fields[] = {"model", "mu", "normals", "separation", "strain_cap",
-                                         "conserve", NULL};
+    static const char *const fields[] = {"model",      "mu",       "normals", "separation",
+                                         "strain_cap", "conserve", NULL};
     static const char *const names[] = {"noslip", "friction", NULL};
     mpm_scene *s = check_scene(L, 1);
     bind_check_table(L, 2, "contact");
@@ -404,8 +416,8 @@ static int l_contact(lua_State *L)
     int model = bind_field_option(L, 2, "contact", "model", names, 0, BIND_REQUIRED);
     core_error err;
     mpm_contact_options o = mpm_default_contact_options();
-    o.normals = (mpm_normals)bind_field_option(L, 2, "contact", "normals", NORMAL_NAMES,
-                                               o.normals, 0);
+    o.normals =
+        (mpm_normals)bind_field_option(L, 2, "contact", "normals", NORMAL_NAMES, o.normals, 0);
     o.separation = bind_field_number(L, 2, "contact", "separation", o.separation, BIND_NONNEG);
     if (o.separation > 1) {
         lua_getfield(L, 2, "separation");
@@ -434,19 +446,23 @@ static int l_prescribe(lua_State *L)
     mpm_scene *s = check_scene(L, 1);
     lua_Integer id = luaL_checkinteger(L, 2);
     if (id < 1 || (size_t)id > mpm_grain_count(s))
-        return luaL_error(L, "bad argument #1 to 'prescribe' (grain id in [1, %d] expected, got "
-                          "%d)", (int)mpm_grain_count(s), (int)id);
+        return luaL_error(L,
+                          "bad argument #1 to 'prescribe' (grain id in [1, %d] expected, got "
+                          "%d)",
+                          (int)mpm_grain_count(s), (int)id);
     double v[2];
     if (lua_type(L, 3) != LUA_TTABLE)
-        return luaL_error(L, "bad argument #2 to 'prescribe' (velocity {vx, vy} expected, got "
-                          "%s)", luaL_typename(L, 3));
+        return luaL_error(L,
+                          "bad argument #2 to 'prescribe' (velocity {vx, vy} expected, got "
+                          "%s)",
+                          luaL_typename(L, 3));
     for (int k = 0; k < 2; k++) {
         lua_rawgeti(L, 3, k + 1);
         int ok;
         v[k] = lua_tonumberx(L, -1, &ok);
         if (!ok || !isfinite(v[k]))
             return luaL_error(L, "bad argument #2 to 'prescribe' (velocity {vx, vy} of finite "
-                              "numbers expected)");
+                                 "numbers expected)");
         lua_pop(L, 1);
     }
     core_error err;
@@ -484,9 +500,9 @@ static int l_plane(lua_State *L)
 /* m:field(name) -> {nx =, ny =, values = {...} (row-major, nan in empty cells), ...} */
 static int l_field(lua_State *L)
 {
-    static const char *const names[] = {"vx", "vy", "speed", "ux", "uy", "displacement", "sxx",
-                                        "syy", "sxy", "pressure", "psd", "eps_p", "grain", "mass",
-                                        NULL};
+    static const char *const names[] = {"vx",           "vy",    "speed", "ux",   "uy",
+                                        "displacement", "sxx",   "syy",   "sxy",  "pressure",
+                                        "psd",          "eps_p", "grain", "mass", NULL};
     mpm_scene *s = check_scene(L, 1);
     int kind = luaL_checkoption(L, 2, NULL, names);
     const mpm_scene_def *d = mpm_def(s);
@@ -552,8 +568,8 @@ static core_status mpm_advance(void *ctx, long n, long *done, core_error *err)
 
 static int l_run(lua_State *L)
 {
-    static const char *const fields[] = {"steps", "time", "dt", "cfl", "force", "every", "on_step",
-                                         "progress", NULL};
+    static const char *const fields[] = {"steps", "time",    "dt",       "cfl", "force",
+                                         "every", "on_step", "progress", NULL};
     mpm_scene *s = check_scene(L, 1);
     bind_check_table(L, 2, "run");
     bind_check_fields(L, 2, "run", fields);
@@ -685,7 +701,6 @@ static int l_grain(lua_State *L)
     return 1;
 }
 
-
 static int l_points(lua_State *L)
 {
     mpm_scene *s = check_scene(L, 1);
@@ -746,8 +761,10 @@ static int l_set_velocities(lua_State *L)
             int isnum;
             v[d][i] = lua_tonumberx(L, -1, &isnum);
             if (!isnum || !isfinite(v[d][i]))
-                return luaL_error(L, "bad field '%s' in argument #1 to 'set_velocities' (%s "
-                                  "expected, entry %d is not)", comp[d], expected, (int)i + 1);
+                return luaL_error(L,
+                                  "bad field '%s' in argument #1 to 'set_velocities' (%s "
+                                  "expected, entry %d is not)",
+                                  comp[d], expected, (int)i + 1);
             lua_pop(L, 1);
         }
     }
@@ -818,9 +835,9 @@ static int l_tostring(lua_State *L)
         lua_pushliteral(L, "mpm.scene (closed)");
     } else {
         const mpm_scene_def *d = mpm_def(u->s);
-        lua_pushfstring(L, "mpm.scene (%d x %d cells, %d grains, %d points, t = %f s)",
-                        d->cells[0], d->cells[1], (int)mpm_grain_count(u->s),
-                        (int)mpm_point_count(u->s), mpm_time(u->s));
+        lua_pushfstring(L, "mpm.scene (%d x %d cells, %d grains, %d points, t = %f s)", d->cells[0],
+                        d->cells[1], (int)mpm_grain_count(u->s), (int)mpm_point_count(u->s),
+                        mpm_time(u->s));
     }
     return 1;
 }
@@ -843,7 +860,8 @@ void bind_open_mpm(lua_State *L)
          "and hydrostatic = true (initial static pressure with grad p = rho g, p = 0 at the "
          "grain's top, the paper's incline)."},
         {"add_polygon", l_add_polygon,
-         "m:add_polygon{ vertices = {{x1, y1}, {x2, y2}, ...}, material = mat, points_per_cell = 2, "
+         "m:add_polygon{ vertices = {{x1, y1}, {x2, y2}, ...}, material = mat, points_per_cell = "
+         "2, "
          "velocity =, omega =, clip =, hydrostatic = }",
          "Fills a simple polygon (either orientation, at least 3 vertices) with points like "
          "add_disk (angular grains); returns the grain id."},
@@ -892,7 +910,8 @@ void bind_open_mpm(lua_State *L)
          "m:run{ steps = N | time = T, dt = 'auto', cfl = 0.4, force = false, every =, "
          "on_step = function(m) end, progress = nil }",
          "Advances the scene (MUSL by default; update = 'usl' in mpm.scene for the paper's "
-         "step order, which is unstable at nearly empty nodes, or 'usf', stress first). dt = 'auto' takes cfl x h / (c + max|v|), "
+         "step order, which is unstable at nearly empty nodes, or 'usf', stress first). dt = "
+         "'auto' takes cfl x h / (c + max|v|), "
          "re-evaluated every step; a fixed dt above the CFL limit is refused unless force = "
          "true. time = T lands exactly on T. on_step runs every `every` steps; returning false "
          "stops the run. Ctrl-C stops between steps with the scene intact; NaN, an inverted "
@@ -943,7 +962,9 @@ void bind_open_mpm(lua_State *L)
          "stops the run); {kind = 'friction', mu = 0.5} applies the grain contact rule against "
          "a rigid wall (Coulomb, only material moving into it); velocity = {vx, vy} moves a "
          "wall. shape: 'linear' (the paper's, 4 nodes per point) or 'bspline' (quadratic, 9 "
-         "nodes, smooth across cell edges; a ghost node layer beyond each wall). update: 'musl' (default: the strain rate from remapped, mass-weighted nodal velocities, stable at nearly empty nodes) or 'usl' (the paper's step order). pic: PIC "
+         "nodes, smooth across cell edges; a ghost node layer beyond each wall). update: 'musl' "
+         "(default: the strain rate from remapped, mass-weighted nodal velocities, stable at "
+         "nearly empty nodes) or 'usl' (the paper's step order). pic: PIC "
          "fraction of the point velocity update (0 = pure FLIP, Eq. 11)."},
         {"material", l_material,
          "mpm.material{ model = 'elastic'|'vonmises', density =, shear =, bulk =, yield =, "

@@ -7,8 +7,12 @@
 
 mpm_material mpm_default_material(void)
 {
-    return (mpm_material){.model = MPM_ELASTIC, .density = 3000, .shear = 2.5e6, .bulk = 10e6,
-                          .yield = 0, .hardening = 0};
+    return (mpm_material){.model = MPM_ELASTIC,
+                          .density = 3000,
+                          .shear = 2.5e6,
+                          .bulk = 10e6,
+                          .yield = 0,
+                          .hardening = 0};
 }
 
 core_status mpm_check_material(const mpm_material *m, core_error *err)

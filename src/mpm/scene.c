@@ -8,17 +8,17 @@
 
 mpm_scene_def mpm_default_scene_def(void)
 {
-    return (mpm_scene_def){.cells = {10, 10},
-                           .origin = {0, 0},
-                           .size = {1, 1},
-                           .periodic = {false, false},
-                           .gravity = {0, 0},
-                           .walls = {MPM_WALL_NOSLIP, MPM_WALL_NOSLIP, MPM_WALL_NOSLIP,
-                                     MPM_WALL_NOSLIP},
-                           .update = MPM_MUSL,
-                           .shape = MPM_SHAPE_LINEAR,
-                           .wall_gap = 0.02,
-                           .pic = 0};
+    return (mpm_scene_def){
+        .cells = {10, 10},
+        .origin = {0, 0},
+        .size = {1, 1},
+        .periodic = {false, false},
+        .gravity = {0, 0},
+        .walls = {MPM_WALL_NOSLIP, MPM_WALL_NOSLIP, MPM_WALL_NOSLIP, MPM_WALL_NOSLIP},
+        .update = MPM_MUSL,
+        .shape = MPM_SHAPE_LINEAR,
+        .wall_gap = 0.02,
+        .pic = 0};
 }
 
 static void *alloc_zero(size_t n, size_t size) { return calloc(n ? n : 1, size); }
@@ -85,7 +85,8 @@ core_status mpm_create(const mpm_scene_def *def, mpm_scene **out, core_error *er
             return core_fail(err, CORE_ERR_ARG, "cells[%d] must be in [1, 1048576], got %d", d + 1,
                              def->cells[d]);
         if (!(def->size[d] > 0) || !isfinite(def->size[d]))
-            return core_fail(err, CORE_ERR_ARG, "size[%d] must be > 0, got %g", d + 1, def->size[d]);
+            return core_fail(err, CORE_ERR_ARG, "size[%d] must be > 0, got %g", d + 1,
+                             def->size[d]);
         if (!isfinite(def->origin[d]) || !isfinite(def->gravity[d]))
             return core_fail(err, CORE_ERR_ARG, "origin and gravity must be finite");
         if (def->periodic[d] && def->cells[d] < 3)
@@ -124,7 +125,7 @@ core_status mpm_create(const mpm_scene_def *def, mpm_scene **out, core_error *er
     s->nnx = def->cells[0] + (def->periodic[0] ? 0 : 1 + 2 * s->gl[0]);
     s->nny = def->cells[1] + (def->periodic[1] ? 0 : 1 + 2 * s->gl[1]);
     s->nnodes = (size_t)s->nnx * (size_t)s->nny;
-    double **fields[] = {&s->nm, &s->npx, &s->npy, &s->nfx, &s->nfy,
+    double **fields[] = {&s->nm,  &s->npx, &s->npy, &s->nfx, &s->nfy,
                          &s->nvx, &s->nvy, &s->nax, &s->nay};
     for (size_t k = 0; k < sizeof fields / sizeof *fields; k++)
         if (!(*fields[k] = alloc_zero(s->nnodes, sizeof(double)))) {
@@ -159,14 +160,15 @@ core_status mpm_create(const mpm_scene_def *def, mpm_scene **out, core_error *er
                 w |= 1u << MPM_RIGHT;
             if (!def->periodic[1] && gj <= 0 && s->planes[MPM_BOTTOM].kind != MPM_WALL_NONE)
                 w |= 1u << MPM_BOTTOM;
-            if (!def->periodic[1] && gj >= def->cells[1] && s->planes[MPM_TOP].kind != MPM_WALL_NONE)
+            if (!def->periodic[1] && gj >= def->cells[1] &&
+                s->planes[MPM_TOP].kind != MPM_WALL_NONE)
                 w |= 1u << MPM_TOP;
             s->nwall[(size_t)j * s->nnx + i] = w;
         }
     s->opt = mpm_default_contact_options();
     for (int k = 0; k < 4; k++)
-        s->slack[k / 2][k % 2] = s->planes[k].kind == MPM_WALL_NONE ? 0
-                                 : 0.25 * (k / 2 ? s->hy : s->hx);
+        s->slack[k / 2][k % 2] =
+            s->planes[k].kind == MPM_WALL_NONE ? 0 : 0.25 * (k / 2 ? s->hy : s->hx);
     for (int k = 0; k < 4; k++) {
         /* the grid edge's plane passes through the edge */
         s->planes[k].point[0] = def->origin[0] + (k == MPM_RIGHT ? def->size[0] : 0);
@@ -184,9 +186,10 @@ core_status mpm_create(const mpm_scene_def *def, mpm_scene **out, core_error *er
 
 static double **point_doubles(mpm_scene *s, int k)
 {
-    double **list[] = {&s->x, &s->y, &s->vx, &s->vy, &s->m, &s->v0, &s->F[0], &s->F[1], &s->F[2],
-                       &s->F[3], &s->be[0], &s->be[1], &s->be[2], &s->be[3], &s->sig[0],
-                       &s->sig[1], &s->sig[2], &s->sig[3], &s->eps_p, &s->ux, &s->uy, NULL};
+    double **list[] = {&s->x,     &s->y,     &s->vx,     &s->vy,     &s->m,      &s->v0,
+                       &s->F[0],  &s->F[1],  &s->F[2],   &s->F[3],   &s->be[0],  &s->be[1],
+                       &s->be[2], &s->be[3], &s->sig[0], &s->sig[1], &s->sig[2], &s->sig[3],
+                       &s->eps_p, &s->ux,    &s->uy,     NULL};
     return list[k];
 }
 
@@ -194,8 +197,8 @@ void mpm_destroy(mpm_scene *s)
 {
     if (!s)
         return;
-    double *fields[] = {s->nm, s->npx, s->npy, s->nfx, s->nfy, s->nvx, s->nvy, s->nax, s->nay,
-                        s->sw, s->sgx, s->sgy};
+    double *fields[] = {s->nm,  s->npx, s->npy, s->nfx, s->nfy, s->nvx,
+                        s->nvy, s->nax, s->nay, s->sw,  s->sgx, s->sgy};
     for (size_t k = 0; k < sizeof fields / sizeof *fields; k++)
         free(fields[k]);
     for (int k = 0; point_doubles(s, k); k++)
@@ -307,8 +310,8 @@ static core_status reserve_points(mpm_scene *s, size_t n, core_error *err)
 
 mpm_grain_def mpm_default_grain_def(void)
 {
-    return (mpm_grain_def){.shape = MPM_DISK, .radius = 0, .material = 0, .points_per_cell = 2,
-                           .clip = false};
+    return (mpm_grain_def){
+        .shape = MPM_DISK, .radius = 0, .material = 0, .points_per_cell = 2, .clip = false};
 }
 
 static bool inside(const mpm_grain_def *g, double x, double y)
@@ -380,7 +383,8 @@ long mpm_add_grain(mpm_scene *s, const mpm_grain_def *g, core_error *err)
     } else {
         for (int a = 0; a < 2; a++) {
             if (!(g->hi[a] > g->lo[a])) {
-                core_fail(err, CORE_ERR_ARG, "the rectangle's upper corner must be above the "
+                core_fail(err, CORE_ERR_ARG,
+                          "the rectangle's upper corner must be above the "
                           "lower one on every axis");
                 return -1;
             }
@@ -392,21 +396,26 @@ long mpm_add_grain(mpm_scene *s, const mpm_grain_def *g, core_error *err)
     for (int a = 0; a < 2; a++) {
         double glo = d->origin[a], ghi = d->origin[a] + d->size[a];
         if (d->periodic[a] && hi[a] - lo[a] >= d->size[a]) {
-            core_fail(err, CORE_ERR_ARG, "the shape spans %g in %s, not less than the periodic "
-                      "length %g", hi[a] - lo[a], axis[a], d->size[a]);
+            core_fail(err, CORE_ERR_ARG,
+                      "the shape spans %g in %s, not less than the periodic "
+                      "length %g",
+                      hi[a] - lo[a], axis[a], d->size[a]);
             return -1;
         }
         if (!d->periodic[a] && !g->clip && (lo[a] < glo || hi[a] > ghi)) {
-            core_fail(err, CORE_ERR_ARG, "the shape spans [%g, %g] in %s, outside the grid [%g, %g]",
-                      lo[a], hi[a], axis[a], glo, ghi);
+            core_fail(err, CORE_ERR_ARG,
+                      "the shape spans [%g, %g] in %s, outside the grid [%g, %g]", lo[a], hi[a],
+                      axis[a], glo, ghi);
             return -1;
         }
     }
     /* Points at the centres of n x n sub-cells of every grid cell, kept when inside the shape. */
     const int n = g->points_per_cell;
     const double dx = s->hx / n, dy = s->hy / n;
-    long i0 = (long)floor((lo[0] - d->origin[0]) / dx), i1 = (long)ceil((hi[0] - d->origin[0]) / dx);
-    long j0 = (long)floor((lo[1] - d->origin[1]) / dy), j1 = (long)ceil((hi[1] - d->origin[1]) / dy);
+    long i0 = (long)floor((lo[0] - d->origin[0]) / dx),
+         i1 = (long)ceil((hi[0] - d->origin[0]) / dx);
+    long j0 = (long)floor((lo[1] - d->origin[1]) / dy),
+         j1 = (long)ceil((hi[1] - d->origin[1]) / dy);
     if (g->clip) { /* sub-cells inside the grid only, on axes that are not periodic */
         const long n0[2] = {(long)n * d->cells[0] - 1, (long)n * d->cells[1] - 1};
         if (!d->periodic[0]) {
@@ -430,8 +439,10 @@ long mpm_add_grain(mpm_scene *s, const mpm_grain_def *g, core_error *err)
             }
         }
     if (count == 0) {
-        core_fail(err, CORE_ERR_ARG, "the shape holds no point at %d points per cell (cell %g x %g): "
-                  "make it larger or use more points per cell", n, s->hx, s->hy);
+        core_fail(err, CORE_ERR_ARG,
+                  "the shape holds no point at %d points per cell (cell %g x %g): "
+                  "make it larger or use more points per cell",
+                  n, s->hx, s->hy);
         return -1;
     }
     cx /= (double)count;
@@ -527,7 +538,8 @@ size_t mpm_point_count(const mpm_scene *s) { return s->np; }
 core_status mpm_set_contact(mpm_scene *s, mpm_contact_model model, core_error *err)
 {
     if (model == MPM_CONTACT_FRICTION)
-        return core_fail(err, CORE_ERR_ARG, "contact model 'friction' needs a friction "
+        return core_fail(err, CORE_ERR_ARG,
+                         "contact model 'friction' needs a friction "
                          "coefficient: use mpm_set_friction(scene, mu)");
     if (model != MPM_CONTACT_NOSLIP)
         return core_fail(err, CORE_ERR_ARG, "unknown contact model %d", (int)model);
@@ -548,13 +560,13 @@ mpm_contact_model mpm_contact(const mpm_scene *s) { return s->contact; }
 double mpm_friction(const mpm_scene *s) { return s->contact == MPM_CONTACT_FRICTION ? s->mu : 0; }
 
 /* realloc that keeps *a on failure. */
-#define GROW(a, n)                                                                                \
-    do {                                                                                          \
-        void *grown_ = realloc((a), ((n) ? (n) : 1) * sizeof *(a));                               \
-        if (!grown_)                                                                              \
-            return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu contact field entries", \
-                             (size_t)(n));                                                       \
-        (a) = grown_;                                                                             \
+#define GROW(a, n)                                                                                 \
+    do {                                                                                           \
+        void *grown_ = realloc((a), ((n) ? (n) : 1) * sizeof *(a));                                \
+        if (!grown_)                                                                               \
+            return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu contact field entries",   \
+                             (size_t)(n));                                                         \
+        (a) = grown_;                                                                              \
     } while (0)
 
 core_status mpm_contact_reserve(mpm_scene *s, core_error *err)
@@ -633,8 +645,8 @@ core_status mpm_set_velocities(mpm_scene *s, const double *vx, const double *vy,
 
 mpm_contact_options mpm_default_contact_options(void)
 {
-    return (mpm_contact_options){.normals = MPM_NORMALS_AVERAGED, .separation = 0,
-                                 .strain_cap = 0, .conserve = true};
+    return (mpm_contact_options){
+        .normals = MPM_NORMALS_AVERAGED, .separation = 0, .strain_cap = 0, .conserve = true};
 }
 
 core_status mpm_set_contact_options(mpm_scene *s, const mpm_contact_options *o, core_error *err)
@@ -693,7 +705,8 @@ core_status mpm_add_plane(mpm_scene *s, const mpm_plane_def *d, core_error *err)
     if (d->kind != MPM_WALL_NOSLIP && d->kind != MPM_WALL_SLIP && d->kind != MPM_WALL_FRICTION)
         return core_fail(err, CORE_ERR_ARG, "a plane is noslip, slip or friction");
     if (!(d->mu >= 0) || !isfinite(d->mu))
-        return core_fail(err, CORE_ERR_ARG, "the plane's mu must be finite and >= 0, got %g", d->mu);
+        return core_fail(err, CORE_ERR_ARG, "the plane's mu must be finite and >= 0, got %g",
+                         d->mu);
     for (int a = 0; a < 2; a++)
         if (!isfinite(d->point[a]) || !isfinite(d->velocity[a]))
             return core_fail(err, CORE_ERR_ARG, "the plane's point and velocity must be finite");

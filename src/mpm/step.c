@@ -103,7 +103,8 @@ core_status mpm_timestep_info(const mpm_scene *s, double cfl, mpm_timestep *out,
     if (!(cfl > 0 && cfl <= 1))
         return core_fail(err, CORE_ERR_ARG, "cfl must be in (0, 1], got %g", cfl);
     if (s->np == 0)
-        return core_fail(err, CORE_ERR_STATE, "the scene has no material points: add a grain first");
+        return core_fail(err, CORE_ERR_STATE,
+                         "the scene has no material points: add a grain first");
     double c = 0;
     for (size_t g = 0; g < s->ngrains; g++) {
         double cg = mpm_wave_speed(&s->mats[s->mat[s->gstart[g]]]);
@@ -310,9 +311,7 @@ static inline void wall_rule(const mpm_plane *pl, double *vx, double *vy, unsign
     double rx = *vx - pl->v[0], ry = *vy - pl->v[1];
     const double vn = rx * pl->n[0] + ry * pl->n[1];
     switch (pl->kind) {
-    case MPM_WALL_NOSLIP:
-        rx = ry = 0;
-        break;
+    case MPM_WALL_NOSLIP: rx = ry = 0; break;
     case MPM_WALL_SLIP:
         rx -= vn * pl->n[0];
         ry -= vn * pl->n[1];
@@ -332,8 +331,7 @@ static inline void wall_rule(const mpm_plane *pl, double *vx, double *vy, unsign
         }
         break;
     }
-    case MPM_WALL_NONE:
-        return;
+    case MPM_WALL_NONE: return;
     }
     *vx = pl->v[0] + rx;
     *vy = pl->v[1] + ry;
@@ -365,8 +363,8 @@ static void apply_walls(mpm_scene *s, double *vx, double *vy, bool decide)
         if (w)
             for (int k = 0; k < s->nplanes; k++)
                 if (w & (1u << k))
-                    wall_rule(&s->planes[k], &vx[i], &vy[i], &s->nwin[i],
-                              (unsigned char)(1u << k), decide, !decide || near_plane(s, k, i));
+                    wall_rule(&s->planes[k], &vx[i], &vy[i], &s->nwin[i], (unsigned char)(1u << k),
+                              decide, !decide || near_plane(s, k, i));
         if (s->npres && s->nforce[i]) {
             vx[i] = s->pv[s->nforce[i] - 1][0];
             vy[i] = s->pv[s->nforce[i] - 1][1];
@@ -389,8 +387,8 @@ static void apply_walls_pairs(mpm_scene *s, double *vx, double *vy, bool decide)
         if (w)
             for (int k = 0; k < s->nplanes; k++)
                 if (w & (1u << k))
-                    wall_rule(&s->planes[k], &vx[e], &vy[e], &s->pwin[q],
-                              (unsigned char)(1u << k), decide, !decide || near_plane(s, k, i));
+                    wall_rule(&s->planes[k], &vx[e], &vy[e], &s->pwin[q], (unsigned char)(1u << k),
+                              decide, !decide || near_plane(s, k, i));
         const int k = s->npres ? s->gpres[s->pgrain[q]] : -1;
         if (k >= 0) {
             vx[e] = s->pv[k][0];
@@ -946,8 +944,8 @@ static size_t check_points(mpm_scene *s, int *why)
     }
     if (first != (size_t)-1)
         *why = isfinite(s->x[first]) && isfinite(s->y[first]) && isfinite(s->vx[first]) &&
-               isfinite(s->vy[first]) && isfinite(s->sig[0][first]) &&
-               isfinite(s->sig[1][first]) && isfinite(s->sig[2][first]);
+               isfinite(s->vy[first]) && isfinite(s->sig[0][first]) && isfinite(s->sig[1][first]) &&
+               isfinite(s->sig[2][first]);
     return first;
 }
 
@@ -961,7 +959,8 @@ core_status mpm_run(mpm_scene *s, const mpm_run_def *run, long *done, core_error
     if (run->dt == 0 && !(run->cfl > 0 && run->cfl <= 1))
         return core_fail(err, CORE_ERR_ARG, "cfl must be in (0, 1], got %g", run->cfl);
     if (s->np == 0)
-        return core_fail(err, CORE_ERR_STATE, "the scene has no material points: add a grain first");
+        return core_fail(err, CORE_ERR_STATE,
+                         "the scene has no material points: add a grain first");
     core_status st;
     const bool friction = s->contact == MPM_CONTACT_FRICTION;
     if (friction) {
@@ -1027,16 +1026,19 @@ core_status mpm_run(mpm_scene *s, const mpm_run_def *run, long *done, core_error
             if (tbad[t] != (size_t)-1)
                 return unstable(s, tbad[t], "was inverted (det F <= 0)",
                                 "the time step is too large for the wave speed, or a point too "
-                                "strongly compressed between walls", err);
+                                "strongly compressed between walls",
+                                err);
         int why = 0;
         size_t bad = check_points(s, &why);
         if (bad != (size_t)-1)
             return why ? unstable(s, bad, "left the grid",
                                   "an edge without a wall (walls = 'none'), or a time step too "
-                                  "large for the speed", err)
+                                  "large for the speed",
+                                  err)
                        : unstable(s, bad, "has a non-finite position, velocity or stress",
                                   "the time step is too large for the wave speed (use dt = "
-                                  "\"auto\" or a smaller cfl)", err);
+                                  "\"auto\" or a smaller cfl)",
+                                  err);
         s->time += dt;
         s->steps++;
         ++*done;
