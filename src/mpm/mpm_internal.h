@@ -86,7 +86,6 @@ struct mpm_scene {
     double *pnx, *pny;      /* sum_p m_p G_pi over the grain: its outward normal direction */
     int *ngr;               /* grains touching node i (nnodes) */
     double *tgx, *tgy;      /* sum_p m_p G_pi over all grains (nnodes) */
-    int *mark;              /* scratch (nnodes, -1): pair of node i for the grain being built */
     int *sv;                /* ns per point: the friction sf */
 
     mpm_material *mats;

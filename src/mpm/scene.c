@@ -226,7 +226,6 @@ void mpm_destroy(mpm_scene *s)
     free(s->pnx);
     free(s->pny);
     free(s->ngr);
-    free(s->mark);
     free(s->sv);
     free(s->grain);
     free(s->mat);
@@ -575,16 +574,13 @@ core_status mpm_contact_reserve(mpm_scene *s, core_error *err)
     if (need + nn > (size_t)INT_MAX)
         return core_fail(err, CORE_ERR_NOMEM, "%zu points are too many for the contact fields",
                          s->np);
-    if (!s->mark) {
+    if (!s->ndp) {
         GROW(s->ngr, nn);
         GROW(s->tgx, nn);
         GROW(s->tgy, nn);
-        GROW(s->mark, nn);
         GROW(s->tvol, nn);
         const size_t nn3 = 3 * nn;
         GROW(s->ndp, nn3);
-        for (size_t i = 0; i < nn; i++)
-            s->mark[i] = -1;
     }
     if (need <= s->paircap && s->sv)
         return CORE_OK;
