@@ -300,15 +300,10 @@ function biax.setup(st, bc, opts)
   return s, lab
 end
 
--- Plate forces (sum of normal contact forces on walls 1 and 2 of the lab).
+-- Plate forces (bottom, top): the normal force each plate exerts on the sample, contacts and the
+-- tied membrane ends (s:wall_force).
 function biax.plate_forces(lab)
-  local C = lab.scene:measure("contacts")
-  local fb, ft = 0, 0
-  local wb, wt = -lab.plates[1], -lab.plates[2]
-  for k = 1, #C.j do
-    if C.j[k] == wb then fb = fb + C.fn[k] elseif C.j[k] == wt then ft = ft + C.fn[k] end
-  end
-  return fb, ft
+  return lab.scene:wall_force(lab.plates[1]), lab.scene:wall_force(lab.plates[2])
 end
 
 -- Width of the sample particles (lateral extent) now.
@@ -328,12 +323,14 @@ end
 -- (s:wall_servo: M dv/dt = p W t - F_contact - M rate v, every step, in C): a velocity servo
 -- updated every 250 steps went unstable at 3300 disks (the plate stiffness of a big sample times
 -- the gain times 250 dt is past 2; plate stress / p still 2.2 / 0.47 after 30000 steps). The
--- plate mass is set so that the terminal approach speed F / (M rate) is `vmax` (1 mm/s, 10 mm
--- for a 5 mm gap: 1000 steps): M = F / (rate vmax); with rate = 100/s the plate on a sample of
--- stiffness k ~ 1e6 N/m is near critically damped (2 sqrt(k / M) ~ 2e2/s).
--- Stages, all under the servo: frictionless with drag until converged (an anisotropically
--- loaded frictional sample creeps and the servo would chase it), friction on (2000 steps), drag
--- off (1000 steps), then on until converged again, judged on the plate force averaged over 250
+-- plate mass is set so that the terminal approach speed F / (M rate) is `vmax` (0.05/s times
+-- the plate gap, 4 mm/s at 3300 disks): M = F / (rate vmax), with rate = 200/s (at 3300 disks
+-- 1 mm/s and 100/s took over 60000 steps, the loose top of the deposit compacting slowly; at
+-- 300 disks 4 mm/s left the plates oscillating).
+-- Stages, all under the servo and with friction (frictionless, as in the consolidation, the
+-- plates chased a sample that flowed sideways; `servo_frictionless` keeps that option): with
+-- drag until converged, 2000 steps more, drag off (1000 steps), then until converged again,
+-- judged on the plate force averaged over 250
 -- steps, three times in a row. No-op for MBC (its penalty drives the strain). Returns the plate
 -- stress / p (bottom, top) averaged over the last 250 steps before the compression starts.
 function biax.start(lab, max_steps, tol)
@@ -343,7 +340,7 @@ function biax.start(lab, max_steps, tol)
     tol = tol or 0.05
     max_steps = max_steps or 30000
     local pb, pt = lab.plates[1], lab.plates[2]
-    local rate, vmax = lab.servo_rate or 100, lab.servo_vmax or 1e-3
+    local rate, vmax = lab.servo_rate or 200, lab.servo_vmax or 0.05 * lab.H0
     local function servo(on)
       local target = c.pressure * sample_width(lab) * c.thickness
       for _, w in ipairs { pb, pt } do
