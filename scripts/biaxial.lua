@@ -17,7 +17,8 @@
 --   mbc       pressure on the whole Delaunay boundary + the penalty of Eqs. 3.2-3.5 driving the
 --             coarse strain rate to E_yy = -rate, E_xy = 0 (E_xx free: the pressure sets it);
 --             K = 20 p t V / rate capped at half the explicit limit for dt (s:boundary doc)
--- Plates are settled onto the sample (2000 steps with drag), then move at +-rate H/2; dt = 1e-5 s
+-- Plates are force-controlled onto the sample until each carries p W t within 5% (biax.start),
+-- then move at +-rate H/2; dt = 1e-5 s
 -- (Table 3.1), velocity Verlet, one thread.
 -- Measured every 0.1% of axial strain (`sample`): the coarse (Bagi-Satake) strain increment of
 -- the sample particles from the Delaunay mesh built at the previous sample (Eq. 3.1, exact for

@@ -14,19 +14,28 @@
 -- sample (n = 600, `scale` of the biaxial sample's 3300) to 0.2% axial strain; the paper's
 -- comparison went to 10%.
 --   grainlab scripts/biaxial_two_timescales.lua [n=600] [strain=0.002] [seed=1]
---       [png=images/biaxial_two_timescales]
+--       [png=images/biaxial_two_timescales] [runs=1,2,...] [plot=1] [out=out/biaxial_tt]
+-- runs = a subset of the six (1 = III, 2 = I, 3-6 = II in the order above) saves each run to
+-- <out>_<k>.lua (split the runs over processes to use several cores: CPU time is per run, so
+-- the speed-ups do not depend on the split); plot=1 then reads the six files and reports.
 local biax = grainlab.biax
 local n = params.n or 600
 local strain = params.strain or 0.002
 local seed = params.seed or 1
 local png = params.png or "images/biaxial_two_timescales"
 local NS = 50
+local outp = params.out or "out/biaxial_tt"
+local only = nil
+if params.runs then
+  only = {}
+  for k in tostring(params.runs):gmatch("%d+") do only[tonumber(k)] = true end
+end
 grainlab.threads(1)
 os.execute("mkdir -p out images")
 local c = biax.config{}
 local dt_large = c.dt
 local dt_small = dt_large / NS
-local st, rep = biax.prepared{ n = n, seed = seed }
+local st = not params.plot and biax.prepared{ n = n, seed = seed } or nil
 
 local runs = {
   { name = "III", integrator = "velocity_verlet", dt = dt_small, per = 1, theory = 1 },
@@ -48,10 +57,26 @@ for _, r in ipairs(runs) do
   r.every = 250 * r.engine_per_macro -- 250 large steps of time between boundary updates
 end
 
+local function save_run(k, r)
+  local rows = {}
+  for _, row in ipairs(r.rows) do rows[#rows + 1] = string.format("{%.17g,%.17g}", row.ea, row.ev) end
+  grainlab.write_file(string.format("%s_%d.lua", outp, k), string.format(
+    "return { cpu = %.17g, evals = %.17g, slip = %.17g, ev = %.17g, servo_b = %.17g, servo_t = %.17g, servo_steps = %d, rows = {%s} }\n",
+    r.cpu, r.evals, r.slip, r.ev, r.servo_b, r.servo_t, r.servo_steps, table.concat(rows, ",")))
+end
+
 local metrics, checks = {}, {}
-for _, r in ipairs(runs) do
+for k, r in ipairs(runs) do
+ if params.plot then
+  local d = dofile(string.format("%s_%d.lua", outp, k))
+  r.cpu, r.evals, r.slip, r.ev = d.cpu, d.evals, d.slip, d.ev
+  r.servo_b, r.servo_t, r.servo_steps = d.servo_b, d.servo_t, d.servo_steps
+  r.rows = {}
+  for _, row in ipairs(d.rows) do r.rows[#r.rows + 1] = { ea = row[1], ev = row[2] } end
+ elseif not only or only[k] then
   local s, lab = biax.setup(st, "pressure", c)
-  biax.start(lab) -- identical for every run (large steps)
+  r.servo_b, r.servo_t = biax.start(lab) -- identical for every run (large steps)
+  r.servo_steps = lab.servo_steps
   s:boundary{ pressure = c.pressure, every = r.every, alpha = c.alpha, sides = "lateral" }
   local mesh = analysis.delaunay(s, { ids = lab.ids })
   r.rows = {}
@@ -77,7 +102,10 @@ for _, r in ipairs(runs) do
   io.stderr:write(string.format("%-12s cpu %.1f s, %d force evaluations, eps_v %.3e\n", r.name, cpu, r.evals, ev))
   s = nil
   collectgarbage()
+  if only then save_run(k, r) end
+ end
 end
+if only then return end
 local III = runs[1]
 print(string.format("%-12s %8s %8s %8s %11s %10s %10s %8s", "run", "theory", "evals", "cpu",
                     "eps_v", "|d eps_v|", "rms d ev", "slip/vR"))
@@ -109,7 +137,9 @@ render.plot{ file = png .. ".png", width = 900, height = 560,
              xlabel = "axial strain (%)", ylabel = "volumetric strain (%)", series = series }
 grainlab.report{
   scenario = "biaxial_two_timescales",
-  params = { n = n, strain = strain, seed = seed, dt_large = dt_large, dt_small = dt_small, N_S = NS },
+  params = { n = n, strain = strain, seed = seed, dt_large = dt_large, dt_small = dt_small, N_S = NS,
+             plate_stress_start_bottom = III.servo_b, plate_stress_start_top = III.servo_t,
+             servo_steps = III.servo_steps },
   metrics = metrics,
   checks = checks,
 }

@@ -300,15 +300,10 @@ function biax.setup(st, bc, opts)
   return s, lab
 end
 
--- Plate forces (sum of normal contact forces on walls 1 and 2 of the lab).
+-- Plate forces (bottom, top): the normal force each plate exerts on the sample, contacts and the
+-- tied membrane ends (s:wall_force).
 function biax.plate_forces(lab)
-  local C = lab.scene:measure("contacts")
-  local fb, ft = 0, 0
-  local wb, wt = -lab.plates[1], -lab.plates[2]
-  for k = 1, #C.j do
-    if C.j[k] == wb then fb = fb + C.fn[k] elseif C.j[k] == wt then ft = ft + C.fn[k] end
-  end
-  return fb, ft
+  return lab.scene:wall_force(lab.plates[1]), lab.scene:wall_force(lab.plates[2])
 end
 
 -- Width of the sample particles (lateral extent) now.
@@ -321,60 +316,83 @@ local function sample_width(lab)
   return xhi - xlo
 end
 
--- Plates: servo them onto the sample (with drag) until each carries p W depth within `tol`,
--- at most `max_steps`; then drag off and the plates move at the imposed strain rate. Replacing
--- the all-round pressure by plates placed at the highest and lowest particle would otherwise
--- let the sample unload vertically and spend the first percent of strain taking up the slack.
--- No-op for MBC (its penalty drives the strain). Returns the plate stress / p (bottom, top).
+-- Plates: force-controlled onto the sample until each carries p W t within `tol` (default 5%),
+-- then the plates move at the imposed strain rate. Replacing the all-round pressure by plates
+-- placed at the highest and lowest particle would otherwise let the sample unload vertically and
+-- spend the first percent of strain taking up the slack. Each plate is a damped body
+-- (s:wall_servo: M dv/dt = p W t - F_contact - M rate v, every step, in C): a velocity servo
+-- updated every 250 steps went unstable at 3300 disks (the plate stiffness of a big sample times
+-- the gain times 250 dt is past 2; plate stress / p still 2.2 / 0.47 after 30000 steps). The
+-- plate mass is set so that the terminal approach speed F / (M rate) is `vmax` (0.05/s times
+-- the plate gap, 4 mm/s at 3300 disks): M = F / (rate vmax), with rate = 200/s (at 3300 disks
+-- 1 mm/s and 100/s took over 60000 steps, the loose top of the deposit compacting slowly; at
+-- 300 disks 4 mm/s left the plates oscillating).
+-- Stages, all under the servo and with friction (frictionless, as in the consolidation, the
+-- plates chased a sample that flowed sideways; `servo_frictionless` keeps that option): with
+-- drag until converged, 2000 steps more, drag off (1000 steps), then until converged again,
+-- judged on the plate force averaged over 250
+-- steps, three times in a row. No-op for MBC (its penalty drives the strain). Returns the plate
+-- stress / p (bottom, top) averaged over the last 250 steps before the compression starts.
 function biax.start(lab, max_steps, tol)
   local s, c = lab.scene, lab.cfg
   local ratio_b, ratio_t = 1, 1
   if lab.plates then
-    -- Frictionless while the plates take the load (as in the consolidation): with the
-    -- regularised friction an anisotropically loaded sample creeps, and the servo would chase it.
-    biax.contact(s, c, true)
-    s:drag(lab.servo_drag or 5) -- enough to damp, little enough not to hold the plates back
     tol = tol or 0.05
     max_steps = max_steps or 30000
-    -- Approach at vmax until each plate carries half the load, then a proportional servo slow
-    -- enough for the mass-scaled sample (its stiffness k ~ 5e5 N/m against a plate; a servo
-    -- time 1/(gain k) ~ 0.02 s, a few wave transits).
-    local vmax, gain, done, stable = 1e-3, lab.servo_gain or 1e-4, 0, 0
-    local approach_b, approach_t = true, true
-    while done < max_steps do
+    local pb, pt = lab.plates[1], lab.plates[2]
+    local rate, vmax = lab.servo_rate or 200, lab.servo_vmax or 0.05 * lab.H0
+    local function servo(on)
       local target = c.pressure * sample_width(lab) * c.thickness
-      local fb, ft = biax.plate_forces(lab)
-      ratio_b, ratio_t = fb / target, ft / target
-      if math.abs(ratio_b - 1) < tol and math.abs(ratio_t - 1) < tol then
-        stable = stable + 1
-        if stable >= 4 then break end
-      else
-        stable = 0
+      for _, w in ipairs { pb, pt } do
+        if on then
+          s:wall_servo(w, { force = target, mass = target / (rate * vmax), rate = rate })
+        else
+          s:wall_servo(w)
+        end
       end
-      approach_b = approach_b and ratio_b < 0.5
-      approach_t = approach_t and ratio_t < 0.5
-      local function v(app, f)
-        if app then return vmax end
-        return math.max(-vmax, math.min(vmax, gain * (target - f)))
-      end
-      s:wall_velocity(lab.plates[1], { 0, v(approach_b, fb) })
-      s:wall_velocity(lab.plates[2], { 0, -v(approach_t, ft) })
-      run(s, 250, c)
-      done = done + 250
-      if lab.verbose then print(done, ratio_b, ratio_t) end
+      return target
     end
-    s:wall_velocity(lab.plates[1], { 0, 0 })
-    s:wall_velocity(lab.plates[2], { 0, 0 })
+    -- `steps` in blocks of 250 (the target follows the width), the plate forces averaged over
+    -- each block's ten sub-blocks; stops early once converged twice in a row when `until_ok`.
+    local done = 0
+    local function servo_run(steps, until_ok)
+      local ok_count, k = 0, 0
+      while k < steps do
+        local target = servo(true)
+        local fb, ft = 0, 0
+        for _ = 1, 10 do
+          run(s, 25, c)
+          fb, ft = fb + s:wall_force(pb) / 10, ft + s:wall_force(pt) / 10
+        end
+        k, done = k + 250, done + 250
+        ratio_b, ratio_t = fb / target, ft / target
+        if lab.verbose then print(done, ratio_b, ratio_t) end
+        if math.abs(ratio_b - 1) < tol and math.abs(ratio_t - 1) < tol then
+          ok_count = ok_count + 1
+          if until_ok and ok_count >= 3 then return true end
+        else
+          ok_count = 0
+        end
+      end
+      return ok_count > 0
+    end
+    biax.contact(s, c, lab.servo_frictionless)
+    s:drag(lab.servo_drag or 5)
+    servo_run(max_steps, true)
+    local steps1 = done
     biax.contact(s, c, false)
-    run(s, 2000, c)
+    servo_run(2000)
     s:drag(0)
-    run(s, 1000, c)
-    local H = s:wall_point(lab.plates[2])[2] - s:wall_point(lab.plates[1])[2]
+    servo_run(1000)
+    local ok = servo_run(max_steps, true)
+    servo(false)
+    lab.servo_converged = ok
+    lab.servo_steps, lab.servo_steps_frictionless = done, steps1
+    local H = s:wall_point(pt)[2] - s:wall_point(pb)[2]
     lab.H0 = H
     local v = 0.5 * c.rate * H
-    s:wall_velocity(lab.plates[1], { 0, v })
-    s:wall_velocity(lab.plates[2], { 0, -v })
-    lab.servo_steps = done
+    s:wall_velocity(pb, { 0, v })
+    s:wall_velocity(pt, { 0, -v })
   end
   lab.t0 = s:info().time
   return ratio_b, ratio_t

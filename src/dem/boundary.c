@@ -455,7 +455,10 @@ core_status dem_boundary_apply(dem_scene *s, double dt, core_error *err)
     for (size_t q = 0; q < b->nt; q++) { /* ties: that component follows the wall */
         long i = b->ti[q];
         int ax = b->ta[q];
-        s->v[ax][i] = s->walls[b->tw[q]].velocity[ax];
+        dem_wall *wl = &s->walls[b->tw[q]];
+        s->v[ax][i] = wl->velocity[ax];
+        /* the wall holds the tied particle, so it carries that force too (a servo sees it) */
+        wl->fn -= s->f[ax][i] * wl->normal[ax];
         s->f[ax][i] = 0;
     }
     for (size_t q = 0; q < b->nspin; q++) { /* prescribed spins */

@@ -133,6 +133,15 @@ core_status dem_wall_geometry(const dem_scene *s, int id, double point[3], doubl
                               int *active, core_error *err);
 /* Current position of the wall's reference point. */
 core_status dem_wall_point(const dem_scene *s, int id, double p[3], core_error *err);
+/* Normal force the wall exerted on the particles at the last force evaluation (N): contacts,
+ * plus the force that holds the particles tied to it (dem_tie_to_wall). */
+core_status dem_wall_force(const dem_scene *s, int id, double *fn, core_error *err);
+/* Force control: the wall becomes a body of mass `mass` moving along its normal, pushed towards
+ * the particles by `force` and held back by their contact force, with velocity damping `rate`
+ * (1/s): M dv/dt = force - F_contact - M rate v. Quasistatically a servo of gain 1/(M rate);
+ * the mass filters the contact noise. mass = 0 switches it off (the wall keeps its velocity). */
+core_status dem_wall_servo(dem_scene *s, int id, double force, double mass, double rate,
+                           core_error *err);
 
 /* ---- time stepping ------------------------------------------------------------------------- */
 typedef enum dem_integrator {

@@ -19,6 +19,9 @@ typedef struct dem_wall {
     uint32_t *cand;        /* particles within r + skin of the wall at the last list build */
     size_t ncand, cap_cand;
     double point_build[3]; /* the wall's point at the last list build (skin test) */
+    double fn;             /* normal force the wall exerts on the particles, last evaluation */
+    int servo;             /* force-controlled: the wall is a damped body pushed with servo_force */
+    double servo_force, servo_mass, servo_rate;
 } dem_wall;
 
 /* The Verlet list: pairs (i < j) closer than r_i + r_j + skin at the last build, sorted by i then

@@ -155,9 +155,19 @@ static core_status forces(dem_scene *s, double dt, double disp2, core_error *err
 
 static void move_walls(dem_scene *s, double dt)
 {
-    for (int w = 0; w < s->nwalls; w++)
+    for (int w = 0; w < s->nwalls; w++) {
+        dem_wall *wl = &s->walls[w];
+        if (wl->servo && wl->active) { /* force control: a damped body along the normal */
+            double vn = 0;
+            for (int d = 0; d < s->dim; d++)
+                vn += wl->velocity[d] * wl->normal[d];
+            vn += dt * ((wl->servo_force - wl->fn) / wl->servo_mass - wl->servo_rate * vn);
+            for (int d = 0; d < s->dim; d++)
+                wl->velocity[d] = vn * wl->normal[d];
+        }
         for (int d = 0; d < s->dim; d++)
-            s->walls[w].point[d] += dt * s->walls[w].velocity[d];
+            wl->point[d] += dt * wl->velocity[d];
+    }
 }
 
 static size_t check_finite(const dem_scene *s)

@@ -516,6 +516,34 @@ core_status dem_wall_geometry(const dem_scene *s, int id, double point[3], doubl
     return CORE_OK;
 }
 
+core_status dem_wall_force(const dem_scene *s, int id, double *fn, core_error *err)
+{
+    if (id < 0 || id >= s->nwalls || !s->walls[id].active)
+        return core_fail(err, CORE_ERR_ARG, "no wall %d", id + 1);
+    *fn = s->walls[id].fn;
+    return CORE_OK;
+}
+
+core_status dem_wall_servo(dem_scene *s, int id, double force, double mass, double rate,
+                           core_error *err)
+{
+    core_status st = check_wall(s, id, err);
+    if (st != CORE_OK)
+        return st;
+    if (!isfinite(force) || force < 0)
+        return core_fail(err, CORE_ERR_ARG, "servo force must be >= 0, got %g", force);
+    if (!isfinite(mass) || mass < 0)
+        return core_fail(err, CORE_ERR_ARG, "servo mass must be >= 0, got %g", mass);
+    if (!isfinite(rate) || rate < 0)
+        return core_fail(err, CORE_ERR_ARG, "servo rate must be >= 0, got %g", rate);
+    dem_wall *wl = &s->walls[id];
+    wl->servo = mass > 0;
+    wl->servo_force = force;
+    wl->servo_mass = mass;
+    wl->servo_rate = rate;
+    return CORE_OK;
+}
+
 core_status dem_wall_point(const dem_scene *s, int id, double p[3], core_error *err)
 {
     core_status st = check_wall(s, id, err);

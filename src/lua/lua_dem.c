@@ -358,6 +358,36 @@ static int l_wall_velocity(lua_State *L)
     return 0;
 }
 
+static int l_wall_force(lua_State *L)
+{
+    dem_scene *s = check_scene(L, 1);
+    double fn;
+    core_error err;
+    if (dem_wall_force(s, wall_arg(L, 2), &fn, &err))
+        return bind_raise(L, "wall_force", &err);
+    lua_pushnumber(L, fn);
+    return 1;
+}
+
+static int l_wall_servo(lua_State *L)
+{
+    dem_scene *s = check_scene(L, 1);
+    const int id = wall_arg(L, 2);
+    double force = 0, mass = 0, rate = 0;
+    if (!lua_isnoneornil(L, 3)) {
+        static const char *const fields[] = {"force", "mass", "rate", NULL};
+        bind_check_table(L, 3, "wall_servo");
+        bind_check_fields(L, 3, "wall_servo", fields);
+        force = bind_field_number(L, 3, "wall_servo", "force", 0, BIND_REQUIRED | BIND_NONNEG);
+        mass = bind_field_number(L, 3, "wall_servo", "mass", 0, BIND_REQUIRED | BIND_POSITIVE);
+        rate = bind_field_number(L, 3, "wall_servo", "rate", 0, BIND_NONNEG);
+    }
+    core_error err;
+    if (dem_wall_servo(s, id, force, mass, rate, &err))
+        return bind_raise(L, "wall_servo", &err);
+    return 0;
+}
+
 static void push_vector(lua_State *L, const double *v, int n)
 {
     lua_createtable(L, n, 0);
@@ -881,6 +911,11 @@ void bind_open_dem(lua_State *L)
         {"remove_wall", l_remove_wall, "s:remove_wall(id)", "Removes a wall during a run."},
         {"wall_velocity", l_wall_velocity, "s:wall_velocity(id, {vx, vy})", "Sets a wall's velocity."},
         {"wall_point", l_wall_point, "s:wall_point(id)", "The wall's reference point now."},
+        {"wall_force", l_wall_force, "s:wall_force(id)",
+         "Normal force (N) the wall exerted on the particles at the last force evaluation."},
+        {"wall_servo", l_wall_servo, "s:wall_servo(id, { force =, mass =, rate = 0 }) or s:wall_servo(id)",
+         "Force control: the wall moves along its normal as a body of this mass pushed with `force` "
+         "against the contacts, velocity damped at `rate` (1/s); no table switches it off."},
         {"set_velocity", l_set_velocity, "s:set_velocity(id, {vx, vy})", "Sets a particle's velocity."},
         {"timestep", l_timestep, "s:timestep{ impact_velocity = v }",
          "The contact time of the stiffest, lightest pair at the impact velocity (default: the "
