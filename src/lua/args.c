@@ -215,3 +215,37 @@ int bind_raise(lua_State *L, const char *call, const core_error *err)
         return luaL_error(L, "%s: %s", call, err->msg);
     return luaL_error(L, "%s: %s", call, core_status_name(err->status));
 }
+
+void bind_field_box(lua_State *L, int arg, const char *call, const char *field, int dim, double *lo,
+                    double *hi)
+{
+    char expected[96];
+    snprintf(expected, sizeof expected, "{{lower corner}, {upper corner}} with %d numbers each",
+             dim);
+    if (lua_getfield(L, arg, field) != LUA_TTABLE || luaL_len(L, -1) != 2)
+        bind_field_error(L, arg, call, field, expected);
+    for (int c = 0; c < 2; c++) {
+        if (lua_rawgeti(L, -1, c + 1) != LUA_TTABLE || luaL_len(L, -1) != dim) {
+            lua_pop(L, 1);
+            bind_field_error(L, arg, call, field, expected);
+        }
+        for (int d = 0; d < dim; d++) {
+            lua_rawgeti(L, -1, d + 1);
+            int isnum;
+            double v = lua_tonumberx(L, -1, &isnum);
+            lua_pop(L, 1);
+            if (!isnum || !isfinite(v)) {
+                lua_pop(L, 1);
+                bind_field_error(L, arg, call, field, expected);
+            }
+            (c == 0 ? lo : hi)[d] = v;
+        }
+        lua_pop(L, 1);
+    }
+    lua_pop(L, 1);
+    for (int d = 0; d < dim; d++)
+        if (!(hi[d] > lo[d])) {
+            lua_getfield(L, arg, field);
+            bind_field_error(L, arg, call, field, "upper corner above the lower one on every axis");
+        }
+}

@@ -57,6 +57,10 @@ int bind_field_option(lua_State *L, int arg, const char *call, const char *field
 int bind_field_vector(lua_State *L, int arg, const char *call, const char *field, int n,
                       double *out, unsigned flags);
 int bind_field_boolean(lua_State *L, int arg, const char *call, const char *field, int def);
+/* Reads a box {{lower corner}, {upper corner}} of dim finite numbers each into lo, hi (required),
+ * the upper corner above the lower one on every axis. */
+void bind_field_box(lua_State *L, int arg, const char *call, const char *field, int dim,
+                    double *lo, double *hi);
 
 /* Raises "bad field 'F' in argument #N to 'call' (EXPECTED expected, got VALUE)" for the value
  * on top of the stack. */

@@ -37,38 +37,6 @@ struct dem_scene *bind_check_dem_scene(lua_State *L, int idx, const char *call)
 }
 
 /* ---- dem.scene{...} ------------------------------------------------------------------------ */
-static void read_box(lua_State *L, int arg, int dim, dem_scene_def *def)
-{
-    char expected[96];
-    snprintf(expected, sizeof expected, "{{lower corner}, {upper corner}} with %d numbers each", dim);
-    if (lua_getfield(L, arg, "box") != LUA_TTABLE || luaL_len(L, -1) != 2)
-        bind_field_error(L, arg, "scene", "box", expected);
-    for (int c = 0; c < 2; c++) {
-        if (lua_rawgeti(L, -1, c + 1) != LUA_TTABLE || luaL_len(L, -1) != dim) {
-            lua_pop(L, 1);
-            bind_field_error(L, arg, "scene", "box", expected);
-        }
-        for (int d = 0; d < dim; d++) {
-            lua_rawgeti(L, -1, d + 1);
-            int isnum;
-            double v = lua_tonumberx(L, -1, &isnum);
-            lua_pop(L, 1);
-            if (!isnum || !isfinite(v)) {
-                lua_pop(L, 1);
-                bind_field_error(L, arg, "scene", "box", expected);
-            }
-            (c == 0 ? def->lo : def->hi)[d] = v;
-        }
-        lua_pop(L, 1);
-    }
-    lua_pop(L, 1);
-    for (int d = 0; d < dim; d++)
-        if (!(def->hi[d] > def->lo[d])) {
-            lua_getfield(L, arg, "box");
-            bind_field_error(L, arg, "scene", "box", "upper corner above the lower one on every axis");
-        }
-}
-
 static int l_scene(lua_State *L)
 {
     static const char *const fields[] = {"dim", "box", "gravity", "periodic", "thickness", "skin",
@@ -77,7 +45,7 @@ static int l_scene(lua_State *L)
     bind_check_fields(L, 1, "scene", fields);
     dem_scene_def def = dem_default_scene_def();
     def.dim = (int)bind_field_integer(L, 1, "scene", "dim", 2, 2, 3, 0);
-    read_box(L, 1, def.dim, &def);
+    bind_field_box(L, 1, "scene", "box", def.dim, def.lo, def.hi);
     bind_field_vector(L, 1, "scene", "gravity", def.dim, def.gravity, 0);
     if (lua_getfield(L, 1, "periodic") != LUA_TNIL) {
         char expected[64];

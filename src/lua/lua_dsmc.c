@@ -69,9 +69,6 @@ static int read_numbers(lua_State *L, int arg, const char *call, const char *fie
 
 static void read_box(lua_State *L, int arg, int dim, dsmc_scene_def *def)
 {
-    char expected[96];
-    snprintf(expected, sizeof expected, "{{lower corner}, {upper corner}} with %d numbers each",
-             dim);
     int has_box = lua_getfield(L, arg, "box") != LUA_TNIL;
     lua_pop(L, 1);
     int has_size = lua_getfield(L, arg, "size") != LUA_TNIL;
@@ -96,33 +93,7 @@ static void read_box(lua_State *L, int arg, int dim, dsmc_scene_def *def)
         }
         return;
     }
-    if (lua_getfield(L, arg, "box") != LUA_TTABLE || luaL_len(L, -1) != 2)
-        bind_field_error(L, arg, "scene", "box", expected);
-    for (int c = 0; c < 2; c++) {
-        if (lua_rawgeti(L, -1, c + 1) != LUA_TTABLE || luaL_len(L, -1) != dim) {
-            lua_pop(L, 1);
-            bind_field_error(L, arg, "scene", "box", expected);
-        }
-        for (int d = 0; d < dim; d++) {
-            lua_rawgeti(L, -1, d + 1);
-            int isnum;
-            double v = lua_tonumberx(L, -1, &isnum);
-            lua_pop(L, 1);
-            if (!isnum || !isfinite(v)) {
-                lua_pop(L, 1);
-                bind_field_error(L, arg, "scene", "box", expected);
-            }
-            (c == 0 ? def->lo : def->hi)[d] = v;
-        }
-        lua_pop(L, 1);
-    }
-    lua_pop(L, 1);
-    for (int d = 0; d < dim; d++)
-        if (!(def->hi[d] > def->lo[d])) {
-            lua_getfield(L, arg, "box");
-            bind_field_error(L, arg, "scene", "box",
-                             "upper corner above the lower one on every axis");
-        }
+    bind_field_box(L, arg, "scene", "box", dim, def->lo, def->hi);
 }
 
 static int l_scene(lua_State *L)
