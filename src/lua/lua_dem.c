@@ -679,6 +679,8 @@ static int l_particles(lua_State *L)
     }
     if (D == 2 && dem_angular_velocities(s, 2))
         bind_push_array(L, dem_angular_velocities(s, 2), n, "omega");
+    if (D == 2 && dem_angles(s)) /* the integrated rotation: exact time averages of omega */
+        bind_push_array(L, dem_angles(s), n, "angle");
     for (int d = 0; D == 3 && d < 3; d++)
         if (dem_angular_velocities(s, d))
             bind_push_array(L, dem_angular_velocities(s, d), n, ws[d]);
@@ -906,7 +908,8 @@ void bind_open_dem(lua_State *L)
          "arrays i, j (negative j: wall), fn, ft, nx, ny, (nz), overlap. displacement: since "
          "set_reference, minus opts.affine (displacement gradient) about opts.center."},
         {"particles", l_particles, "s:particles()",
-         "Arrays of positions, velocities, angular velocities, radii and masses."},
+         "Arrays x, y (z), vx, vy (vz), omega (2D) or wx, wy, wz (3D), angle (2D: the integrated "
+         "rotation in rad), radius and mass; count."},
         {"set_reference", l_set_reference, "s:set_reference()",
          "Remembers the current positions for displacement measurements."},
         {"scale_mass", l_scale_mass, "s:scale_mass(factor)",
