@@ -7,6 +7,7 @@
 #include <stdint.h>
 
 #include "dem/dem.h"
+#include "dem/power.h"
 
 #define DEM_PI 3.14159265358979323846
 
@@ -76,6 +77,7 @@ struct dem_scene {
     dem_material *mats;
     int nmat, cap_mat;
     dem_contact_def contact;
+    dem_power slip_pow;    /* x^(1/exponent) of the regularised Coulomb law */
 
     dem_wall *walls;
     int nwalls, cap_walls;

@@ -71,10 +71,11 @@ static inline double spring_stiffness(const dem_contact_def *c, double k, double
 
 /* Magnitude of the regularised Coulomb force (Padbidri Eq. 2.18), capped at mu f_n: the paper's
  * law is meant for slip rates near v_R; the cap keeps fast sliding Coulombic. */
-static inline double regularized(const dem_contact_def *c, double mu, double fn, double s)
+static inline double regularized(const dem_contact_def *c, const dem_power *pw, double mu,
+                                 double fn, double s)
 {
     double x = s / c->v_r;
-    return x >= 1 ? mu * fn : mu * fn * pow(x, 1.0 / c->exponent);
+    return x >= 1 ? mu * fn : mu * fn * dem_power_eval(pw, x); /* x^(1/c) */
 }
 
 #define DIM 2

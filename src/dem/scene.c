@@ -165,6 +165,7 @@ core_status dem_set_contact(dem_scene *s, const dem_contact_def *c, core_error *
     }
     int spring_before = s->contact.tangential == DEM_TANGENT_SPRING;
     s->contact = *c;
+    dem_power_init(&s->slip_pow, c->tangential == DEM_TANGENT_REGULARIZED ? 1 / c->exponent : 0);
     if (c->tangential != DEM_TANGENT_NONE || c->rolling) {
         core_status st = dem_ensure_rotation(s, err);
         if (st != CORE_OK)
