@@ -39,8 +39,8 @@ static void test_against_pow(void **state)
         dem_power_init(&p, as[k]);
         double w1 = worst_rel(&p, as[k], 1), w2 = worst_rel(&p, as[k], 0);
         print_message("a = %.4f: largest relative error %.2e (log-uniform x), %.2e (uniform x); "
-                      "libm pow %.2e, %.2e\n", as[k], w1, w2, worst_rel(NULL, as[k], 1),
-                      worst_rel(NULL, as[k], 0));
+                      "libm pow %.2e, %.2e\n",
+                      as[k], w1, w2, worst_rel(NULL, as[k], 1), worst_rel(NULL, as[k], 0));
         assert_true(w1 <= 6e-16); /* 3 ulp */
         assert_true(w2 <= 6e-16);
     }
