@@ -74,7 +74,7 @@ static inline double spring_stiffness(const dem_contact_def *c, double k, double
 static inline double regularized(const dem_contact_def *c, const dem_power *pw, double mu,
                                  double fn, double s)
 {
-    double x = s / c->v_r;
+    double x = s * (1 / c->v_r); /* the reciprocal is loop-invariant: hoisted out of the kernel */
     return x >= 1 ? mu * fn : mu * fn * dem_power_eval(pw, x); /* x^(1/c) */
 }
 
