@@ -28,8 +28,9 @@
 -- distance from the forced particle in mean diameters <d> (Fig. 4.5; binned maximum and mean
 -- drawn over the scatter; the data in out/rotation_propagation.csv); the influence distance =
 -- where the binned mean |d omega|/omega0 falls (and stays, 3 bins) below `threshold` (10%), and
--- where it falls below twice the far-field floor (the two runs also decorrelate far away: free
--- spinners, local rearrangements; the floor is the mean beyond 15 <d>); the map of |omega|/omega0
+-- where the binned largest falls (and stays) below it, and where the mean falls below twice the
+-- far-field floor (the two runs also decorrelate far away: free spinners, local rearrangements;
+-- the floor is the mean beyond 15 <d>); the map of |omega|/omega0
 -- (Fig. 4.4a); the weighted directional tensor T = sum 1/|s| s^ (x) b^ f/<f> over the contact
 -- segments with midpoints within 10 <d> (Eq. 4.1; b^ oriented outward, b^.s^ >= 0; T <d> is
 -- reported, dimensionless) with the eigenvectors of sym(T); and the rose of W(b, theta) =
@@ -146,16 +147,18 @@ local floor_sum, floor_n = 0, 0
 local far = math.min(15, 0.6 * bx[#bx]) -- small samples: the outer 40%
 for k = 1, #bx do if bx[k] > far then floor_sum, floor_n = floor_sum + bmean[k], floor_n + 1 end end
 local floor = floor_sum / math.max(1, floor_n)
-local function crossing(level)
+local function crossing(level, curve)
+  curve = curve or bmean
   for k = 1, #bx do
     local below = true
-    for q = k, math.min(#bx, k + 2) do below = below and bmean[q] < level end
+    for q = k, math.min(#bx, k + 2) do below = below and curve[q] < level end
     if below then return bx[k] - 0.5 end
   end
   return bx[#bx] + 0.5
 end
 local infl_mean = crossing(threshold)
 local infl_floor = crossing(2 * floor)
+local infl_max = crossing(threshold, bmax) -- where no particle of 3 successive bins reaches it
 local lines = { "distance_d,d_omega_over_omega0" }
 for k = 1, #dist do lines[#lines + 1] = string.format("%.4f,%.6e", dist[k], ratio[k]) end
 assert(grainlab.write_file(params.csv or "out/rotation_propagation.csv", table.concat(lines, "\n") .. "\n"))
@@ -232,14 +235,15 @@ render.plot{ file = png .. "_rose.png", width = 760, height = 720,
              title = string.format("Fig. 4.4b: rose of W within 10 <d> (%d segments)", segments),
              xlabel = "W cos(theta)", ylabel = "W sin(theta)", series = series }
 
-print(string.format("forced particle %d; influence distance (binned mean < %g omega0) %.1f <d>, (< 2 x floor %.3g) %.1f <d>; outermost particle >= %g omega0: %.1f <d>",
-                    forced, threshold, infl_mean, floor, infl_floor, threshold, infl10))
+print(string.format("forced particle %d; influence distance (binned mean < %g omega0) %.1f <d>, (binned largest < %g omega0) %.1f <d>, (mean < 2 x floor %.3g) %.1f <d>; outermost particle >= %g omega0: %.1f <d>",
+                    forced, threshold, infl_mean, threshold, infl_max, floor, infl_floor, threshold, infl10))
 grainlab.report{
   scenario = "rotation_propagation",
   params = { n = n, seed = seed, omega0 = omega0, ramp_s = ramp, hold_s = hold, dt = dt,
              threshold = threshold, pressure_pa = c.pressure },
   metrics = {
     influence_distance_d = infl_mean, influence_distance_floor_d = infl_floor,
+    influence_distance_max_d = infl_max,
     far_field_floor = floor, outermost_above_threshold_d = infl10,
     outermost_above_half_threshold_d = infl5,
     far_field_mean_ratio = far_sum / math.max(1, far_n), forced_particle = forced,
