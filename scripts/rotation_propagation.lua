@@ -230,8 +230,8 @@ local series = { { x = rx, y = ry, label = "W(b, theta), 15 degree sectors", sty
                    label = string.format("eigenvector of sym(T), %.3g", l1), style = "line" },
                  { x = { e1 * math.sin(phi), -e1 * math.sin(phi) }, y = { -e1 * math.cos(phi), e1 * math.cos(phi) },
                    label = string.format("eigenvector of sym(T), %.3g", l2), style = "line" },
-                 { x = { -1.25 * e1, 1.25 * e1 }, y = { -1.25 * e1, 1.25 * e1 }, style = "points" } }
-render.plot{ file = png .. "_rose.png", width = 760, height = 720,
+                 { x = { -1.25 * e1, 1.25 * e1 }, y = { -1.25 * e1, 1.25 * e1 }, style = "none" } } -- equal extents
+render.plot{ file = png .. "_rose.png", width = 720, height = 740, -- a square frame
              title = string.format("Fig. 4.4b: rose of W within 10 <d> (%d segments)", segments),
              xlabel = "W cos(theta)", ylabel = "W sin(theta)", series = series }
 

@@ -565,7 +565,7 @@ static int l_image(lua_State *L)
 }
 
 /* ---- render.plot{...} ---------------------------------------------------------------------- */
-static const char *const STYLES[] = {"line", "points", "both", NULL};
+static const char *const STYLES[] = {"line", "points", "both", "none", NULL};
 
 /* Reads field `name` of the series table at st (series number k) into a new userdata buffer left
  * on the stack (so an error cannot leak it); *n: the length it must have, or (size_t)-1.
@@ -662,7 +662,8 @@ static int l_plot(lua_State *L)
             while (t == LUA_TSTRING && STYLES[m] && strcmp(STYLES[m], lua_tostring(L, -1)))
                 m++;
             if (t != LUA_TSTRING || !STYLES[m])
-                return bind_field_error(L, 1, "plot", sf, "one of 'line', 'points', 'both'");
+                return bind_field_error(L, 1, "plot", sf,
+                                        "one of 'line', 'points', 'both', 'none'");
             s->style = (render_plot_style)m;
         }
         lua_pop(L, 1);
@@ -1120,10 +1121,11 @@ void bind_open_render(lua_State *L)
         {"plot", l_plot,
          "render.plot{ file =, width = 800, height = 560, title =, xlabel =, ylabel =, xlog = "
          "false, ylog = false, series = { { x = {...}, y = {...}, label =, style = 'line'|"
-         "'points'|'both' }, ... } }",
+         "'points'|'both'|'none' }, ... } }",
          "A line plot with nice ticks (decades on log axes), grid, labels and a legend of the "
-         "labelled series. NaN in a series breaks its line. Writes file (PNG, whole) and "
-         "returns its name, or without file returns a render.image."},
+         "labelled series. A 'none' series is not drawn; it only widens the axes. NaN in a "
+         "series breaks its line. Writes file (PNG, whole) and returns its name, or without "
+         "file returns a render.image."},
         {"field", l_field,
          "render.field{ file =, frame =, width = 1024, height =, values = {...} or {{row 1}, "
          "...}, nx =, ny =, extent = {{x0, y0}, {x1, y1}}, mask = {booleans}, background = {r, g, b}, "

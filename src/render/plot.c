@@ -215,6 +215,8 @@ core_status render_plot(render_context *rc, const render_plot_def *def, render_i
         const unsigned char *c3 = SERIES_RGB[k % 10];
         rgba8 c = rgba(c3[0], c3[1], c3[2], 255);
         double prev[2] = {NAN, NAN};
+        if (s->style == RENDER_HIDDEN)
+            continue;
         for (size_t i = 0; s->style != RENDER_POINTS && i < s->n; i++) {
             double x = s->x[i], y = s->y[i];
             if (!isfinite(x) || !isfinite(y)) {
@@ -243,7 +245,8 @@ core_status render_plot(render_context *rc, const render_plot_def *def, render_i
     int nl = 0;
     double lwid = 0;
     for (int k = 0; k < def->nseries; k++)
-        if (def->series[k].label && *def->series[k].label) {
+        if (def->series[k].label && *def->series[k].label &&
+            def->series[k].style != RENDER_HIDDEN) {
             nl++;
             lwid = fmax(lwid, canvas_text_width(rc, def->series[k].label, fs));
         }
@@ -284,7 +287,7 @@ core_status render_plot(render_context *rc, const render_plot_def *def, render_i
         int row = 0;
         for (int k = 0; k < def->nseries; k++) {
             const render_series *s = &def->series[k];
-            if (!s->label || !*s->label)
+            if (!s->label || !*s->label || s->style == RENDER_HIDDEN)
                 continue;
             const unsigned char *c3 = SERIES_RGB[k % 10];
             rgba8 c = rgba(c3[0], c3[1], c3[2], 255);

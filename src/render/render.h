@@ -182,7 +182,13 @@ core_status render_points(render_context *rc, const render_points_def *def, rend
                           render_view *view, core_error *err);
 
 /* ---- line plots ---------------------------------------------------------------------------- */
-typedef enum render_plot_style { RENDER_LINE, RENDER_POINTS, RENDER_BOTH } render_plot_style;
+/* RENDER_HIDDEN: the series only widens the axes (equal extents for a rose, a common origin). */
+typedef enum render_plot_style {
+    RENDER_LINE,
+    RENDER_POINTS,
+    RENDER_BOTH,
+    RENDER_HIDDEN
+} render_plot_style;
 
 typedef struct render_series {
     const double *x, *y;

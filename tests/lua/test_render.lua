@@ -157,6 +157,26 @@ check.eq(render.plot{ file = dir .. "/p.png", title = "squares", xlabel = "n", y
                       series = { { x = x, y = y, label = "n^2", style = "both" } } }, dir .. "/p.png", "plot file")
 local pim = render.plot{ width = 300, height = 200, xlog = true, ylog = true, series = { { x = x, y = y } } }
 check.eq(select(2, pim:size()), 200, "plot image height")
+-- A 'none' series widens the axes and draws nothing (no marker, no legend entry): the orange of
+-- the second series appears with style 'points' and not at all with 'none'.
+do
+  local function orange_pixels(style)
+    local im = render.plot{ width = 200, height = 160, series = {
+      { x = { 0, 1 }, y = { 0, 1 }, label = "line" },
+      { x = { -2, 3 }, y = { -2, 3 }, label = "extent", style = style } } }
+    local w, h = im:size()
+    local count = 0
+    for py = 1, h do
+      for px = 1, w do
+        local r, g, b = im:pixel(px, py)
+        if r > 200 and g > 90 and g < 160 and b < 60 then count = count + 1 end
+      end
+    end
+    return count
+  end
+  check.gt(orange_pixels("points"), 20, "points series drawn")
+  check.eq(orange_pixels("none"), 0, "none series not drawn")
+end
 local function pbad(def, text, what)
   check.errors(function() render.plot(def) end, text, what)
 end
@@ -164,7 +184,7 @@ pbad({ series = {} }, "bad field 'series' in argument #1 to 'plot' (non-empty ar
 pbad({ series = { { x = { 1, 2 }, y = { 1 } } } },
   "bad field 'series[1].y' in argument #1 to 'plot' (array as long as series[1].x (2) expected", "lengths differ")
 pbad({ series = { { x = { 1 }, y = { 1 }, style = "dots" } } },
-  "bad field 'series[1].style' in argument #1 to 'plot' (one of 'line', 'points', 'both' expected, got 'dots')", "style")
+  "bad field 'series[1].style' in argument #1 to 'plot' (one of 'line', 'points', 'both', 'none' expected, got 'dots')", "style")
 pbad({ series = { { x = { 1 }, y = { 1 }, colour = "red" } } }, "bad field 'series[1]' in argument #1 to 'plot' (unknown key 'colour'",
   "unknown series key")
 pbad({ ylog = true, series = { { x = { 1, 2 }, y = { 1, 0 } } } },
