@@ -5,6 +5,24 @@
 
 #include "dsmc/dsmc_internal.h"
 
+/* Sums of |c|^2 and |c|^4 over particles a .. a + N - 1, c = v - u the peculiar velocity. */
+static void peculiar_sums(const dsmc_scene *s, size_t a, size_t N, const double *u, double *s2,
+                          double *s4)
+{
+    double q2 = 0, q4 = 0;
+    for (size_t i = a; i < a + N; i++) {
+        double q = 0;
+        for (int k = 0; k < s->D; k++) {
+            double d = s->v[k][i] - u[k];
+            q += d * d;
+        }
+        q2 += q;
+        q4 += q * q;
+    }
+    *s2 = q2;
+    *s4 = q4;
+}
+
 void dsmc_measure_moments(const dsmc_scene *s, dsmc_moments *out)
 {
     memset(out, 0, sizeof *out);
@@ -28,16 +46,8 @@ void dsmc_measure_moments(const dsmc_scene *s, dsmc_moments *out)
         out->momentum[k] = s->mass * sum[k];
     }
     out->kinetic_energy = 0.5 * s->mass * ke;
-    double s2 = 0, s4 = 0;
-    for (size_t i = 0; i < n; i++) {
-        double q = 0;
-        for (int k = 0; k < D; k++) {
-            double d = s->v[k][i] - u[k];
-            q += d * d;
-        }
-        s2 += q;
-        s4 += q * q;
-    }
+    double s2, s4;
+    peculiar_sums(s, 0, n, u, &s2, &s4);
     double m2 = s2 / (double)n, m4 = s4 / (double)n;
     out->t_over_m = m2 / D;
     out->temperature = s->mass * out->t_over_m;
@@ -69,16 +79,8 @@ void dsmc_measure_fields(const dsmc_scene *s, const dsmc_fields *f)
                 u[k] += s->v[k][i];
             u[k] = N ? u[k] / (double)N : NAN;
         }
-        double s2 = 0, s4 = 0;
-        for (size_t i = a; i < a + N; i++) {
-            double q = 0;
-            for (int k = 0; k < D; k++) {
-                double d = s->v[k][i] - u[k];
-                q += d * d;
-            }
-            s2 += q;
-            s4 += q * q;
-        }
+        double s2, s4;
+        peculiar_sums(s, a, N, u, &s2, &s4);
         if (f->count)
             f->count[c] = (double)N;
         if (f->density)
