@@ -34,22 +34,13 @@ static core_status threads_setup(mpm_scene *s, core_error *err)
     if (nt < 1)
         nt = 1;
     if (nt > s->ntcap || !s->tp) {
-        size_t *a = realloc(s->tp, (size_t)(nt + 1) * sizeof *a);
-        if (!a)
-            return core_fail(err, CORE_ERR_NOMEM, "out of memory for %d threads", nt);
-        s->tp = a;
-        size_t *b = realloc(s->tg, (size_t)(nt + 1) * sizeof *b);
-        if (!b)
-            return core_fail(err, CORE_ERR_NOMEM, "out of memory for %d threads", nt);
-        s->tg = b;
-        size_t *c = realloc(s->tq, (size_t)(nt + 1) * sizeof *c);
-        if (!c)
-            return core_fail(err, CORE_ERR_NOMEM, "out of memory for %d threads", nt);
-        s->tq = c;
-        size_t *d = realloc(s->tc, (size_t)(nt + 1) * sizeof *d);
-        if (!d)
-            return core_fail(err, CORE_ERR_NOMEM, "out of memory for %d threads", nt);
-        s->tc = d;
+        size_t **ranges[4] = {&s->tp, &s->tg, &s->tq, &s->tc};
+        for (int r = 0; r < 4; r++) {
+            size_t *a = realloc(*ranges[r], (size_t)(nt + 1) * sizeof *a);
+            if (!a)
+                return core_fail(err, CORE_ERR_NOMEM, "out of memory for %d threads", nt);
+            *ranges[r] = a;
+        }
         free(s->tmark);
         free(s->tbuf);
         s->tmark = malloc((size_t)nt * s->nnodes * sizeof *s->tmark);
