@@ -467,6 +467,16 @@ static void push_cells(lua_State *L, const dsmc_scene *s, const double *a, const
     bind_push_array(L, a, dsmc_cell_count(s), name);
 }
 
+/* {{lo...}, {hi...}}: the scene's box. */
+static void push_box(lua_State *L, const dsmc_scene_def *d)
+{
+    lua_createtable(L, 2, 0);
+    push_vec(L, d->lo, d->dim);
+    lua_rawseti(L, -2, 1);
+    push_vec(L, d->hi, d->dim);
+    lua_rawseti(L, -2, 2);
+}
+
 static void push_grid(lua_State *L, const dsmc_scene *s)
 {
     const dsmc_scene_def *d = dsmc_def(s);
@@ -476,11 +486,7 @@ static void push_grid(lua_State *L, const dsmc_scene *s)
         lua_pushinteger(L, d->cells[k]);
         lua_setfield(L, -2, nn[k]);
     }
-    lua_createtable(L, 2, 0);
-    push_vec(L, d->lo, D);
-    lua_rawseti(L, -2, 1);
-    push_vec(L, d->hi, D);
-    lua_rawseti(L, -2, 2);
+    push_box(L, d);
     lua_setfield(L, -2, "extent");
 }
 
@@ -698,11 +704,7 @@ static int l_info(lua_State *L)
     lua_createtable(L, 0, 20);
     lua_pushinteger(L, D);
     lua_setfield(L, -2, "dim");
-    lua_createtable(L, 2, 0);
-    push_vec(L, d->lo, D);
-    lua_rawseti(L, -2, 1);
-    push_vec(L, d->hi, D);
-    lua_rawseti(L, -2, 2);
+    push_box(L, d);
     lua_setfield(L, -2, "box");
     double cells[3] = {d->cells[0], d->cells[1], d->cells[2]}, h[3];
     push_vec(L, cells, D);
