@@ -401,8 +401,9 @@ core_status dem_boundary_apply(dem_scene *s, double dt, core_error *err)
                 fy[a] -= P * hy;
                 fx[c] -= P * hx;
                 fy[c] -= P * hy;
-                b->pres_max = fmax(b->pres_max, P * hypot(hx, hy));
+                b->pres_max = fmax(b->pres_max, hx * hx + hy * hy); /* squared; root below */
             }
+        b->pres_max = P * sqrt(b->pres_max);
         if (b->closed && b->def.penalty > 0) {
             if (!(V > 0))
                 return core_fail(err, CORE_ERR_UNSTABLE, "the boundary loop encloses area %g <= 0 "
@@ -436,11 +437,12 @@ core_status dem_boundary_apply(dem_scene *s, double dt, core_error *err)
                 fy[p] += Fy;
                 b->pen_sum[0] += Fx;
                 b->pen_sum[1] += Fy;
-                b->pen_max = fmax(b->pen_max, hypot(Fx, Fy));
+                b->pen_max = fmax(b->pen_max, Fx * Fx + Fy * Fy); /* squared; root below */
                 g2 += gx * gx + gy * gy;
                 if (s->inv_m[p] > 0)
                     mmin = fmin(mmin, s->m[p]);
             }
+            b->pen_max = sqrt(b->pen_max);
             /* The penalty acts as a dashpot on the boundary's collective motion with rate
              * K sum|g|^2 / (V^2 m): explicit steps need rate * dt < 2; refuse beyond 1. */
             b->stiffness = isfinite(mmin) ? b->def.penalty * g2 / (V * V * mmin) : 0;
