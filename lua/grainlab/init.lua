@@ -9,6 +9,7 @@ grainlab.biax = require("grainlab.biax")
 local pretty = require("grainlab.pretty")
 grainlab.pretty, grainlab.show = pretty.pretty, pretty.show
 help = require("grainlab.help")
+require("grainlab.docs")
 
 grainlab.doc(grainlab, { name = "grainlab",
   doc = [[Core: report, check, material, pack, biax, pretty, show, rng, progress, clock, elapsed, threads, write_file, doc, version.]] })

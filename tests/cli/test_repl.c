@@ -233,6 +233,8 @@ static void test_completion_and_help(void **state)
     assert_true(expect(&s, "Reports a scenario's figures"));
     enter(&s, "help()");
     assert_true(expect(&s, "Modules:"));
+    enter(&s, "help(grainlab.pack.deposit)"); /* Lua-side functions answer help directly */
+    assert_true(expect(&s, "gravity deposition"));
     enter(&s, "help('grainlab.rng')");
     assert_true(expect(&s, "grainlab.rng{ seed = 0, stream = 0 }"));
     assert_int_equal(finish(&s), 0);
