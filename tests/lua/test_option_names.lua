@@ -3,6 +3,7 @@
 local check = grainlab.check
 
 local s = dem.scene{ dim = 2, box = { { 0, 0 }, { 0.1, 0.1 } } }
+s:add_disk{ pos = { 0.05, 0.05 }, radius = 0.01 }
 local DEM = "'energy', 'stress', 'coordination', 'slip', 'contacts', 'displacement'"
 check.errors(function() s:measure("stres") end,
   "bad argument #1 to 'measure' (invalid option 'stres'; did you mean 'stress'? Valid options: " .. DEM .. ")",
