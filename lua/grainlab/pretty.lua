@@ -18,10 +18,14 @@ local function number(v)
   return s
 end
 
+-- Quoted and escaped as Lua would read it back; cut after max characters (bytes if the string
+-- is not UTF-8, whose bytes above 127 are then shown as \xNN).
 local function quote(s, max)
-  local cut = #s > max
-  if cut then s = s:sub(1, max) end
+  local utf = utf8.len(s) ~= nil
+  local cut = (utf and utf8.len(s) or #s) > max
+  if cut then s = s:sub(1, (utf and utf8.offset(s, max + 1) or max + 1) - 1) end
   s = string.format("%q", s):gsub("\\\n", "\\n"):gsub("\\13", "\\r")
+  if not utf then s = s:gsub("[\128-\255]", function(c) return string.format("\\x%02x", c:byte()) end) end
   if cut then s = s:sub(1, -2) .. "…\"" end
   return s
 end
@@ -50,6 +54,9 @@ local function key_less(a, b)
 end
 
 local format
+
+-- Columns a string takes: characters for UTF-8, bytes otherwise (binary strings).
+local function len(s) return utf8.len(s) or #s end
 
 local function key_text(k, o, path)
   if type(k) == "string" and k:match("^[%a_][%w_]*$") and not KEYWORDS[k] then return k end
@@ -85,19 +92,19 @@ function format(v, o, path, level, indent, col)
   for j = 1, math.min(#keys, o.fields) do
     local k = keys[j]
     local kt = key_text(k, o, path) .. " = "
-    parts[#parts + 1] = kt .. format(rawget(v, k), o, path, level + 1, indent + 2, indent + 2 + utf8.len(kt))
+    parts[#parts + 1] = kt .. format(rawget(v, k), o, path, level + 1, indent + 2, indent + 2 + len(kt))
   end
   if #keys > o.fields then parts[#parts + 1] = string.format("…(%d more fields)", #keys - o.fields) end
   path[v] = nil
 
   local line = "{" .. table.concat(parts, ", ") .. "}"
-  if col + utf8.len(line) <= o.width and not line:find("\n", 1, true) then return line end
+  if col + len(line) <= o.width and not line:find("\n", 1, true) then return line end
   -- Broken: array elements fill lines up to the width, each other field has its own line.
   local pad = string.rep(" ", indent + 2)
   local lines, cur = {}, nil
   for j, p in ipairs(parts) do
     local packable = j <= npos and not p:find("\n", 1, true)
-    if cur and packable and #pad + utf8.len(cur) + 2 + utf8.len(p) + 1 <= o.width then -- "," too
+    if cur and packable and #pad + len(cur) + 2 + len(p) + 1 <= o.width then -- "," too
       cur = cur .. ", " .. p
     else
       if cur then lines[#lines + 1] = cur end
@@ -114,6 +121,7 @@ local OPTS = { "depth", "items", "fields", "width", "string" }
 local function pretty(v, opts)
   local o = {}
   for k, d in pairs(DEFAULTS) do o[k] = d end
+  o.width = math.type(M.width) == "integer" and M.width or o.width -- the REPL's terminal
   if opts ~= nil then
     if type(opts) ~= "table" then
       error("bad argument #2 to 'pretty' (table expected, got " .. type(opts) .. ")", 2)
@@ -153,7 +161,8 @@ sorted (then other keys); tables nested deeper than `depth` as {…}; arrays pas
 elements and more than `fields` other keys elided with …(N more); strings quoted (cut after
 `string` bytes); numbers %.6g (integers as integers, floats keep a .0, nan, inf); a table seen
 again inside itself as <cycle>; tables with __tostring and userdata through tostring. Lines
-longer than `width` break, one entry per line. print(t) itself is unchanged.]] })
+longer than `width` (in the REPL: the terminal's) break, array elements filling lines, other
+fields one per line. print(t) itself is unchanged.]] })
 grainlab.doc(show, { name = "grainlab.show", usage = "grainlab.show(...)",
   doc = [[Prints its arguments as the REPL prints results: tables through grainlab.pretty, other
 values as print shows them, separated by tabs.]] })

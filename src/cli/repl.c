@@ -230,6 +230,13 @@ static void push_printer(lua_State *L)
     lua_pushliteral(L, "grainlab.pretty");
     if (lua_pcall(L, 1, 1, 0) == LUA_OK && lua_istable(L, -1) &&
         lua_getfield(L, -1, "show") == LUA_TFUNCTION) {
+        int rows = 0, cols = 0;
+        if (use_readline) /* tables break at the terminal's width */
+            rl_get_screen_size(&rows, &cols);
+        if (cols >= 40) {
+            lua_pushinteger(L, cols - 1);
+            lua_setfield(L, -3, "width");
+        }
         lua_remove(L, -2);
         return;
     }

@@ -27,6 +27,8 @@ check.eq(P{ 0 / 0, 1 / 0, -1 / 0, -0.0, 43.0, 1 / 3, 2 ^ 63, 1e-300, 7, math.min
   "numbers: %.6g, floats keep .0, nan and inf readable, integers exact")
 check.eq(P{ s = "line\nbreak \"q\"" }, [[{s = "line\nbreak \"q\""}]], "escapes")
 check.eq(P(("x"):rep(100), { string = 5 }), '"xxxxx…"', "long strings cut")
+check.eq(P{ "\xff\0" }, [[{"\xff\0"}]], "bytes of a non-UTF-8 string escaped")
+check.eq(P("ééééé", { string = 3 }), '"ééé…"', "UTF-8 cut at a character")
 
 local fields = {}
 for i = 1, 5 do fields["k" .. i] = i end
