@@ -33,7 +33,7 @@ run() {  # run SCRIPT [name=value…] -- FIGURE…
   echo "ok    ${args[*]} -> out/: ${figs[*]}"
 }
 run mbc_shear_circle.lua n=60 gamma=0.01 -- mbc_shear_circle.png
-run haff.lua n=2000 -- haff_time.png haff_collisions.png haff_particles.png haff_density.png
+run haff.lua n=500 -- haff_time.png haff_collisions.png haff_particles.png haff_density.png
 run vibrated_bed.lua n=100 settle=0.1 avg=0.1 -- vibrated_bed_density.png vibrated_bed_temperature.png \
     vibrated_bed_density_field.png vibrated_bed_temperature_field.png vibrated_bed_particles.png
 run incline.lua quick=true T=0.1 -- incline_cases.png incline_refinement.png
