@@ -851,6 +851,52 @@ static void read_matrix(lua_State *L, int tab, const char *key, int arg, const c
     lua_pop(L, 1);
 }
 
+/* Readers for a table nested in argument arg (mbc): errors name the field as 'mbc.K' of that
+ * argument (args.c's readers would number the nested table by its stack slot). */
+static void nested_check_fields(lua_State *L, int tab, int arg, const char *call, const char *name,
+                                const char *const fields[])
+{
+    tab = lua_absindex(L, tab);
+    lua_pushnil(L);
+    while (lua_next(L, tab)) {
+        lua_pop(L, 1);
+        int known = 0;
+        for (int i = 0; fields[i] && !known && lua_type(L, -1) == LUA_TSTRING; i++)
+            known = strcmp(lua_tostring(L, -1), fields[i]) == 0;
+        if (!known) {
+            char key[64], list[256] = "";
+            bind_describe(L, -1, key, sizeof key);
+            for (int i = 0; fields[i]; i++) {
+                if (i)
+                    strncat(list, ", ", sizeof list - strlen(list) - 1);
+                strncat(list, fields[i], sizeof list - strlen(list) - 1);
+            }
+            luaL_error(L,
+                       "bad field '%s' in argument #%d to '%s' (unknown field %s; valid "
+                       "fields: %s)",
+                       name, user_argn(L, arg), call, key, list);
+        }
+    }
+}
+
+/* Field key of the nested table at tab: a finite number, > 0 (positive) or >= 0, def if absent. */
+static double nested_number(lua_State *L, int tab, const char *key, int arg, const char *call,
+                            const char *label, double def, int positive)
+{
+    if (lua_getfield(L, tab, key) == LUA_TNIL) {
+        lua_pop(L, 1);
+        return def;
+    }
+    double v = lua_tonumber(L, -1);
+    if (lua_type(L, -1) != LUA_TNUMBER || !isfinite(v) || (positive ? !(v > 0) : !(v >= 0))) {
+        char got[64];
+        bind_describe(L, -1, got, sizeof got);
+        field_fail(L, arg, call, label, positive ? "positive number" : "non-negative number", got);
+    }
+    lua_pop(L, 1);
+    return v;
+}
+
 static void push_boundary_info(lua_State *L, dem_scene *s)
 {
     dem_boundary_info bi;
@@ -932,8 +978,12 @@ static int l_boundary(lua_State *L)
     int has_mbc = lua_getfield(L, 2, "mbc") != LUA_TNIL;
     int mbc = lua_gettop(L);
     if (has_mbc) {
-        bind_check_table(L, mbc, call);
-        bind_check_fields(L, mbc, call, mfields);
+        if (!lua_istable(L, mbc)) {
+            char got[64];
+            bind_describe(L, mbc, got, sizeof got);
+            return field_fail(L, 2, call, "mbc", "table", got);
+        }
+        nested_check_fields(L, mbc, 2, call, "mbc", mfields);
         int has_e = lua_getfield(L, mbc, "strain_rate") != LUA_TNIL;
         int has_g = lua_getfield(L, mbc, "gradient") != LUA_TNIL;
         lua_pop(L, 2);
@@ -945,11 +995,11 @@ static int l_boundary(lua_State *L)
         if (lua_getfield(L, mbc, "mask") != LUA_TNIL)
             read_matrix(L, mbc, "mask", 2, call, "mbc.mask", def.mask);
         lua_pop(L, 1);
-        K = bind_field_number(L, mbc, call, "K", 0, BIND_POSITIVE);
-        kappa = bind_field_number(L, mbc, call, "kappa", 20, BIND_POSITIVE);
-        rate = bind_field_number(L, mbc, call, "rate", 0, BIND_POSITIVE);
-        mdt = bind_field_number(L, mbc, call, "dt", 0, BIND_POSITIVE);
-        def.tau = bind_field_number(L, mbc, call, "tau", mdt > 0 ? 1000 * mdt : 0, BIND_NONNEG);
+        K = nested_number(L, mbc, "K", 2, call, "mbc.K", 0, 1);
+        kappa = nested_number(L, mbc, "kappa", 2, call, "mbc.kappa", 20, 1);
+        rate = nested_number(L, mbc, "rate", 2, call, "mbc.rate", 0, 1);
+        mdt = nested_number(L, mbc, "dt", 2, call, "mbc.dt", 0, 1);
+        def.tau = nested_number(L, mbc, "tau", 2, call, "mbc.tau", mdt > 0 ? 1000 * mdt : 0, 0);
         if (rate == 0)
             for (int q = 0; q < 4; q++)
                 rate = fmax(rate, fabs(def.target[q]) * (def.mask[q] != 0));

@@ -171,6 +171,15 @@ check.errors(function() s:boundary{ mode = "delaunay", mbc = { gradient = { { 1,
 msg = check.errors(function() s:boundary{ mode = "delaunay", mbc = { strain_rate = { { 1, 0 }, { 0, 1 } }, mask = { { 1, 0 }, { 0, nan } } } } end,
   "bad field 'mbc.mask' in argument #1 to 'boundary' (2x2 matrix {{xx, xy}, {yx, yy}} of finite numbers expected, got ", "mbc mask NaN")
 check.contains(msg, "nan at row 2, column 2)", "mbc NaN shown")
+check.errors(function() s:boundary{ mode = "delaunay", mbc = { strain_rate = { { 1, 0 }, { 0, 1 } }, K = -1 } } end,
+  "bad field 'mbc.K' in argument #1 to 'boundary' (positive number expected, got -1)", "mbc.K named (was argument #2)")
+check.errors(function() s:boundary{ mode = "delaunay", mbc = { strain_rate = { { 1, 0 }, { 0, 1 } }, tau = "x" } } end,
+  "bad field 'mbc.tau' in argument #1 to 'boundary' (non-negative number expected, got 'x')", "mbc.tau named")
+check.errors(function() s:boundary{ mode = "delaunay", mbc = { strain_rate = { { 1, 0 }, { 0, 1 } }, Kx = 1 } } end,
+  "bad field 'mbc' in argument #1 to 'boundary' (unknown field 'Kx'; valid fields: strain_rate, gradient, mask, K, kappa, rate, dt, tau)",
+  "mbc typo")
+check.errors(function() s:boundary{ mode = "delaunay", mbc = 5 } end,
+  "bad field 'mbc' in argument #1 to 'boundary' (table expected, got 5)", "mbc not a table")
 check.eq(s:boundary{ mode = "delaunay", ids = { 1, 2, 3, 4 } }.edges, 4, "boundary on listed ids")
 s:boundary{ mode = "none" }
 check.errors(function() s:springs{ i = { 1, 2 }, j = { 3 }, k = 1 } end,
