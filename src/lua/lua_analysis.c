@@ -1236,8 +1236,11 @@ void bind_open_analysis(lua_State *L)
          "Delaunay triangulation of 2D particle centres (qhull), with the boundary triangles "
          "peeled while their outer edge (a, b) is longer than alpha (r_a + r_b) and their third "
          "particle is inside (so the outline never pinches and every particle stays in the mesh; "
-         "alpha = 0: the convex hull; without radii, r is half the median edge). ids: triangulate only these particles. Refuses fewer than 3 particles, "
-         "collinear centres and duplicate positions. Returns an analysis.mesh."},
+         "alpha = 0: the convex hull; without radii, r is half the median edge). Triangles "
+         "flat to rounding on the outline (centres in a row along a wall) are peeled whatever "
+         "alpha. ids: triangulate only these particles (distinct ids, entries of x/y or of the "
+         "scene). Refuses fewer than 3 particles, collinear centres, duplicate positions and "
+         "non-positive radii. Returns an analysis.mesh."},
         {NULL, NULL, NULL, NULL}};
     lua_newtable(L);
     bind_register(L, -1, fns);
