@@ -49,6 +49,9 @@ static int field_fail(lua_State *L, int arg, const char *call, const char *name,
                       user_argn(L, arg), call, expected, got);
 }
 
+static void nested_check_fields(lua_State *L, int tab, int arg, const char *call, const char *name,
+                                const char *const fields[]);
+
 /* The field error for the value on top, entry k (1-based) of the array `name`. */
 static int entry_error(lua_State *L, int arg, const char *call, const char *name,
                        const char *expected, size_t k)
@@ -59,12 +62,13 @@ static int entry_error(lua_State *L, int arg, const char *call, const char *name
     return field_fail(L, arg, call, name, expected, got);
 }
 
-/* Reads field `name` of the table at arg as an array of exactly n finite numbers (n = 0: any
- * length, returned in *n). The buffer stays on the stack (freed by the GC, also on errors). */
-static double *read_array(lua_State *L, int arg, const char *call, const char *name, size_t *n,
-                          int required)
+/* Reads field `key` of the table at tab as an array of exactly n finite numbers (n = 0: any
+ * length, returned in *n); errors name field `name` of argument arg. The buffer stays on the
+ * stack (freed by the GC, also on errors). */
+static double *read_array_at(lua_State *L, int tab, const char *key, int arg, const char *call,
+                             const char *name, size_t *n, int required)
 {
-    int t = lua_getfield(L, arg, name);
+    int t = lua_getfield(L, tab, key);
     if (t == LUA_TNIL && !required) {
         lua_pop(L, 1);
         return NULL;
@@ -82,21 +86,27 @@ static double *read_array(lua_State *L, int arg, const char *call, const char *n
         snprintf(got, sizeof got, "%zu values", len);
         field_fail(L, arg, call, name, what, got);
     }
-    int tab = lua_gettop(L);
+    int arr = lua_gettop(L);
     double *v = scratch(L, len);
-    lua_insert(L, tab); /* the buffer below the table */
-    tab++;
+    lua_insert(L, arr); /* the buffer below the array */
+    arr++;
     for (size_t i = 0; i < len; i++) {
-        lua_rawgeti(L, tab, (lua_Integer)i + 1);
+        lua_rawgeti(L, arr, (lua_Integer)i + 1);
         int isnum = lua_type(L, -1) == LUA_TNUMBER;
         v[i] = lua_tonumber(L, -1);
         if (!isnum || !isfinite(v[i]))
             entry_error(L, arg, call, name, what, i + 1);
         lua_pop(L, 1);
     }
-    lua_pop(L, 1); /* the table; the buffer stays */
+    lua_pop(L, 1); /* the array; the buffer stays */
     *n = len;
     return v;
+}
+
+static double *read_array(lua_State *L, int arg, const char *call, const char *name, size_t *n,
+                          int required)
+{
+    return read_array_at(L, arg, name, arg, call, name, n, required);
 }
 
 /* Reads field `key` of the table at tab as an array of particle ids, integers in [1, max],
@@ -258,8 +268,19 @@ static int l_delaunay(lua_State *L)
 
 /* Current positions (and velocities) of the mesh's vertices from a dem.scene or a table
  * {x =, y = [, vx =, vy =]} at arg; buffers stay on the stack. Without arg: the build positions. */
+static void config_at(lua_State *L, lmesh *u, int arg, int uarg, const char *nest, const char *call,
+                      const double **x, const double **y, const double **vx, const double **vy);
+
 static void config(lua_State *L, lmesh *u, int arg, const char *call, const double **x,
                    const double **y, const double **vx, const double **vy)
+{
+    config_at(L, u, arg, arg, NULL, call, x, y, vx, vy);
+}
+
+/* config() of the state at stack index arg, which is argument uarg itself (nest NULL) or its
+ * field `nest` (raster's state): errors name 'x' or 'state.x' of argument uarg. */
+static void config_at(lua_State *L, lmesh *u, int arg, int uarg, const char *nest, const char *call,
+                      const double **x, const double **y, const double **vx, const double **vy)
 {
     const analysis_mesh *m = u->m;
     size_t n = m->np;
@@ -299,17 +320,27 @@ static void config(lua_State *L, lmesh *u, int arg, const char *call, const doub
         return;
     }
     static const char *const fields[] = {"x", "y", "vx", "vy", NULL};
-    bind_check_table(L, arg, call);
-    bind_check_fields(L, arg, call, fields);
-    size_t len = n;
-    *x = read_array(L, arg, call, "x", &len, 1);
-    *y = read_array(L, arg, call, "y", &len, 1);
-    if (vx) {
-        *vx = read_array(L, arg, call, "vx", &len, 0);
-        *vy = read_array(L, arg, call, "vy", &len, 0);
-        if (!*vx || !*vy)
-            luaL_error(L, "%s: give vx and vy (or a dem.scene)", call);
+    if (nest) {
+        if (!lua_istable(L, arg)) {
+            char got[64];
+            bind_describe(L, arg, got, sizeof got);
+            field_fail(L, uarg, call, nest, "dem.scene or {x =, y =}", got);
+        }
+        nested_check_fields(L, arg, uarg, call, nest, fields);
+    } else {
+        bind_check_table(L, arg, call);
+        bind_check_fields(L, arg, call, fields);
     }
+    static const char *const keys[4] = {"x", "y", "vx", "vy"};
+    const double **out[4] = {x, y, vx, vy};
+    size_t len = n;
+    for (int q = 0; q < (vx ? 4 : 2); q++) {
+        char label[48];
+        snprintf(label, sizeof label, "%s%s%s", nest ? nest : "", nest ? "." : "", keys[q]);
+        *out[q] = read_array_at(L, arg, keys[q], uarg, call, label, &len, q < 2);
+    }
+    if (vx && (!*vx || !*vy))
+        luaL_error(L, "%s: give vx and vy (or a dem.scene)", call);
 }
 
 static int l_mesh_info(lua_State *L)
@@ -602,7 +633,7 @@ static int l_mesh_raster(lua_State *L)
     lua_getfield(L, 3, "state");
     int state = lua_gettop(L);
     const double *x, *y;
-    config(L, u, state, call, &x, &y, NULL, NULL);
+    config_at(L, u, state, 3, "state", call, &x, &y, NULL, NULL);
     double *out = scratch(L, (size_t)nx * (size_t)ny);
     core_error err;
     if (analysis_rasterize(m, x, y, vals, nx, ny, ext, out, &err))

@@ -94,6 +94,17 @@ check.errors(function() m:raster({ 1, 2, 3 }, { nx = 2, ny = 2, extent = { 1, 2 
   "raster: extent rows are numbers (crashed)")
 check.errors(function() m:raster({ 1, 2, 3 }, { nx = 2, ny = 2, extent = { { 0, 0 }, { 0, 1 } } }) end,
   "bad field 'extent' in argument #2 to 'raster' (upper corner above the lower one on every axis expected", "raster: empty extent")
+-- raster's state is a field of argument #2: its errors say so (they named a stack slot).
+local ro = { nx = 2, ny = 2, extent = { { 0, 0 }, { 1, 1 } } }
+ro.state = 5
+check.errors(function() m:raster({ 1, 2, 3 }, ro) end,
+  "bad field 'state' in argument #2 to 'raster' (dem.scene or {x =, y =} expected, got 5)", "raster: state a number")
+ro.state = { x = { 1, 2 }, y = { 1, 2 } }
+check.errors(function() m:raster({ 1, 2, 3 }, ro) end,
+  "bad field 'state.x' in argument #2 to 'raster' (array of 5 finite numbers expected, got 2 values)", "raster: state.x length")
+ro.state = { x = square.x, y = square.y, z = 1 }
+check.errors(function() m:raster({ 1, 2, 3 }, ro) end,
+  "bad field 'state' in argument #2 to 'raster' (unknown field 'z'; valid fields: x, y, vx, vy)", "raster: state typo")
 local img = m:raster({ 1, 2, 3 }, { nx = 4, ny = 4, extent = { { 0, 0 }, { 1, 1 } } })
 check.eq(#img, 16, "raster of a valid call")
 check.errors(function() m.info() end, "bad argument #1 to 'info' (analysis.mesh expected", "mesh method with '.'")
