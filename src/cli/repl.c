@@ -17,6 +17,7 @@
 #include <readline/readline.h>
 
 #include "cli/cli.h"
+#include "core/interrupt.h"
 
 enum { READ_EOF = 0, READ_LINE = 1, READ_INTERRUPTED = -1 };
 
@@ -86,6 +87,11 @@ static int read_tty(const char *prompt, char **out)
             fputs("^C\n", stdout);
             fflush(stdout);
             result = READ_INTERRUPTED;
+            break;
+        }
+        if (interrupt_terminating()) { /* SIGTERM ends the session, unlike Ctrl-C */
+            rl_callback_handler_remove();
+            result = READ_EOF;
             break;
         }
         if (n < 0 && errno == EINTR)
@@ -336,6 +342,8 @@ void repl_run(lua_State *L)
             continue;
         if (status == LUA_OK)
             status = cli_docall(L, 0, LUA_MULTRET);
+        if (interrupt_terminating())
+            break;
         if (status == LUA_OK)
             print_results(L);
         else
