@@ -100,12 +100,27 @@ static int fail(lua_State *L, progress *prog, const bind_run *r, const char *cal
     if (r->expect > 0)
         snprintf(of, sizeof of, " of %s%ld", r->steps == r->expect ? "" : "about ", r->expect);
     if (interrupted) {
+        /* The run says where it stopped; the CLI's Ctrl-C hook (raising "interrupted" in the next
+         * Lua call, here the guard's __close) would replace that message. A termination's hook
+         * stays: nothing may catch it. */
+        if (!interrupt_terminating())
+            lua_sethook(L, NULL, 0, 0);
         char where[160];
         snprintf(where, sizeof where, "step %ld%s of '%s'", done, of, r->label);
         interrupt_note(where);
     }
-    if (!err)
+    if (!err) { /* from on_step; a Ctrl-C there says where the run stood */
+        if (interrupted && lua_type(L, -1) == LUA_TSTRING) {
+            char msg[160];
+            snprintf(
+                msg, sizeof msg,
+                " (in on_step: the run stopped at step %ld%s of this run; the scene is intact)",
+                done, of);
+            lua_pushstring(L, msg);
+            lua_concat(L, 2);
+        }
         return lua_error(L);
+    }
     if (err->status == CORE_ERR_INTERRUPTED) {
         /* the kernels say "interrupted at step S (t = T s); ...": keep the time */
         char t[64] = "";
@@ -113,11 +128,13 @@ static int fail(lua_State *L, progress *prog, const bind_run *r, const char *cal
         if (p)
             snprintf(t, sizeof t, " %.*s", (int)strcspn(p, ")") + 1, p);
         int sig = interrupt_terminating();
-        return luaL_error(L, "%s: %s at step %ld%s of this run%s; the scene is intact", call,
-                          sig == SIGTERM ? "terminated (SIGTERM)"
-                          : sig          ? "terminated"
-                                         : "interrupted",
-                          done, of, t);
+        char msg[320]; /* lua_pushfstring knows no %ld */
+        snprintf(msg, sizeof msg, "%s: %s at step %ld%s of this run%s; the scene is intact", call,
+                 sig == SIGTERM ? "terminated (SIGTERM)"
+                 : sig          ? "terminated"
+                                : "interrupted",
+                 done, of, t);
+        return luaL_error(L, "%s", msg);
     }
     return bind_raise(L, call, err);
 }
