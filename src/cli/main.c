@@ -155,8 +155,16 @@ static void on_sigint(int sig)
 /* SIGTERM (a batch scheduler's time limit) stops the run between steps like Ctrl-C, then ends the
  * process (main: cleanup, message, status 128 + 15), also from the REPL. A second SIGTERM before
  * that ends it at once, removing the temporary files of writes in progress. */
+volatile sig_atomic_t cli_wake_fd = -1;
+
 static void on_sigterm(int sig)
 {
+    if (cli_wake_fd >= 0) {
+        int saved = errno;
+        ssize_t w = write(cli_wake_fd, "t", 1);
+        (void)w;
+        errno = saved;
+    }
     if (interrupt_terminating()) {
         fileio_remove_temporaries();
         _exit(128 + sig);

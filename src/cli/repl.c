@@ -78,7 +78,9 @@ static int read_tty(const char *prompt, char **out)
             FD_SET(sigint_pipe[0], &fds);
             maxfd = sigint_pipe[0] > maxfd ? sigint_pipe[0] : maxfd;
         }
-        int n = prompt_sigint ? -1 : select(maxfd + 1, &fds, NULL, NULL, NULL);
+        int n = prompt_sigint || interrupt_terminating()
+                    ? -1
+                    : select(maxfd + 1, &fds, NULL, NULL, NULL);
         if (prompt_sigint) {
             drain_sigint_pipe();
             rl_free_line_state();
@@ -330,6 +332,7 @@ void repl_run(lua_State *L)
     if (use_readline && pipe(sigint_pipe) == 0) {
         for (int k = 0; k < 2; k++)
             fcntl(sigint_pipe[k], F_SETFL, fcntl(sigint_pipe[k], F_GETFL) | O_NONBLOCK);
+        cli_wake_fd = sigint_pipe[1]; /* SIGTERM wakes the prompt too */
     }
     if (use_readline)
         setup_readline(L);
@@ -355,6 +358,7 @@ void repl_run(lua_State *L)
         close_readline();
     }
     sigaction(SIGINT, &old, NULL);
+    cli_wake_fd = -1;
     for (int k = 0; k < 2; k++)
         if (sigint_pipe[k] >= 0) {
             close(sigint_pipe[k]);
