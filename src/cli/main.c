@@ -143,11 +143,20 @@ static void stop_hook(lua_State *L, lua_Debug *ar)
     luaL_error(L, "interrupted by Ctrl-C");
 }
 
+/* A second Ctrl-C before the first is handled ends the process, without leaving the temporary
+ * files of writes in progress behind. */
+static void on_second_sigint(int sig)
+{
+    fileio_remove_temporaries();
+    signal(sig, SIG_DFL);
+    raise(sig);
+}
+
 /* Only async-signal-safe work: a flag for the kernels and a hook for the Lua VM (lua.c does the
- * same). A second Ctrl-C before the first is handled ends the process. */
+ * same). */
 static void on_sigint(int sig)
 {
-    signal(sig, SIG_DFL);
+    signal(sig, on_second_sigint);
     interrupt_request();
     lua_sethook(running_L, stop_hook, LUA_MASKCALL | LUA_MASKRET | LUA_MASKCOUNT, 1);
 }

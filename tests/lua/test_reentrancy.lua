@@ -109,6 +109,17 @@ do
   c:run{ steps = 10, on_step = function() end }
 end
 
+-- the boundary conditions of lua_analysis.c (pressure on the Delaunay boundary) switched on and
+-- off from on_step: rebuilt by the kernel between steps
+local packed = dem.scene{ box = { { 0, 0 }, { 0.02, 0.02 } } }
+for i = 1, 5 do for j = 1, 5 do packed:add_disk{ pos = { 0.004 + 0.0021 * i, 0.004 + 0.0021 * j }, radius = 1e-3 } end end
+res = packed:run{ steps = 200, every = 50, on_step = function(sc)
+  sc:boundary{ pressure = 1e4, every = 10, depth = 1e-3 }
+end }
+check.eq(res.steps, 200, "boundary switched on from on_step")
+check.eq(packed:run{ steps = 100, every = 50, on_step = function(sc) sc:boundary{ mode = "none" } end }.steps,
+         100, "and off")
+
 -- ---- MPM ---------------------------------------------------------------------------------------
 local function mpm_scene()
   local m = mpm.scene{ cells = { 16, 16 }, size = { 1, 1 }, gravity = { 0, -9.81 } }
