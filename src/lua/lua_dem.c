@@ -947,7 +947,10 @@ void bind_open_dem(lua_State *L)
          "the paper's macro step m(n + q) dt; the cycle simply repeats); steps count small-step "
          "equivalents. on_step runs every `every` steps; returning false stops "
          "the run. Ctrl-C stops between steps with the scene intact. Returns {steps, time, dt, "
-         "force_evaluations, stopped}."},
+         "force_evaluations, stopped}. Progress on stderr: "
+         "nil shows it once the run has taken 2 s, true at once, false never (--quiet: never). "
+         "From on_step, calls that would invalidate the run (a nested run, close, ...) are "
+         "refused."},
         {"measure", l_measure, "s:measure('energy'|'stress'|'coordination'|'slip'|'contacts'|'displacement', opts)",
          "energy: kinetic, rotational, elastic, potential, total (J). stress: assembly stress "
          "sum(branch x force)/V (opts.volume; compression positive) with pressure. "

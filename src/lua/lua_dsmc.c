@@ -807,7 +807,10 @@ void bind_open_dsmc(lua_State *L)
          "(i) collisional regime, (ii) mean free path larger than the cell, (iii) mean collision "
          "time larger than dt are checked and each violation is warned with its numbers on "
          "stderr (warn = false: silent; s:measure('validity') returns them). on_step runs every "
-         "`every` steps; returning false stops. Returns {steps, time, dt, stopped}."},
+         "`every` steps; returning false stops. Returns {steps, time, dt, stopped}. Progress on stderr: "
+         "nil shows it once the run has taken 2 s, true at once, false never (--quiet: never). "
+         "From on_step, calls that would invalidate the run (a nested run, close, ...) are "
+         "refused."},
         {"measure", l_measure,
          "s:measure('temperature'|'a2'|'fields'|'histogram'|'stats'|'profile'|'validity', opts)",
          "temperature: temperature (J, m <|v - u|^2>/d), t_over_m, kinetic_energy, momentum, "

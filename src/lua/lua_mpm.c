@@ -925,7 +925,10 @@ void bind_open_mpm(lua_State *L)
          "true. time = T lands exactly on T. on_step runs every `every` steps; returning false "
          "stops the run. Ctrl-C stops between steps with the scene intact; NaN, an inverted "
          "point or a point leaving the grid stop the run with an error naming the step, point "
-         "and grain. Returns {steps, time, dt, stopped}."},
+         "and grain. Returns {steps, time, dt, stopped}. Progress on stderr: "
+         "nil shows it once the run has taken 2 s, true at once, false never (--quiet: never). "
+         "From on_step, calls that would invalidate the run (a nested run, close, ...) are "
+         "refused."},
         {"measure", l_measure, "m:measure('energy'|'momentum'|'columns'|'shear')",
          "energy: kinetic, elastic (Hencky stored energy), plastic (plastic work), potential "
          "(gravity), total; per unit depth (J/m). momentum: linear = {px, py}, angular (about "
