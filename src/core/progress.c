@@ -67,12 +67,16 @@ static int terminal_width(FILE *out)
     return 80;
 }
 
+/* An estimated total (a time-based run at a varying dt) can be passed: then the work shows as
+ * an amount without percentage, never as 104%. */
+static int known_total(const progress *p) { return p->total > 0 && p->done <= p->total; }
+
 static void draw_bar(progress *p, double now)
 {
     double elapsed = now - p->t_start;
     double rate = elapsed > 0 ? p->done / elapsed : 0;
     char tail[96], eta[32];
-    if (p->total > 0) {
+    if (known_total(p)) {
         progress_format_duration(eta, sizeof eta, rate > 0 ? (p->total - p->done) / rate : -1);
         snprintf(tail, sizeof tail, " %5.1f%% %9.3g %s/s ETA %s", 100 * p->done / p->total, rate,
                  p->unit, eta);
@@ -83,7 +87,7 @@ static void draw_bar(progress *p, double now)
     int width = terminal_width(p->out) - 1;
     int room = width - (int)strlen(p->label) - (int)strlen(tail) - 3;
     fprintf(p->out, "\r%s ", p->label);
-    if (p->total > 0 && room >= 10) {
+    if (known_total(p) && room >= 10) {
         int fill = (int)(room * fmin(1.0, p->done / p->total));
         fputc('[', p->out);
         for (int i = 0; i < room; i++)
@@ -101,7 +105,7 @@ static void print_line(progress *p, double now)
     double rate = elapsed > 0 ? p->done / elapsed : 0;
     char el[32], eta[32];
     progress_format_duration(el, sizeof el, elapsed);
-    if (p->total > 0) {
+    if (known_total(p)) {
         progress_format_duration(eta, sizeof eta, rate > 0 ? (p->total - p->done) / rate : -1);
         fprintf(p->out, "%s: %3.0f%% (%.0f/%.0f %s) %.3g %s/s, elapsed %s, ETA %s\n", p->label,
                 100 * p->done / p->total, p->done, p->total, p->unit, rate, p->unit, el, eta);
@@ -163,7 +167,7 @@ void progress_end_early(progress *p, const char *why)
         fputs("\r\033[K", p->out);
     int steps = strcmp(p->unit, "steps") == 0;
     fprintf(p->out, "%s: %s at %s%.0f", p->label, why, steps ? "step " : "", p->done);
-    if (p->total > 0)
+    if (known_total(p))
         fprintf(p->out, " of %.0f", p->total);
     fprintf(p->out, "%s%s after %s\n", steps ? "" : " ", steps ? "" : p->unit, el);
     fflush(p->out);
