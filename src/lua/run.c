@@ -50,23 +50,32 @@ void bind_refuse_running(lua_State *L, int idx, const char *call, const char *wh
                strcmp(call, "run") == 0 ? "already " : "", why);
 }
 
-/* The guard's __close (also on errors): the scene is no longer running. */
-static int guard_close(lua_State *L)
+/* The scene is no longer running. Done in C by the run loop itself before it raises or returns:
+ * the guard's __close, a Lua call, may never run its body when a Ctrl-C or SIGTERM hook raises
+ * at the call; it only covers errors the loop does not see (out of memory). */
+static void disarm(lua_State *L, int guard)
 {
-    int *armed = luaL_checkudata(L, 1, GUARD);
+    int *armed = luaL_checkudata(L, guard, GUARD);
     if (*armed) {
         *armed = 0;
         depth--;
         push_running_table(L);
-        lua_getiuservalue(L, 1, 1);
+        lua_getiuservalue(L, guard, 1);
         lua_pushnil(L);
         lua_rawset(L, -3);
+        lua_pop(L, 1);
     }
+}
+
+static int guard_close(lua_State *L)
+{
+    disarm(L, 1);
     return 0;
 }
 
-/* Marks the scene at idx as running r until the value pushed here goes out of scope. */
-static void push_guard(lua_State *L, int idx, const bind_run *r)
+/* Marks the scene at idx as running r until disarm(), or until the value pushed here (its index
+ * is returned) goes out of scope. */
+static int push_guard(lua_State *L, int idx, const bind_run *r)
 {
     idx = lua_absindex(L, idx);
     int *armed = lua_newuserdatauv(L, sizeof *armed, 1);
@@ -88,12 +97,14 @@ static void push_guard(lua_State *L, int idx, const bind_run *r)
     *armed = 1;
     depth++;
     lua_toclose(L, -1);
+    return lua_gettop(L);
 }
 
 /* Closes the reporter for a run ending early and raises the error on top of the stack (or err). */
-static int fail(lua_State *L, progress *prog, const bind_run *r, const char *call, long done,
-                const core_error *err)
+static int fail(lua_State *L, int guard, progress *prog, const bind_run *r, const char *call,
+                long done, const core_error *err)
 {
+    disarm(L, guard);
     int interrupted = (err && err->status == CORE_ERR_INTERRUPTED) || interrupt_pending();
     progress_end_early(prog, interrupted ? "interrupted" : "failed");
     char of[64] = "";
@@ -153,7 +164,7 @@ int bind_run_chunks(lua_State *L, int scene, int arg, const char *call, const bi
         every = r->steps > 0 ? r->steps : 1;
     int want = bind_field_boolean(L, arg, call, "progress", -1);
     bind_refuse_running(L, scene, call, "return false from on_step to stop it");
-    push_guard(L, scene, r);
+    int guard = push_guard(L, scene, r);
 
     /* Unasked, a run shows progress once it has taken a few seconds (so short runs stay silent),
      * and only the outermost run of nested ones (they would share one line). */
@@ -185,13 +196,13 @@ int bind_run_chunks(lua_State *L, int scene, int arg, const char *call, const bi
         }
         done += got;
         if (st != CORE_OK)
-            return fail(L, &prog, r, call, done, &err);
+            return fail(L, guard, &prog, r, call, done, &err);
         finished = got < n; /* the kernel reached its end (e.g. an end time) */
         if (has_cb && got > 0) {
             lua_pushvalue(L, cb);
             lua_pushvalue(L, scene);
             if (lua_pcall(L, 1, 1, 0) != LUA_OK)
-                return fail(L, &prog, r, call, done, NULL);
+                return fail(L, guard, &prog, r, call, done, NULL);
             stopped = lua_type(L, -1) == LUA_TBOOLEAN && !lua_toboolean(L, -1);
             lua_pop(L, 1);
         }
@@ -200,7 +211,8 @@ int bind_run_chunks(lua_State *L, int scene, int arg, const char *call, const bi
         progress_end_early(&prog, "stopped (on_step returned false)");
     else
         progress_end(&prog);
-    lua_settop(L, cb - 1); /* closes the guard */
+    disarm(L, guard);
+    lua_settop(L, cb - 1);
     return stopped;
 }
 
