@@ -564,7 +564,7 @@ static int l_measure(lua_State *L)
                                              "contacts", "displacement", NULL};
     dem_scene *s = check_scene(L, 1);
     const int D = dem_dim(s);
-    int what = luaL_checkoption(L, 2, NULL, what_names);
+    int what = bind_check_option(L, 2, NULL, what_names);
     switch (what) {
     case 0: {
         dem_energy e;
