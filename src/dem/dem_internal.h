@@ -77,6 +77,7 @@ struct dem_scene {
     dem_material *mats;
     int nmat, cap_mat;
     dem_contact_def contact;
+    double brill_c;        /* Brilliantov from a restitution: lambda(e) v^{-1/5} (dem.h) */
     dem_power slip_pow;    /* x^(1/exponent) of the regularised Coulomb law */
 
     dem_wall *walls;

@@ -594,7 +594,7 @@ core_status dem_timestep_info(const dem_scene *s, double v_imp, dem_timestep *ou
         tc = fmin(tc, t);
         double b = gamma / (2 * m_eff);
         if (s->contact.damping == DEM_DAMPING_BRILLIANTOV) /* rate T k d^{1/2} / (2 m_eff) */
-            b = s->contact.damping_time * k * sqrt(dmax) / (2 * m_eff);
+            b = gamma * k * sqrt(dmax) / (2 * m_eff);
         bmax = fmax(bmax, b);
     }
     out->impact_velocity = v_imp;
@@ -608,18 +608,18 @@ core_status dem_timestep_info(const dem_scene *s, double v_imp, dem_timestep *ou
 
 /* ---- Brilliantov damping time from a restitution ------------------------------------------ */
 /* x'' = -x^{3/2} - lambda x^{1/2} x', x(0) = 0, x'(0) = 1 (lengths in d* = (m v^2/K)^{2/5}, times
- * in units of d* / v): integrated with RK4 until x returns to 0; the force is clipped at zero, so after it
- * vanishes the particles separate at constant speed. Returns the restitution. */
-static double brilliantov_e(double lambda)
+ * in units of d* / v), integrated with RK4 until x returns to 0. With clip the force is never
+ * attractive, so once it vanishes the particles separate at constant speed. */
+double dem_brilliantov_restitution(double lambda, bool clip)
 {
-    const double h = 2e-4;
+    const double h = 2e-4; /* of a contact lasting about 3.2 */
     double x = 0, u = 1;
-    for (int step = 0; step < 200000; step++) {
+    for (int step = 0; step < 1000000; step++) {
         double kx[4], ku[4], xs = x, us = u;
         for (int stage = 0; stage < 4; stage++) {
             double xx = xs > 0 ? xs : 0;
             double a = -xx * sqrt(xx) - lambda * sqrt(xx) * us;
-            if (a > 0)
+            if (clip && a > 0)
                 a = 0; /* no attraction */
             kx[stage] = us;
             ku[stage] = a;
@@ -639,47 +639,62 @@ static double brilliantov_e(double lambda)
     return 0; /* overdamped: never came back */
 }
 
-core_status dem_brilliantov_time(double e, double m_eff, double K, double v, double *T,
-                                 core_error *err)
+core_status dem_brilliantov_lambda(double e, bool clip, double *lambda, core_error *err)
 {
     if (!(e > 0 && e <= 1))
         return core_fail(err, CORE_ERR_ARG, "restitution must be in (0, 1], got %g", e);
-    if (!(m_eff > 0) || !(K > 0) || !(v > 0))
-        return core_fail(err, CORE_ERR_ARG, "mass, stiffness and speed must be > 0");
-    double dstar = pow(m_eff * v * v / K, 0.4);
     if (e == 1) {
-        *T = 0;
+        *lambda = 0;
         return CORE_OK;
     }
+    /* e falls monotonically with lambda: bracket, then bisect. */
     double lo = 0, hi = 1;
-    while (brilliantov_e(hi) > e && hi < 1e6)
+    while (dem_brilliantov_restitution(hi, clip) > e) {
+        lo = hi;
         hi *= 2;
-    for (int it = 0; it < 60; it++) {
+        if (hi > 1e6)
+            return core_fail(err, CORE_ERR_ARG,
+                             "restitution %g is below what brilliantov damping reaches", e);
+    }
+    for (int it = 0; it < 60 && hi - lo > 1e-12 * hi; it++) {
         double mid = 0.5 * (lo + hi);
-        if (brilliantov_e(mid) > e)
+        if (dem_brilliantov_restitution(mid, clip) > e)
             lo = mid;
         else
             hi = mid;
     }
-    *T = 0.5 * (lo + hi) * dstar / v;
+    *lambda = 0.5 * (lo + hi);
     return CORE_OK;
 }
 
-core_status dem_damping_time_for(const dem_scene *s, double e, double v, double *T,
+core_status dem_brilliantov_time(double e, double m_eff, double K, double v, double *T,
                                  core_error *err)
 {
-    if (s->n == 0)
-        return core_fail(err, CORE_ERR_STATE, "add particles before setting brilliantov damping "
-                         "from a restitution (T is solved for their mean pair)");
-    double rm = 0, mm = 0;
-    for (size_t i = 0; i < s->n; i++) {
-        rm += s->r[i];
-        mm += s->m[i];
-    }
-    rm /= (double)s->n;
-    mm /= (double)s->n;
-    const dem_material *mat = &s->mats[s->mat[0]];
-    double estar = mat->young / (2 * (1 - mat->poisson * mat->poisson));
-    double K = 4.0 / 3.0 * estar * sqrt(rm / 2);
-    return dem_brilliantov_time(e, mm / 2, K, v, T, err);
+    if (!(m_eff > 0) || !(K > 0) || !(v > 0))
+        return core_fail(err, CORE_ERR_ARG, "mass, stiffness and speed must be > 0");
+    double lambda;
+    core_status st = dem_brilliantov_lambda(e, true, &lambda, err);
+    if (st != CORE_OK)
+        return st;
+    *T = lambda * pow(m_eff / K, 0.4) * pow(v, -0.2);
+    return CORE_OK;
+}
+
+core_status dem_pair_damping(const dem_scene *s, size_t i, size_t j, int wall, double *out,
+                             core_error *err)
+{
+    if (i >= s->n || (wall < 0 && j >= s->n))
+        return core_fail(err, CORE_ERR_ARG, "particle %zu out of range (the scene has %zu)",
+                         (i >= s->n ? i : j) + 1, s->n);
+    if (wall >= s->nwalls)
+        return core_fail(err, CORE_ERR_ARG, "wall %d out of range (the scene has %d)", wall + 1,
+                         s->nwalls);
+    if (wall < 0 && i == j)
+        return core_fail(err, CORE_ERR_ARG, "particle %zu paired with itself", i + 1);
+    double k, mu;
+    if (wall >= 0)
+        dem_wall_parameters(s, &s->walls[wall], i, &k, out, &mu);
+    else
+        dem_pair_parameters((dem_scene *)s, i, j, &k, out, &mu);
+    return CORE_OK;
 }
