@@ -98,6 +98,13 @@ struct dem_scene {
     long tt_phase;
 
     struct dem_boundary *bnd; /* boundary conditions (boundary.c); NULL when none */
+
+    /* Energy watch (integrate.c): in a scene without drivers the mechanical energy must not
+     * grow; checked every DEM_WATCH_EVERY steps against the lowest energy since the reference,
+     * which any change to the scene from outside a step resets (dem_invalidate). */
+    int watch_on;
+    long watch_next, watch_min_step;
+    double watch_min, watch_min_t, watch_scale;
 };
 
 /* neighbor.c */

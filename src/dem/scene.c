@@ -44,6 +44,7 @@ void dem_invalidate(dem_scene *s, int list)
     s->forces_ready = 0;
     s->gear_ready = 0;
     s->prev_ready = 0;
+    s->watch_on = 0; /* the energy may change from outside: a new reference */
     if (list)
         s->need_rebuild = 1;
 }
