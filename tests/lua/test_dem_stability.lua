@@ -392,17 +392,17 @@ do
   check.gt((tonumber(b) - tonumber(a)) / tonumber(b), 0.1, "3x: it grew by more than 10%")
   check.gt(tonumber(b), e0, "3x: above the initial energy")
 end
-do -- the same gas at the stable limit, 20,000 steps, never trips
+do -- the same gas at the stable limit, 10,000 steps, never trips
   local s, limit = gas(1)
   local e0 = s:measure("energy").total
-  local r = s:run{ steps = 20000, dt = limit, progress = false }
-  check.eq(r.steps, 20000, "at the limit: ran to the end")
+  local r = s:run{ steps = 10000, dt = limit, progress = false }
+  check.eq(r.steps, 10000, "at the limit: ran to the end")
   check.near(s:measure("energy").total, e0, 0.01, "at the limit: energy within 1%")
   -- and in chunks with a callback (the watch keeps its reference across chunks)
   local s2 = gas(2)
   local n = 0
-  s2:run{ steps = 20000, dt = limit, every = 500, progress = false, on_step = function() n = n + 1 end }
-  check.eq(n, 40, "at the limit, in chunks: ran to the end")
+  s2:run{ steps = 6000, dt = limit, every = 500, progress = false, on_step = function() n = n + 1 end }
+  check.eq(n, 12, "at the limit, in chunks: ran to the end")
 end
 do -- in chunks at 3x: the watch keeps its reference across chunks and still stops it
   local s, limit = gas(1)
