@@ -53,6 +53,7 @@ static int open_grainlab(lua_State *L)
     bind_open_analysis(L);
     bind_open_mpm(L);
     bind_open_dsmc(L);
+    bind_open_checkpoint_mpm(L);
     bind_open_render(L);
 
     /* The Lua-side library completes the table: report, check, help. */

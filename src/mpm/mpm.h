@@ -312,4 +312,13 @@ double mpm_shear_strain(const mpm_scene *s);
 /* Total linear momentum and angular momentum about the origin. */
 void mpm_measure_momentum(const mpm_scene *s, double p[2], double *lz);
 
+/* ---- checkpoints (src/mpm/checkpoint.c) ----------------------------------------------------
+ * mpm_save writes everything a bit-exact continuation needs into a grainlab checkpoint at path
+ * (core/checkpoint.h: written whole through a temporary file and a rename); version is the
+ * grainlab version recorded in its header. mpm_load reads one into a new scene (*out), refusing a
+ * missing, truncated, corrupt, foreign (another engine's) or newer file with nothing allocated
+ * left behind. Running the loaded scene gives the same bits as continuing the saved one. */
+core_status mpm_save(const mpm_scene *s, const char *path, const char *version, core_error *err);
+core_status mpm_load(const char *path, mpm_scene **out, core_error *err);
+
 #endif
