@@ -68,7 +68,7 @@ function M.run(s, integrator, steps, every, on_step)
 end
 
 -- Every position, velocity, angular velocity and angle, the walls and the counters, in %a.
-function M.dump(s)
+function M.dump(s, nwalls)
   local p = s:particles()
   local info = s:info()
   local keys = info.dim == 2 and { "x", "y", "vx", "vy", "omega", "angle" }
@@ -80,7 +80,7 @@ function M.dump(s)
     for _, key in ipairs(keys) do row[#row + 1] = string.format("%a", p[key][i]) end
     out[#out + 1] = table.concat(row, " ")
   end
-  for w = 1, (info.dim == 2 and 4 or 6) do
+  for w = 1, nwalls or (info.dim == 2 and 4 or 6) do
     local q = s:wall_point(w)
     out[#out + 1] = string.format("wall %d %a %a %a force %a", w, q[1], q[2], q[3] or 0,
                                   s:wall_force(w))
