@@ -49,7 +49,7 @@ static void put_plane(ckpt_writer *w, const mpm_plane *p)
 }
 
 /* The point arrays of the scene, in the order of the file. */
-static void point_arrays(mpm_scene *s, double *a[21])
+static void point_arrays(const mpm_scene *s, double *a[21])
 {
     double *list[21] = {s->x,      s->y,      s->vx,     s->vy,     s->m,     s->v0,    s->F[0],
                         s->F[1],   s->F[2],   s->F[3],   s->be[0],  s->be[1], s->be[2], s->be[3],
@@ -57,9 +57,8 @@ static void point_arrays(mpm_scene *s, double *a[21])
     memcpy(a, list, sizeof list);
 }
 
-core_status mpm_save(const mpm_scene *cs, const char *path, const char *version, core_error *err)
+core_status mpm_save(const mpm_scene *s, const char *path, const char *version, core_error *err)
 {
-    mpm_scene *s = (mpm_scene *)cs; /* only read */
     const size_t ng = s->ngrains, np = s->np;
     const size_t ntmp = np > ng ? np : ng;
     int64_t *tmp = malloc((ntmp ? ntmp : 1) * sizeof *tmp);

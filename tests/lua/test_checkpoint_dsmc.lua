@@ -3,7 +3,8 @@
 -- counters), in 2D and 3D with inelastic collisions, gravity, specular walls with restitution < 1,
 -- a diffuse wall (its own random streams) and a vibrating wall; saved on 1 thread and continued
 -- on 2, also above the particle count at which the kernels start threads. Then every bad file.
--- (tests/cli/test_checkpoint.sh repeats the continuation in a second grainlab process.)
+-- (tests/cli/test_checkpoint_mpm_dsmc.sh repeats the continuation in a second grainlab
+-- process.)
 local check = grainlab.check
 local dir = os.getenv("TMPDIR") or "/tmp"
 local base = string.format("%s/grainlab_ckpt_dsmc_%d", dir, math.random(1, 1 << 30))
@@ -164,7 +165,8 @@ write(bad, reseal(put(s, 12, string.pack("=I4", 2))))
 check.errors(function() dsmc.load(bad) end, "format version 2", "newer format")
 -- Behind a valid checksum: the last section holds the particles, the last value a velocity.
 write(bad, reseal(put(s, #s - 24 - 8, string.pack("=d", 1 / 0))))
-check.errors(function() dsmc.load(bad) end, "corrupt dsmc checkpoint: a particle is outside the box",
+check.errors(function() dsmc.load(bad) end,
+             "corrupt dsmc checkpoint: a particle is outside the box",
              "infinite velocity")
 write(bad, reseal(s))
 check.eq(dsmc.load(bad):info().steps, 3, "a resealed copy loads")

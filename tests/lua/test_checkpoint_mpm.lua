@@ -3,8 +3,8 @@
 -- (several grains, a friction wall and plane, a prescribed grain, von Mises plasticity) and for
 -- noslip (B-splines, USF, a PIC blend, a periodic axis); saved on 1 thread and continued on 2.
 -- Then every bad file: missing, empty, truncated, corrupt, another engine's, a newer format, and
--- values that pass the checksum but cannot be a scene. (tests/cli/test_checkpoint.sh repeats the
--- continuation in a second grainlab process.)
+-- values that pass the checksum but cannot be a scene. (tests/cli/test_checkpoint_mpm_dsmc.sh
+-- repeats the continuation in a second grainlab process.)
 local check = grainlab.check
 local dir = os.getenv("TMPDIR") or "/tmp"
 local base = string.format("%s/grainlab_ckpt_mpm_%d", dir, math.random(1, 1 << 30))
@@ -26,7 +26,8 @@ local function friction_scene()
   m:add_disk{ center = { 1.0, 0.95 }, radius = 0.25, material = elastic, velocity = { 0, -1 } }
   m:add_polygon{ vertices = { { 1.6, 0.9 }, { 2.1, 0.95 }, { 1.9, 1.4 } }, material = plastic,
                  points_per_cell = 3 }
-  m:add_disk{ center = { 2.033, 0.284 }, radius = 0.15, material = elastic, velocity = { 0.5, -0.5 } }
+  m:add_disk{ center = { 2.033, 0.284 }, radius = 0.15, material = elastic,
+              velocity = { 0.5, -0.5 } }
   local top = m:add_rect{ lo = { 0.3, 1.55 }, hi = { 1.5, 1.75 }, material = elastic }
   m:prescribe(top, { 0.2, 0 })
   m:plane{ point = { 2.4, 0.3 }, normal = { -0.5, 1 }, kind = "friction", mu = 0.3 }
@@ -171,10 +172,14 @@ write(bad, put(s, #s // 2, string.char(s:byte(#s // 2 + 1) ~ 0x10)))
 check.errors(function() mpm.load(bad) end, "checksum mismatch", "one flipped bit")
 write(bad, "-- a Lua script, not a checkpoint\nprint(1)\n")
 check.errors(function() mpm.load(bad) end, "not a grainlab checkpoint", "foreign file")
-write(bad, reseal(put(s, 24, "dem\0")))
+local d = dem.scene{ dim = 2, box = { { 0, 0 }, { 1, 1 } } }
+d:add_disk{ pos = { 0.5, 0.5 }, radius = 0.1,
+            material = grainlab.material{ density = 2650, young = 1e7, poisson = 0.3 } }
+d:save(bad)
 check.errors(function() mpm.load(bad) end, "is a dem checkpoint, not an mpm one", "DEM checkpoint")
 write(bad, reseal(put(s, 24, "dsmc")))
-check.errors(function() mpm.load(bad) end, "is a dsmc checkpoint, not an mpm one", "DSMC checkpoint")
+check.errors(function() mpm.load(bad) end, "is a dsmc checkpoint, not an mpm one",
+             "DSMC checkpoint")
 write(bad, reseal(put(s, 12, string.pack("=I4", 99))))
 check.errors(function() mpm.load(bad) end, "format version 99", "newer format")
 -- Behind a valid checksum: the last section is mpm.clock (time, steps, m_min), then the 24-byte
@@ -191,7 +196,8 @@ write(bad, reseal(s))
 check.eq(mpm.load(bad):info().steps, 2, "a resealed copy loads")
 
 -- save: argument errors and an unwritable place; the old file stays whole.
-check.errors(function() m:save() end, "bad argument #1 to 'save' (file name expected, got no value)",
+check.errors(function() m:save() end,
+             "bad argument #1 to 'save' (file name expected, got no value)",
              "save without a path")
 check.errors(function() m:save(dir .. "/no/such/dir/x.ckpt") end, "save:", "unwritable path")
 check.errors(function() mpm.load() end, "bad argument #1 to 'load'", "load without a path")

@@ -7,12 +7,15 @@ local n, m = params.n or 30, params.m or 30
 local function make()
   if engine:sub(1, 3) == "mpm" then
     local el = mpm.material{ density = 3000, shear = 2.5e6, bulk = 10e6 }
-    local pl = mpm.material{ model = "vonmises", density = 2500, shear = 2e6, bulk = 8e6, yield = 4e4 }
+    local pl = mpm.material{ model = "vonmises", density = 2500, shear = 2e6, bulk = 8e6,
+                             yield = 4e4 }
     local friction = engine == "mpm_friction"
     local s = mpm.scene{ cells = { 24, 20 }, size = { 2.4, 2 }, gravity = { 0.4, -9.8 },
-                         walls = friction and { bottom = { kind = "friction", mu = 0.5 } } or "noslip",
+                         walls = friction and { bottom = { kind = "friction", mu = 0.5 } }
+                                 or "noslip",
                          shape = friction and "linear" or "bspline" }
-    s:add_disk{ center = { 0.7, 0.32 }, radius = 0.3, material = el, velocity = { 0.8, 0 }, omega = 1.5 }
+    s:add_disk{ center = { 0.7, 0.32 }, radius = 0.3, material = el, velocity = { 0.8, 0 },
+                omega = 1.5 }
     s:add_disk{ center = { 1.35, 0.33 }, radius = 0.3, material = pl, velocity = { -0.6, 0 } }
     s:add_rect{ lo = { 0.8, 0.7 }, hi = { 1.3, 1.1 }, material = pl, velocity = { 0, -1 } }
     if friction then s:contact{ model = "friction", mu = 0.3 } end
@@ -30,14 +33,19 @@ local function make()
 end
 
 local function run(s, steps)
-  if engine:sub(1, 3) == "mpm" then s:run{ steps = steps } else s:run{ steps = steps, dt = 2e-4, warn = false } end
+  if engine:sub(1, 3) == "mpm" then
+    s:run{ steps = steps }
+  else
+    s:run{ steps = steps, dt = 2e-4, warn = false }
+  end
 end
 
 local function dump(s)
   local p = engine:sub(1, 3) == "mpm" and s:points() or s:particles()
   print(string.format("t %a steps %d count %d", s:info().time, s:info().steps, p.count))
   for i = 1, p.count do
-    print(p.z and string.format("%a %a %a %a %a %a", p.x[i], p.y[i], p.z[i], p.vx[i], p.vy[i], p.vz[i])
+    print(p.z and string.format("%a %a %a %a %a %a", p.x[i], p.y[i], p.z[i], p.vx[i], p.vy[i],
+                                p.vz[i])
           or string.format("%a %a %a %a", p.x[i], p.y[i], p.vx[i], p.vy[i]))
   end
 end
