@@ -176,6 +176,17 @@ check.errors(function() g:save(42) end, "bad argument #1 to 'save' (file name ex
 check.errors(function() g:save(dir .. "/no/such/dir/x.ckpt") end, "save:", "unwritable path")
 check.eq(dsmc.load(good):info().steps, 3, "the file is intact after failed saves")
 
+-- An empty gas round-trips and takes particles afterwards.
+do
+  local e = dsmc.scene{ dim = 3, size = { 0.05, 0.05, 0.05 }, cells = { 2, 2, 2 }, radius = 1e-3 }
+  e:save(good)
+  local l4 = dsmc.load(good)
+  check.eq(l4:info().count, 0, "empty gas: no particles")
+  l4:fill{ n = 20, temperature = 1e-6, seed = 2 }
+  l4:run{ steps = 2, dt = 1e-4, warn = false }
+  check.eq(l4:info().steps, 2, "empty gas: runs once filled")
+end
+
 os.remove(good)
 os.remove(bad)
 os.remove(mpm_file)

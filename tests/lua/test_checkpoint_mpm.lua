@@ -234,6 +234,17 @@ do
   os.remove(path)
 end
 
+-- An empty scene round-trips and takes grains afterwards.
+do
+  local e = mpm.scene{ cells = { 4, 4 }, size = { 1, 1 }, periodic = { true, false } }
+  e:save(good)
+  local l4 = mpm.load(good)
+  check.eq(l4:info().points, 0, "empty scene: no points")
+  l4:add_disk{ center = { 0.5, 0.5 }, radius = 0.3, material = elastic }
+  l4:run{ steps = 2 }
+  check.eq(l4:info().steps, 2, "empty scene: runs once filled")
+end
+
 os.remove(good)
 os.remove(bad)
 check.done()
