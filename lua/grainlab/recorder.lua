@@ -5,7 +5,7 @@
 -- When the CSV is written: at construction (the header: a bad path fails before the run), then
 -- again at most every `flush` seconds of wall clock while samples arrive (default 10, and never
 -- more often than 20x the time the last write took, so rewriting a long file costs < 5% of the
--- run), at rec:write(), at the end of a `<close>` scope, and when the recorder is collected or
+-- run; flush = 0: at every sample, flush = false: not during the run), at rec:write(), at the end of a `<close>` scope, and when the recorder is collected or
 -- Lua closes — which a script that dies with an error or Ctrl-C still reaches. A run killed
 -- outright (SIGKILL, a node's time limit) loses at most the last `flush` seconds of samples; the
 -- file on disk is always a complete CSV of the rows sampled before its last write.
@@ -184,9 +184,11 @@ local function append(rec, row)
   rec._n = n
   if rec._file and rec._flush then
     local now = grainlab.clock()
-    if now - rec._last >= math.max(rec._flush, 20 * rec._cost) then
+    -- flush = 0 asks for every sample; otherwise a long file is not rewritten more often than
+    -- 20x the time its last write took (< 5% of the run spent writing)
+    if rec._flush == 0 or now - rec._last >= math.max(rec._flush, 20 * rec._cost) then
       local ok, err = write(rec, rec._file)
-      if not ok then error("recorder: cannot write " .. rec._file .. ": " .. tostring(err), 3) end
+      if not ok then error("recorder: " .. tostring(err), 3) end
     end
   end
 end
@@ -272,7 +274,7 @@ function M.write(rec, path)
   end
   mkdir_for(path)
   local ok, err = write(rec, path)
-  if not ok then error("write: cannot write " .. path .. ": " .. tostring(err), 2) end
+  if not ok then error("write: " .. tostring(err), 2) end
   return path
 end
 
@@ -350,7 +352,7 @@ end
 local function finish(rec)
   if rec._file and rec._written ~= rec._n then
     local ok, err = write(rec, rec._file)
-    if not ok then io.stderr:write("grainlab.recorder: cannot write ", rec._file, ": ", tostring(err), "\n") end
+    if not ok then io.stderr:write("grainlab.recorder: ", tostring(err), "\n") end
   end
 end
 MT.__close = finish
