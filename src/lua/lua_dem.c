@@ -145,6 +145,8 @@ static int l_contact(lua_State *L)
         "impact_velocity", "tangential", "gamma_t", "kt", "v_r", "exponent", "clip", "rolling",
         NULL};
     dem_scene *s = check_scene(L, 1);
+    bind_refuse_running(L, 1, "contact", "the contact law cannot change under the time step its "
+                                         "run was checked at: change it between runs");
     bind_check_table(L, 2, "contact");
     bind_check_fields(L, 2, "contact", fields);
     dem_contact_def c = dem_default_contact_def();
@@ -205,6 +207,36 @@ static int l_contact(lua_State *L)
 }
 
 /* ---- particles ------------------------------------------------------------------------------ */
+/* From the on_step of a run (not forced), a particle may join only if the stability limit that
+ * run's dt was checked against still holds: the limit comes from the smallest particle of each
+ * material (contact times grow with size), so the new one must be no smaller than those. */
+static void refuse_smaller_during_run(lua_State *L, dem_scene *s, const char *call,
+                                      const dem_particle_def *p)
+{
+    const bind_run *r = bind_running(L, 1);
+    if (!r || r->forced)
+        return;
+    const double *rad = dem_radii(s);
+    const int *mat = dem_particle_materials(s);
+    double rmin = INFINITY;
+    for (size_t i = 0; i < dem_count(s); i++)
+        if (mat[i] == p->material && rad[i] < rmin)
+            rmin = rad[i];
+    if (p->radius >= rmin)
+        return;
+    char why[320];
+    if (isinf(rmin))
+        snprintf(why, sizeof why, "a particle of a material new to the scene could shorten the "
+                 "stability limit the run's dt = %g s was checked at: add it between runs, or run "
+                 "with force = true", r->dt);
+    else
+        snprintf(why, sizeof why, "a particle smaller than any of its material (radius %g m < %g "
+                 "m) could shorten the stability limit the run's dt = %g s was checked at: add it "
+                 "between runs, or run with force = true", p->radius, rmin, r->dt);
+    lua_pushstring(L, why);
+    bind_refuse_running(L, 1, call, lua_tostring(L, -1));
+}
+
 static int add_particle(lua_State *L, const char *call, int want_dim)
 {
     static const char *const fields[] = {"pos", "radius", "material", "vel", "omega", "fixed",
@@ -232,6 +264,7 @@ static int add_particle(lua_State *L, const char *call, int want_dim)
     if ((p.flags & DEM_FIXED) && (p.flags & DEM_PRESCRIBED))
         return luaL_error(L, "%s: a particle is either fixed or prescribed, not both", call);
     p.material = material_index(L, 1, 2, call, "material", 0);
+    refuse_smaller_during_run(L, s, call, &p);
     core_error err;
     long i = dem_add_particle(s, &p, &err);
     if (i < 0)
@@ -416,13 +449,14 @@ typedef struct dem_advance_ctx {
     dem_run_def *run;
 } dem_advance_ctx;
 
-static core_status dem_advance(void *ctx, long n, long *done, core_error *err)
+static core_status dem_advance(void *ctx, long n, progress *p, long *done, core_error *err)
 {
     dem_advance_ctx *c = ctx;
     c->run->steps = n;
-    c->run->progress = NULL;
-    *done = n;
-    return dem_run(c->s, c->run, err);
+    c->run->progress = p; /* counts the steps taken, also those before an interruption */
+    core_status st = dem_run(c->s, c->run, err);
+    *done = st == CORE_OK ? n : (long)(p->done - p->base);
+    return st;
 }
 
 static int l_run(lua_State *L)
@@ -431,6 +465,7 @@ static int l_run(lua_State *L)
                                          "integrator", "m", "n", "q", "every", "on_step",
                                          "progress", NULL};
     dem_scene *s = check_scene(L, 1);
+    bind_refuse_running(L, 1, "run", "return false from on_step to stop it");
     bind_check_table(L, 2, "run");
     bind_check_fields(L, 2, "run", fields);
     dem_run_def run = dem_default_run_def();
@@ -477,7 +512,9 @@ static int l_run(lua_State *L)
     double t0 = dem_time(s);
     long s0 = dem_steps_done(s), f0 = dem_force_evaluations(s);
     dem_advance_ctx ctx = {s, &run};
-    bind_run r = {"dem run", steps, steps, dem_advance, &ctx};
+    /* dt for two timescales: the large step n dt is the one checked against the limit */
+    bind_run r = {"dem run", steps, steps, dem_advance, &ctx, 1,
+                  run.integrator == DEM_TWO_TIMESCALES ? run.tt_n * run.dt : run.dt, force};
     int stopped = bind_run_chunks(L, 1, 2, "run", &r);
     lua_createtable(L, 0, 5);
     lua_pushinteger(L, dem_steps_done(s) - s0);
@@ -733,6 +770,10 @@ static int l_set_reference(lua_State *L)
 static int l_scale_mass(lua_State *L)
 {
     dem_scene *s = check_scene(L, 1);
+    const bind_run *r = bind_running(L, 1);
+    if (r && !r->forced && luaL_checknumber(L, 2) < 1) /* lighter: shorter contact times */
+        bind_refuse_running(L, 1, "scale_mass", "a factor below 1 shortens the stability limit "
+                                                "the run's dt was checked at: scale between runs");
     core_error err;
     if (dem_scale_mass(s, luaL_checknumber(L, 2), &err))
         return bind_raise(L, "scale_mass", &err);
@@ -742,6 +783,11 @@ static int l_scale_mass(lua_State *L)
 static int l_scale_stiffness(lua_State *L)
 {
     dem_scene *s = check_scene(L, 1);
+    const bind_run *r = bind_running(L, 1);
+    if (r && !r->forced && luaL_checknumber(L, 2) > 1) /* stiffer: shorter contact times */
+        bind_refuse_running(L, 1, "scale_stiffness", "a factor above 1 shortens the stability "
+                                                     "limit the run's dt was checked at: scale "
+                                                     "between runs");
     core_error err;
     if (dem_scale_stiffness(s, luaL_checknumber(L, 2), &err))
         return bind_raise(L, "scale_stiffness", &err);
@@ -864,6 +910,7 @@ static int l_info(lua_State *L)
 static int l_gc(lua_State *L)
 {
     lscene *u = luaL_checkudata(L, 1, SCENE);
+    bind_refuse_running(L, 1, "close", "it can be closed once its run has returned");
     dem_destroy(u->s);
     u->s = NULL;
     return 0;
@@ -930,7 +977,10 @@ void bind_open_dem(lua_State *L)
          "the paper's macro step m(n + q) dt; the cycle simply repeats); steps count small-step "
          "equivalents. on_step runs every `every` steps; returning false stops "
          "the run. Ctrl-C stops between steps with the scene intact. Returns {steps, time, dt, "
-         "force_evaluations, stopped}."},
+         "force_evaluations, stopped}. Progress on stderr: "
+         "nil shows it once the run has taken 2 s, true at once, false never (--quiet: never). "
+         "From on_step, calls that would invalidate the run (a nested run, close, ...) are "
+         "refused."},
         {"measure", l_measure, "s:measure('energy'|'stress'|'coordination'|'slip'|'contacts'|'displacement', opts)",
          "energy: kinetic, rotational, elastic, potential, total (J). stress: assembly stress "
          "sum(branch x force)/V (opts.volume; compression positive) with pressure. "
