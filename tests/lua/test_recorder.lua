@@ -31,6 +31,7 @@ local t = rec:column("t")
 check.eq(#t, 3, "column() length")
 t[1] = 99
 check.eq(rec:column("t")[1], 0.0, "column() is a copy")
+check.eq(grainlab.doc_of(rec).name, "grainlab.recorder", "help(rec) answers with the type's text")
 check.eq(tostring(rec), "grainlab.recorder(step, t, kinetic; 3 samples -> " .. dir .. "/sub/a.csv)", "tostring")
 
 -- ---- %.17g reads back to the same double, for awkward values --------------------------------
@@ -137,6 +138,13 @@ gone = nil
 collectgarbage()
 collectgarbage()
 check.eq(slurp(dir .. "/gone.csv"), "x\n1\n2\n", "collected: the last rows written")
+
+-- ... at the end of a <close> scope ...
+do
+  local scoped <close> = grainlab.recorder{ file = dir .. "/scoped.csv", flush = false, columns = { "x" } }
+  scoped:add{ x = 0.25 }
+end
+check.eq(slurp(dir .. "/scoped.csv"), "x\n0.25\n", "<close>: the rows written")
 
 -- ... and when a script dies with an error: Lua closes and the recorder writes what it has.
 local exe = arg and arg[-1]
