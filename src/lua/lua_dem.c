@@ -177,6 +177,10 @@ static int l_contact(lua_State *L)
         lua_pop(L, 1);
     }
     double v_imp = bind_field_number(L, 2, "contact", "impact_velocity", 1, BIND_POSITIVE);
+    if (e < 0 && lua_getfield(L, 2, "impact_velocity") != LUA_TNIL)
+        return bind_field_error(
+            L, 2, "contact", "impact_velocity",
+            "nothing unless restitution is given (the speed at which it holds)");
     c.tangential = (dem_tangential_law)bind_field_option(L, 2, "contact", "tangential",
                                                          TANGENT_NAMES, DEM_TANGENT_NONE, 0);
     c.gamma_t = bind_field_number(L, 2, "contact", "gamma_t", 0, BIND_NONNEG);
@@ -191,19 +195,22 @@ static int l_contact(lua_State *L)
         if (c.damping_time < 0 && e < 0)
             return luaL_error(L, "contact: brilliantov damping needs damping_time (s) or "
                                  "restitution (with impact_velocity, default 1 m/s)");
-        if (e >= 0) {
-            core_error err;
-            double T;
-            if (dem_damping_time_for(s, e, v_imp, &T, &err) != CORE_OK)
-                return bind_raise(L, "contact", &err);
-            c.damping_time = T;
-        }
+        if (c.damping_time >= 0 && e >= 0)
+            return luaL_error(L, "contact: give damping_time (one T for every pair) or "
+                                 "restitution (a T per pair), not both");
+        /* From a restitution each pair gets its own T when the pair list is built: nothing
+         * depends on the particles present now. */
+        c.restitution = e;
+        c.impact_velocity = v_imp;
     }
     core_error err;
     if (dem_set_contact(s, &c, &err) != CORE_OK)
         return bind_raise(L, "contact", &err);
-    lua_pushnumber(L, c.damping_time);
-    return 1;
+    if (c.damping == DEM_DAMPING_BRILLIANTOV && e < 0) {
+        lua_pushnumber(L, c.damping_time);
+        return 1;
+    }
+    return 0;
 }
 
 /* ---- particles ------------------------------------------------------------------------------ */
@@ -283,6 +290,31 @@ static size_t particle_arg(lua_State *L, dem_scene *s, int arg, const char *call
         luaL_error(L, "bad argument #%d to '%s' (particle id in [1, %d] expected, got %d)",
                    arg - 1, call, (int)dem_count(s), (int)i);
     return (size_t)(i - 1);
+}
+
+/* s:damping_time(i, j) or s:damping_time(i, { wall = w }): the pair's Brilliantov T as the force
+ * loop uses it (per pair when solved from a restitution). */
+static int l_damping_time(lua_State *L)
+{
+    dem_scene *s = check_scene(L, 1);
+    size_t i = particle_arg(L, s, 2, "damping_time"), j = 0;
+    int wall = -1;
+    if (lua_istable(L, 3)) {
+        static const char *const fields[] = {"wall", NULL};
+        bind_check_fields(L, 3, "damping_time", fields);
+        wall =
+            (int)bind_field_number(L, 3, "damping_time", "wall", 0, BIND_POSITIVE | BIND_REQUIRED) -
+            1;
+    } else
+        j = particle_arg(L, s, 3, "damping_time");
+    if (dem_contact(s)->damping != DEM_DAMPING_BRILLIANTOV)
+        return luaL_error(L, "damping_time: the contact law has no brilliantov damping");
+    core_error err;
+    double T;
+    if (dem_pair_damping(s, i, j, wall, &T, &err) != CORE_OK)
+        return bind_raise(L, "damping_time", &err);
+    lua_pushnumber(L, T);
+    return 1;
 }
 
 static int l_set_velocity(lua_State *L)
@@ -938,11 +970,17 @@ void bind_open_dem(lua_State *L)
          "Sets the contact law of the scene. Normal: linear f = k d (Herrmann Eq. 1a, beta = 1), "
          "power f = k d^beta (beta 1, 1.5 or 2), hertz f = 4/3 E* sqrt(R) d^1.5 (Padbidri Eq. "
          "1.1). Damping: viscous gamma_n d' (Eq. 1b; gamma_n per pair from the materials' "
-         "restitution unless given), brilliantov T K d^0.5 d' (Eq. 2.16; T = damping_time, or "
-         "solved from restitution at impact_velocity for the scene's mean pair). Tangential: "
+         "restitution unless given), brilliantov T K d^0.5 d' (Eq. 2.16) with T = damping_time for "
+         "every pair, or, from restitution = e at impact_velocity (default 1 m/s), a T per pair "
+         "(walls too): T = lambda(e) (m*/K)^(2/5) v^(-1/5) with K = 4/3 E* sqrt(R*), so a "
+         "head-on impact at that speed rebounds with e for every pair whatever its radii, masses "
+         "and materials (at other speeds e follows Brilliantov's law: higher when slower); "
+         "s:damping_time(i, j) gives a pair's T. Tangential: "
          "viscous -gamma_t s (Eq. 2a), spring (Cundall-Strack, Eq. 2b; kt defaults to 2/7 of "
          "the normal tangent stiffness), coulomb_regularized mu f_n min(1, (s/v_r)^(1/exponent)) "
-         "(Eq. 2.18). clip = true forbids attractive normal forces. Returns the damping time."},
+         "(Eq. 2.18). clip = true forbids attractive normal forces. Returns damping_time when one "
+         "is "
+         "given, else nothing."},
         {"add_disk", l_add_disk,
          "s:add_disk{ pos = {x, y}, radius = r, material = m, vel = {vx, vy}, omega = w, "
          "fixed = false, prescribed = false }",
@@ -952,18 +990,28 @@ void bind_open_dem(lua_State *L)
          "s:add_sphere{ pos = {x, y, z}, radius = r, material = m, vel = {...}, omega = {...} }",
          "Adds a sphere to a 3D scene; returns its id."},
         {"add_wall", l_add_wall,
-         "s:add_wall{ point = {...}, normal = {...}, velocity = {...}, friction = mu, material = m }",
+         "s:add_wall{ point = {...}, normal = {...}, velocity = {...}, friction = mu, material = m "
+         "}",
          "Adds a planar wall (normal into the domain), optionally moving and with its own "
          "friction; returns the wall id."},
         {"remove_wall", l_remove_wall, "s:remove_wall(id)", "Removes a wall during a run."},
-        {"wall_velocity", l_wall_velocity, "s:wall_velocity(id, {vx, vy})", "Sets a wall's velocity."},
+        {"wall_velocity", l_wall_velocity, "s:wall_velocity(id, {vx, vy})",
+         "Sets a wall's velocity."},
         {"wall_point", l_wall_point, "s:wall_point(id)", "The wall's reference point now."},
         {"wall_force", l_wall_force, "s:wall_force(id)",
          "Normal force (N) the wall exerted on the particles at the last force evaluation."},
-        {"wall_servo", l_wall_servo, "s:wall_servo(id, { force =, mass =, rate = 0 }) or s:wall_servo(id)",
-         "Force control: the wall moves along its normal as a body of this mass pushed with `force` "
+        {"wall_servo", l_wall_servo,
+         "s:wall_servo(id, { force =, mass =, rate = 0 }) or s:wall_servo(id)",
+         "Force control: the wall moves along its normal as a body of this mass pushed with "
+         "`force` "
          "against the contacts, velocity damped at `rate` (1/s); no table switches it off."},
-        {"set_velocity", l_set_velocity, "s:set_velocity(id, {vx, vy})", "Sets a particle's velocity."},
+        {"set_velocity", l_set_velocity, "s:set_velocity(id, {vx, vy})",
+         "Sets a particle's velocity."},
+        {"damping_time", l_damping_time, "s:damping_time(i, j) or s:damping_time(i, { wall = w })",
+         "The Brilliantov damping time T (s) of particles i and j, or of particle i against wall "
+         "w, "
+         "as the force loop uses it (one T for all, or each pair's own when s:contact solved it "
+         "from a restitution)."},
         {"timestep", l_timestep, "s:timestep{ impact_velocity = v }",
          "The contact time of the stiffest, lightest pair at the impact velocity (default: the "
          "fastest particle or sqrt(2 g H), at least 0.1 m/s), the stability limit (1/10 of it, "
@@ -981,7 +1029,8 @@ void bind_open_dem(lua_State *L)
          "nil shows it once the run has taken 2 s, true at once, false never (--quiet: never). "
          "From on_step, calls that would invalidate the run (a nested run, close, ...) are "
          "refused."},
-        {"measure", l_measure, "s:measure('energy'|'stress'|'coordination'|'slip'|'contacts'|'displacement', opts)",
+        {"measure", l_measure,
+         "s:measure('energy'|'stress'|'coordination'|'slip'|'contacts'|'displacement', opts)",
          "energy: kinetic, rotational, elastic, potential, total (J). stress: assembly stress "
          "sum(branch x force)/V (opts.volume; compression positive) with pressure. "
          "coordination: z, z_no_rattlers. slip: mean |slip velocity| at contacts. contacts: "
