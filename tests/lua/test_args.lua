@@ -45,5 +45,5 @@ check.eq(ok, nil, "write_file result")
 check.eq(err, "cannot write '/nonexistent_dir/x.txt': No such file or directory", "write_file message")
 
 check.errors(function() grainlab.doc(print, { nme = "x" }) end,
-  "bad argument #2 to 'doc' (unknown field 'nme'; valid fields: name, usage, doc)", "doc fields")
+  "bad argument #2 to 'doc' (unknown field 'nme'; valid fields: name, usage, doc, fields)", "doc fields")
 check.done()
