@@ -350,3 +350,30 @@ void bind_field_box(lua_State *L, int arg, const char *call, const char *field, 
             bind_field_error(L, arg, call, field, "upper corner above the lower one on every axis");
         }
 }
+
+int bind_steps_or_time(lua_State *L, int arg, const char *call, long *steps, double *time)
+{
+    *steps = (long)bind_field_integer(L, arg, call, "steps", -1, 0, LUA_MAXINTEGER, 0);
+    *time = bind_field_number(L, arg, call, "time", -1, BIND_NONNEG);
+    if (*steps >= 0 && *time >= 0) {
+        lua_getfield(L, arg, "time");
+        bind_field_error(L, arg, call, "time", "nothing when 'steps' is given (give one)");
+    }
+    if (*steps < 0 && *time < 0) {
+        lua_pushnil(L);
+        bind_field_error(L, arg, call, "steps", "step count (or field 'time')");
+    }
+    return *steps >= 0;
+}
+
+long bind_time_steps(lua_State *L, int arg, const char *call, double time, double dt)
+{
+    double n = ceil(time / dt - 1e-9);
+    if (!(n <= 1e15)) {
+        char expected[128];
+        snprintf(expected, sizeof expected, "time of at most 1e15 steps of dt = %g s", dt);
+        lua_getfield(L, arg, "time");
+        bind_field_error(L, arg, call, "time", expected);
+    }
+    return n > 0 ? (long)n : 0;
+}

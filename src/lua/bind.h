@@ -98,6 +98,15 @@ typedef struct bind_run {
  * Returns 1 when on_step returned false. */
 int bind_run_chunks(lua_State *L, int scene, int arg, const char *call, const bind_run *r);
 
+/* Reads `steps` (a non-negative integer) or `time` (s, non-negative) from the run options at
+ * arg, exactly one of them, with errors naming the fields. Returns 1 with *steps set, or 0 with
+ * *time set. */
+int bind_steps_or_time(lua_State *L, int arg, const char *call, long *steps, double *time);
+/* The number of steps of dt that cover `time`, or an error naming field 'time' beyond 1e15 steps
+ * (a year at a million steps a second: beyond it a count loses its meaning, and it would soon
+ * overflow). */
+long bind_time_steps(lua_State *L, int arg, const char *call, double time, double dt);
+
 /* Sets field `name` of the table on top to an array of the n values. */
 void bind_push_array(lua_State *L, const double *a, size_t n, const char *name);
 

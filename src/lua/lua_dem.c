@@ -502,28 +502,10 @@ static int l_run(lua_State *L)
         }
     }
     lua_pop(L, 1);
-    long steps = (long)bind_field_integer(L, 2, "run", "steps", -1, 0, LUA_MAXINTEGER, 0);
-    double time = bind_field_number(L, 2, "run", "time", -1, BIND_NONNEG);
-    if (steps >= 0 && time >= 0) {
-        lua_getfield(L, 2, "time");
-        return bind_field_error(L, 2, "run", "time", "nothing when 'steps' is given (give one)");
-    }
-    if (steps < 0 && time < 0) {
-        lua_pushnil(L);
-        return bind_field_error(L, 2, "run", "steps", "step count (or field 'time')");
-    }
-    if (time >= 0) {
-        /* A run is counted in steps: beyond 1e15 (a year at a million steps a second) the count
-         * loses its meaning and would overflow a long long before the end. */
-        double n = ceil(time / run.dt - 1e-9);
-        if (!(n <= 1e15)) {
-            char expected[128];
-            snprintf(expected, sizeof expected, "time of at most 1e15 steps of dt = %g s", run.dt);
-            lua_getfield(L, 2, "time");
-            return bind_field_error(L, 2, "run", "time", expected);
-        }
-        steps = (long)n;
-    }
+    long steps;
+    double time;
+    if (!bind_steps_or_time(L, 2, "run", &steps, &time))
+        steps = bind_time_steps(L, 2, "run", time, run.dt);
     double t0 = dem_time(s);
     long s0 = dem_steps_done(s), f0 = dem_force_evaluations(s);
     dem_advance_ctx ctx = {s, &run};
