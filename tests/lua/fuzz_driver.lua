@@ -18,6 +18,7 @@
 --     mode = "stress",                             -- fields come from doc.modes[mode]
 --     accept = { field = { "nil", "zero", ... } }, -- classes a field legitimately takes
 --     pos = { [i] = { "nil", ... } },              -- positional args to fuzz and what they take
+--     strings = { [i or field] = "..." },          -- the "string" class there (a file path)
 --     todo = { field = "why" },                    -- printed, not fuzzed (a fix pending elsewhere)
 --     name = "add_disk" }                          -- the name errors use (default: the key's)
 -- An entry may be a list of such tables (one per mode).
@@ -151,8 +152,10 @@ local function fuzz_entry(key, e, fn, doc)
       for _, c in ipairs(derived(base)) do classes[#classes + 1] = c end
       for _, c in ipairs(classes) do
         local cname, v = c[1], c[2]
+        if cname == "string" and e.strings and e.strings[f] then v = e.strings[f] end
         case(key, e, fn, "field '" .. f .. "' = " .. cname .. " (" .. describe(v) .. ")",
-          function(args) args[e.opts][f] = copy(v) end, ok_set[cname], { "'" .. f .. "'" })
+          function(args) args[e.opts][f] = copy(v) end, ok_set[cname],
+          { "'" .. f .. "'", "'" .. f .. ".", "'" .. f .. "[" })
       end
     end
   end
@@ -171,6 +174,7 @@ local function fuzz_entry(key, e, fn, doc)
     for _, c in ipairs(derived(probe[i])) do classes[#classes + 1] = c end
     for _, c in ipairs(classes) do
       local cname, v = c[1], c[2]
+      if cname == "string" and e.strings and e.strings[i] then v = e.strings[i] end
       case(key, e, fn, "argument #" .. i .. " = " .. cname .. " (" .. describe(v) .. ")",
         function(args) args[i] = copy(v); return i end, ok_set[cname],
         { "#" .. i, table.unpack(e.argnames and e.argnames[i] or {}) })
