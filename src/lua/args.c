@@ -94,8 +94,13 @@ lua_Integer bind_arg_integer(lua_State *L, int arg, const char *call, lua_Intege
     lua_Integer v = lua_tointegerx(L, arg, &isint);
     if (!isint || lua_type(L, arg) != LUA_TNUMBER || v < min || v > max) {
         char expected[96];
-        snprintf(expected, sizeof expected, "integer in [%lld, %lld]", (long long)min,
-                 (long long)max);
+        if (min == LUA_MININTEGER && max == LUA_MAXINTEGER)
+            snprintf(expected, sizeof expected, "integer");
+        else if (max == LUA_MAXINTEGER)
+            snprintf(expected, sizeof expected, "integer >= %lld", (long long)min);
+        else
+            snprintf(expected, sizeof expected, "integer in [%lld, %lld]", (long long)min,
+                     (long long)max);
         bind_arg_error(L, arg, call, expected);
     }
     return v;

@@ -115,7 +115,9 @@ static const char *const DOC_FIELDS[] = {"name", "usage", "doc", "fields", NULL}
  * fields lists the keys of its options table (as the C bindings record them). */
 static int l_doc(lua_State *L)
 {
-    luaL_checkany(L, 1);
+    int t1 = lua_type(L, 1); /* the registry is keyed by the object: only API objects qualify */
+    if (t1 != LUA_TFUNCTION && t1 != LUA_TTABLE && t1 != LUA_TUSERDATA)
+        bind_arg_error(L, 1, "doc", "function, table or userdata");
     bind_check_table(L, 2, "doc");
     bind_check_fields(L, 2, "doc", DOC_FIELDS);
     const char *name = bind_field_string(L, 2, "doc", "name", NULL, BIND_REQUIRED);
@@ -124,7 +126,10 @@ static int l_doc(lua_State *L)
     int t = lua_getfield(L, 2, "fields");
     if (t != LUA_TNIL) {
         int ok = t == LUA_TTABLE;
-        lua_Integer n = ok ? luaL_len(L, -1) : 0;
+        lua_Integer n = ok ? (lua_Integer)lua_rawlen(L, -1) : 0, keys = 0;
+        for (lua_pushnil(L); ok && lua_next(L, -2); lua_pop(L, 1))
+            keys++; /* {a = 'x'} is no list of names */
+        ok = ok && keys == n;
         for (lua_Integer i = 1; ok && i <= n; i++) {
             ok = lua_rawgeti(L, -1, i) == LUA_TSTRING;
             lua_pop(L, 1);

@@ -19,6 +19,7 @@
 --     accept = { field = { "nil", "zero", ... } }, -- classes a field legitimately takes
 --     pos = { [i] = { "nil", ... } },              -- positional args to fuzz and what they take
 --     strings = { [i or field] = "..." },          -- the "string" class there (a file path)
+--     slow = { field = { class = "why" } },        -- an accepted class printed, not run (cost)
 --     todo = { field = "why" },                    -- printed, not fuzzed (a fix pending elsewhere)
 --     name = "add_disk" }                          -- the name errors use (default: the key's)
 -- An entry may be a list of such tables (one per mode).
@@ -153,9 +154,13 @@ local function fuzz_entry(key, e, fn, doc)
       for _, c in ipairs(classes) do
         local cname, v = c[1], c[2]
         if cname == "string" and e.strings and e.strings[f] then v = e.strings[f] end
-        case(key, e, fn, "field '" .. f .. "' = " .. cname .. " (" .. describe(v) .. ")",
+        local slow = e.slow and e.slow[f] and e.slow[f][cname]
+        if slow then
+          print(key .. ": field '" .. f .. "' = " .. cname .. " not run (accepted, but slow): " .. slow)
+        else case(key, e, fn, "field '" .. f .. "' = " .. cname .. " (" .. describe(v) .. ")",
           function(args) args[e.opts][f] = copy(v) end, ok_set[cname],
           { "'" .. f .. "'", "'" .. f .. ".", "'" .. f .. "[" })
+        end
       end
     end
   end
@@ -216,11 +221,13 @@ function M.run(spec)
     local doc = grainlab.doc_of(fn)
     local variants = e[1] and e or { e }
     local modes = {}
+    local t0 = os.clock()
     for _, v in ipairs(variants) do
       v._fname, v._form, v._module = key:match("[.:]([%w_]+)$"), module and "." or ":", module
       if v.mode then modes[v.mode] = true end
       fuzz_entry(key, v, fn, doc)
     end
+    if os.getenv("FUZZ_TIMES") then print(string.format("%-32s %.3f s", key, os.clock() - t0)) end
     for m in pairs(doc and doc.modes or {}) do
       if not modes[m] then fail(key, "mode '" .. m .. "' has fields but no base call") end
     end

@@ -32,7 +32,7 @@ check.errors(function() return grainlab.threads(0) end,
 
 -- Methods count arguments as the user sees them: self is not #1.
 local r = grainlab.rng{ seed = 1 }
-check.errors(function() return r:integer() end, "bad argument #1 to 'integer' (number expected, got no value)", "method arg")
+check.errors(function() return r:integer() end, "bad argument #1 to 'integer' (integer expected, got no value)", "method arg")
 check.errors(function() return r:uniform(2, 1) end, "bad argument #2 to 'uniform' (upper bound below lower bound)", "bounds")
 check.errors(function() return r.uniform(5) end, "bad argument #1 to 'uniform' (grainlab.rng expected, got number)", "bad self")
 local p = grainlab.progress{ total = 1 }
