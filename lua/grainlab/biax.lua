@@ -111,6 +111,9 @@ end
 function biax.contact(s, c, frictionless)
   args.object("grainlab.biax.contact", 1, s, "dem.scene")
   c = cfg_of(c, "grainlab.biax.contact", 2)
+  if frictionless ~= nil and type(frictionless) ~= "boolean" then
+    args.arg_fail("grainlab.biax.contact", 3, "boolean", frictionless)
+  end
   if frictionless then
     s:contact{ normal = "hertz", damping = "brilliantov", damping_time = c.damping_time }
   else
@@ -312,6 +315,9 @@ function biax.setup(st, bc, opts)
     args.arg_fail("grainlab.biax.setup", 2, "one of 'pressure', 'membrane', 'mbc'", bc)
   end
   local c = cfg_of(opts, "grainlab.biax.setup", 3)
+  if not (c.thickness > 0) then -- the boundary pressure acts on edges of this depth
+    args.fail("grainlab.biax.setup", 3, "thickness", "positive number (the pressure needs a depth)", c.thickness)
+  end
   local n0 = #st.x
   local ids = {}
   for i = 1, n0 do ids[i] = i end
