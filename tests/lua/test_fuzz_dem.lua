@@ -2,6 +2,7 @@
 -- function and dem.scene method gets every bad-value class; only the classes declared below are
 -- accepted, everything else must end in an error naming the call and the field.
 local fuzz = dofile("fuzz_driver.lua")
+local check = grainlab.check
 local mat = grainlab.material{ density = 2650, young = 1e7, poisson = 0.3, friction = 0.3 }
 
 local function scene2()
@@ -139,3 +140,19 @@ local skip = { ["dem.scene:boundary"] = pending, ["dem.scene:boundary_edges"] = 
                ["dem.scene:springs"] = pending, ["dem.scene:tie"] = pending }
 
 fuzz.run{ modules = { dem = dem }, types = { ["dem.scene"] = scene2() }, calls = calls, skip = skip }
+
+-- Absurd sizes are refused with the limit in the message (issue 12).
+check.errors(function() dem.scene{ box = { { 0, 0 }, { 1e300, 1 } } } end,
+  "bad field 'box' in argument #1 to 'scene' (box corners of magnitude at most 1e+100 expected", "box of 1e300 m")
+check.errors(function() scene2():add_disk{ pos = { 0.5, 0.5 }, radius = 0.6 } end,
+  "add_disk: radius 0.6 is larger than half the box's smallest extent 0.5 (field 'radius')", "radius above the box")
+check.errors(function()
+    dem.scene{ box = { { 0, 0 }, { 1e6, 1e6 } } }:add_disk{ pos = { 1, 1 }, radius = 1e-6 }
+  end, "add_disk: radius 1e-06 is below 1e-9 of the largest box coordinate 1e+06", "radius lost in rounding")
+check.errors(function() scene2():run{ time = 1e99, dt = 1e-6 } end,
+  "bad field 'time' in argument #1 to 'run' (time of at most 1e15 steps of dt = 1e-06 s expected, got 1e+99)", "time of 1e99 s")
+check.errors(function() scene2():set_velocity(1, { 0, 0, 1 }) end,
+  "bad argument #2 to 'set_velocity' (array of 2 finite numbers expected, got table)", "3 components in 2D")
+check.errors(function() scene2():wall_velocity(1, { 0, 0, 1 }) end,
+  "bad argument #2 to 'wall_velocity' (array of 2 finite numbers expected, got table)", "wall velocity in 3 components")
+check.done()
