@@ -35,7 +35,10 @@
 --
 --   grainlab scripts/biaxial.lua [bc=all|pressure|membrane|mbc|plot] [scale=1] [n=3300]
 --       [strain=0.20] [rate=0.005] [seed=1] [sample=0.001] [png=images/biaxial] [csv=out/biaxial]
---       [affine=full|yy]
+--       [affine=full|yy] [out=out]
+-- Figures go to images/ only from the full-size run (all of n, strain, rate, seed, sample,
+-- affine at their defaults); any other run writes them to out/ (or out=DIR), its CSVs to
+-- out/biaxial_reduced_<bc>.csv (grainlab.figures).
 -- bc = one condition writes out/biaxial_<bc>.csv and its maps (run the three in parallel), then
 -- bc = plot draws the comparison figures from the CSVs present and reports; bc = all does both.
 -- Map and window strains are the paper's (L_II/p at 7%, 7.5%, 8.5%; windows 10-12-14%,
@@ -47,16 +50,24 @@ local strain = params.strain or 0.20
 local rate = params.rate or 5e-3
 local seed = params.seed or 1
 local sample = params.sample or 0.001
-local png = params.png or "images/biaxial"
-local csv = params.csv or "out/biaxial"
 local which = params.bc or "all"
 local affine = params.affine or "full"
+-- Only the full-size run (the defaults) publishes into images/; any other run writes its figures
+-- and CSVs into out/ (or out=DIR) under other names, so neither a figure in images/ nor the CSVs
+-- that bc=plot draws them from are overwritten by a reduced run.
+local figures = require("grainlab.figures")
+local published = figures.published({ n = n, strain = strain, rate = rate, seed = seed, sample = sample,
+                                      affine = affine },
+                                    { n = 3300, strain = 0.20, rate = 5e-3, seed = 1, sample = 0.001,
+                                      affine = "full" })
+local png = params.png or figures.path("biaxial", { published = published, out = params.out })
+local csv = params.csv or (published and "out/biaxial" or figures.path("biaxial_reduced", { published = false, out = params.out }))
 assert(affine == "full" or affine == "yy", "affine must be 'full' or 'yy', got " .. tostring(affine))
 grainlab.threads(1)
 for name, v in pairs { n = n, strain = strain, rate = rate, sample = sample } do
   assert(type(v) == "number" and v > 0, name .. " must be a positive number")
 end
-os.execute("mkdir -p out images")
+os.execute("mkdir -p out")
 local c = biax.config{ rate = rate }
 local f = strain / 0.20 -- paper strains are for a run to 20%
 local plan = {

@@ -15,6 +15,8 @@
 -- comparison went to 10%.
 --   grainlab scripts/biaxial_two_timescales.lua [n=600] [strain=0.002] [seed=1]
 --       [png=images/biaxial_two_timescales] [runs=1,2,...] [plot=1] [out=out/biaxial_tt]
+-- Only n=3300 strain=0.01 seed=1 (the documented run) writes images/biaxial_two_timescales.png;
+-- plot=1 takes the same n, strain and seed as the runs.
 -- runs = a subset of the six (1 = III, 2 = I, 3-6 = II in the order above) saves each run to
 -- <out>_<k>.lua (split the runs over processes to use several cores: CPU time is per run, so
 -- the speed-ups do not depend on the split); plot=1 then reads the six files and reports.
@@ -22,16 +24,22 @@ local biax = grainlab.biax
 local n = params.n or 600
 local strain = params.strain or 0.002
 local seed = params.seed or 1
-local png = params.png or "images/biaxial_two_timescales"
+-- The published figure (images/, shown in docs/analysis.md) is the documented run, n = 3300 to
+-- 1 % strain, seed 1; any other run, the small default included, writes its figure to out/ and
+-- keeps its run files apart (out/biaxial_tt_reduced_<k>.lua), so plot=1 of the full run never
+-- draws a reduced run's data (grainlab.figures).
+local figures = require("grainlab.figures")
+local published = figures.published({ n = n, strain = strain, seed = seed }, { n = 3300, strain = 0.01, seed = 1 })
+local png = params.png or figures.path("biaxial_two_timescales", { published = published })
 local NS = 50
-local outp = params.out or "out/biaxial_tt"
+local outp = params.out or (published and "out/biaxial_tt" or "out/biaxial_tt_reduced")
 local only = nil
 if params.runs then
   only = {}
   for k in tostring(params.runs):gmatch("%d+") do only[tonumber(k)] = true end
 end
 grainlab.threads(1)
-os.execute("mkdir -p out images")
+os.execute("mkdir -p out")
 local c = biax.config{}
 local dt_large = c.dt
 local dt_small = dt_large / NS
@@ -61,14 +69,18 @@ local function save_run(k, r)
   local rows = {}
   for _, row in ipairs(r.rows) do rows[#rows + 1] = string.format("{%.17g,%.17g}", row.ea, row.ev) end
   grainlab.write_file(string.format("%s_%d.lua", outp, k), string.format(
-    "return { cpu = %.17g, evals = %.17g, slip = %.17g, ev = %.17g, servo_b = %.17g, servo_t = %.17g, servo_steps = %d, rows = {%s} }\n",
-    r.cpu, r.evals, r.slip, r.ev, r.servo_b, r.servo_t, r.servo_steps, table.concat(rows, ",")))
+    "return { n = %d, strain = %.17g, seed = %d, cpu = %.17g, evals = %.17g, slip = %.17g, ev = %.17g, servo_b = %.17g, servo_t = %.17g, servo_steps = %d, rows = {%s} }\n",
+    n, strain, seed, r.cpu, r.evals, r.slip, r.ev, r.servo_b, r.servo_t, r.servo_steps, table.concat(rows, ",")))
 end
 
 local metrics, checks = {}, {}
 for k, r in ipairs(runs) do
  if params.plot then
   local d = dofile(string.format("%s_%d.lua", outp, k))
+  if d.n and (d.n ~= n or d.strain ~= strain or d.seed ~= seed) then
+    error(string.format("%s_%d.lua holds a run with n=%d strain=%g seed=%d: plot with the run's parameters",
+                        outp, k, d.n, d.strain, d.seed))
+  end
   r.cpu, r.evals, r.slip, r.ev = d.cpu, d.evals, d.slip, d.ev
   r.servo_b, r.servo_t, r.servo_steps = d.servo_b, d.servo_t, d.servo_steps
   r.rows = {}

@@ -4,8 +4,10 @@
 -- gate that holds it is removed, and the column slumps and spreads along the floor until it
 -- comes to rest (the 2D column collapse of Lube et al. 2005 and Lajeunesse et al. 2005). The
 -- script writes frames coloured by grain, a force-chain frame, a speed frame with a colour bar
--- and two plots into images/ (README.md shows them), about 180 frames for a movie into
--- out/frames/ (800 px, one per 5 ms), and one report.
+-- and two plots into images/ (README.md shows them), 156 frames for a movie into out/frames/
+-- (800 px, one per 5 ms), and one report. Only the default run publishes into images/; a run
+-- with any other n, seed, aspect, young, mu, frame_dt or width writes those images into out/
+-- (grainlab.figures).
 --
 -- Choices and why:
 --  * Grains: n disks (default 1500), radii uniform in [0.5, 1] mm, density 2650 kg/m^3,
@@ -154,7 +156,14 @@ local prep_wall = grainlab.clock() - t_start
 print(string.format("demo: %d disks, column %.1f x %.1f mm (aspect %.2f), floor %.0f mm, E = %g Pa, dt = %.3g s; prepared in %.1f s",
                     n, W0 * 1e3, st0.height * 1e3, st0.height / W0, L * 1e3, young, dt, prep_wall))
 
-os.execute("mkdir -p images out/frames")
+-- images/ only for the run README.md shows (the defaults); movie=false changes no image.
+local figures = require("grainlab.figures")
+local published = figures.published({ n = n, seed = seed, aspect = aspect, young = young, mu = mu,
+                                      frame_dt = frame_dt, width = width },
+                                    { n = 1500, seed = 1, aspect = 2, young = 5e6, mu = 0.5,
+                                      frame_dt = 0.005, width = 1000 })
+local fig_dir = figures.dir{ published = published }
+os.execute("mkdir -p out/frames")
 local function stamp(t) return string.format("t = %.3f s", t) end
 local base = { width = width, walls = walls, show = { "walls", "box" } }
 local function opts(extra)
@@ -165,7 +174,7 @@ local function opts(extra)
 end
 local frame_no = 0
 local function snap(t, title)
-  render.png(s, "images/demo_frame_%02d.png", opts{ frame = frame_no, color = "grain", title = title,
+  render.png(s, fig_dir .. "/demo_frame_%02d.png", opts{ frame = frame_no, color = "grain", title = title,
              stamp = stamp(t) })
   frame_no = frame_no + 1
 end
@@ -181,7 +190,7 @@ local function movie_frame(t, with_gate)
 end
 
 local gate_walls = { walls[1], walls[2], walls[3], gate_def }
-render.png(s, "images/demo_frame_%02d.png", opts{ frame = 0, color = "grain", walls = gate_walls,
+render.png(s, fig_dir .. "/demo_frame_%02d.png", opts{ frame = 0, color = "grain", walls = gate_walls,
            title = string.format("%d disks deposited behind a gate", n), stamp = stamp(0) })
 frame_no = 1
 movie_frame(0, true)
@@ -216,12 +225,12 @@ while t < T_max - 1e-9 do
     if math.abs(t - sn[1]) < frame_dt / 2 then snap(t, sn[2]) end
   end
   if math.abs(t - chains_at) < frame_dt / 2 then
-    render.png(s, "images/demo_force_chains.png", opts{ color = "grain", show = { "force_chains", "walls", "box" },
+    render.png(s, fig_dir .. "/demo_force_chains.png", opts{ color = "grain", show = { "force_chains", "walls", "box" },
                title = "force chains: the static core carries the weight, the flowing skin does not",
                stamp = stamp(t) })
   end
   if math.abs(t - speed_at) < frame_dt / 2 then
-    render.png(s, "images/demo_speed.png", opts{ color = "speed", colormap = "viridis", range = { 0, 1 },
+    render.png(s, fig_dir .. "/demo_speed.png", opts{ color = "speed", colormap = "viridis", range = { 0, 1 },
                show = { "walls", "box", "colorbar" }, label = "speed (m/s)",
                title = "grain speed", stamp = stamp(t) })
   end
@@ -230,14 +239,14 @@ end
 local released = E0 - st.total
 snap(t, "at rest")
 
-render.plot{ file = "images/demo_runout.png", width = 1000, height = 560,
+render.plot{ file = fig_dir .. "/demo_runout.png", width = 1000, height = 560,
              title = string.format("column collapse: %d disks, aspect %.1f, mu %.2f", n, aspect, mu),
              xlabel = "time after the gate opens (s)", ylabel = "mm",
              series = { { x = series.t, y = series.runout, label = "runout: front - W0" },
                         { x = series.t, y = series.height, label = "height over the column's footprint" } } }
 local ke_plot = {}
 for k, v in ipairs(series.ke) do ke_plot[k] = v > 0 and v or 0 / 0 end
-render.plot{ file = "images/demo_energy.png", width = 1000, height = 560, ylog = true,
+render.plot{ file = fig_dir .. "/demo_energy.png", width = 1000, height = 560, ylog = true,
              title = "kinetic energy (translation + rotation)",
              xlabel = "time after the gate opens (s)", ylabel = "J", series = { { x = series.t, y = ke_plot, label = "kinetic" } } }
 

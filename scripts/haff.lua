@@ -33,15 +33,20 @@
 --   grainlab scripts/haff.lua [n=40000] [ppc=5] [excluded=none|free_volume] [drop=25] [zdt=0.002]
 --                             [csv=out/haff.csv]
 --                             [png=images/haff_time.png] [png_c=images/haff_collisions.png]
+-- (figures in images/ from the default run only, otherwise in out/: grainlab.figures)
 local N = params.n or 40000
 local drop = params.drop or 25
 local zdt = params.zdt or 0.002
 local csv_path = params.csv or "out/haff.csv"
-local png_t = params.png or "images/haff_time.png"
-local png_c = params.png_c or "images/haff_collisions.png"
 local R = 1e-3
 local per_cell = params.ppc or 5
 local excluded = params.excluded or "none"
+-- images/ only from the default run (docs/dsmc.md shows it); any other run writes to out/.
+local figures = require("grainlab.figures")
+local fig = { published = figures.published({ n = N, drop = drop, zdt = zdt, ppc = per_cell, excluded = excluded },
+                                            { n = 40000, drop = 25, zdt = 0.002, ppc = 5, excluded = "none" }) }
+local png_t = params.png or figures.path("haff_time.png", fig)
+local png_c = params.png_c or figures.path("haff_collisions.png", fig)
 
 local function a2_of(e, d)
   return 16 * (1 - e) * (1 - 2 * e * e) / (9 + 24 * d - e * (41 - 8 * d) + 30 * e * e * (1 - e))
@@ -128,13 +133,13 @@ local function run_case(d, e)
   local final = s:measure("temperature")
   if d == 2 and e == 0.5 then -- the end state, to see that it is still homogeneous
     local p = s:particles()
-    render.points{ file = "images/haff_particles.png", x = p.x, y = p.y, values = p.speed, size = 3,
+    render.points{ file = figures.path("haff_particles.png", fig), x = p.x, y = p.y, values = p.speed, size = 3,
                    extent = { { 0, 0 }, { L, L } }, width = 900,
                    range = { 0, 2 * math.sqrt(d * final.t_over_m) }, -- 0 .. twice the rms speed
                    title = string.format("2D, e = 0.5, N = %d after T fell %dx: particles by speed", N, drop),
                    label = "speed (m/s)" }
     local f = s:measure("fields")
-    render.field{ file = "images/haff_density.png", nx = f.nx, ny = f.ny, values = f.packing,
+    render.field{ file = figures.path("haff_density.png", fig), nx = f.nx, ny = f.ny, values = f.packing,
                   extent = f.extent, width = 900, title = "same state: packing fraction per cell",
                   label = "packing fraction" }
   end

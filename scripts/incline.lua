@@ -23,12 +23,17 @@
 --
 -- params: T (run time, s; default 1), shape ('linear' | 'bspline'), wall_gap (the friction
 -- wall's gap test, cells; default the scene's), quick=true (skip the rotated-plane runs),
--- out (image prefix, default images/incline).
+-- out (image prefix, default images/incline for the default run, out/incline for any other).
 local T = tonumber(params.T or 1)
 local shape = params.shape or "linear"
 local wall_gap = params.wall_gap and tonumber(params.wall_gap) or nil
 local quick = params.quick == true
-local out = params.out or "images/incline"
+-- The default run publishes into images/ (docs/mpm.md shows it); quick, shorter or other-shape
+-- runs write to out/ (grainlab.figures).
+local figures = require("grainlab.figures")
+local out = params.out or figures.path("incline", {
+  published = figures.published({ T = T, shape = shape, wall_gap = wall_gap, quick = quick },
+                                { T = 1, shape = "linear", quick = false }) and wall_gap == nil })
 local R, g = 0.5, 9.8
 local mat = mpm.material{ density = 3000, shear = 2.5e6, bulk = 10e6 }
 

@@ -14,9 +14,13 @@ local n = params.n or 400
 local gamma = params.gamma or 0.2
 local gamma_rate = params.gamma_rate or 0.05
 local seed = params.seed or 1
-local png = params.png or "images/mbc_shear_circle.png"
+-- images/ only from the default run (docs/analysis.md shows it); any other run writes to out/.
+local figures = require("grainlab.figures")
+local png = params.png or figures.path("mbc_shear_circle.png", {
+  published = figures.published({ n = n, gamma = gamma, gamma_rate = gamma_rate, seed = seed },
+                                { n = 400, gamma = 0.2, gamma_rate = 0.05, seed = 1 }) })
 grainlab.threads(1)
-os.execute("mkdir -p out images")
+os.execute("mkdir -p out")
 local c = biax.config{}
 local st = biax.prepared{ n = n, seed = seed, shape = "circle" }
 local s = biax.scene(st, c)

@@ -56,7 +56,8 @@
 --    fit; the basin heap below the box floor. A CSV (param `csv`, default out/repose.csv) with
 --    columns mu, atan_mu_deg, theta_r_deg, particles_left, fit_points (means over the seeds).
 --    `surface=FILE` also writes the final surface profiles (mu, seed, x_m, top_m). A PNG plot of
---    theta_r against mu beside mu = tan theta (param `png`, default images/repose.png).
+--    theta_r against mu beside mu = tan theta (param `png`, default images/repose.png for the
+--    default run, out/repose.png for any other: grainlab.figures).
 --
 -- Measured (n = 2000, defaults, seeds 1-4 one by one; mean and sd over the 4 packings):
 --     mu     atan(mu)   theta_r (seeds 1 / 2 / 3 / 4)         mean +- sd   grains left (of 2000)
@@ -87,7 +88,6 @@ local v_rest = params.v_rest or 5e-3
 local T_max = params.T_max or 4
 local rms_limit = params.rms_limit or 1
 local csv = params.csv or "out/repose.csv"
-local png = params.png or "images/repose.png"
 local verbose = params.verbose == true
 assert(n and n >= 50, "n must be an integer >= 50")
 assert(seed and seed >= 0, "seed must be a non-negative integer")
@@ -108,6 +108,14 @@ if params.mus then -- "0.1,0.8" or a single number
   end
   table.sort(mus)
 end
+-- images/ only from the default run (docs/dem.md shows it); any other run writes to out/.
+local figures = require("grainlab.figures")
+local published = figures.published({ n = n, seed = seed, seeds = seeds, young = young, dt_factor = dt_factor,
+                                      aspect = aspect, v_rest = v_rest, T_max = T_max,
+                                      mus = table.concat(mus, ",") },
+                                    { n = 2000, seed = 1, seeds = 2, young = 1e6, dt_factor = 1, aspect = 0.5,
+                                      v_rest = 5e-3, T_max = 4, mus = "0.1,0.2,0.3,0.5,0.8" })
+local png = params.png or figures.path("repose.png", { published = published })
 
 local rmin, rmax = 0.5e-3, 1e-3
 local dmean = rmin + rmax          -- mean diameter

@@ -45,9 +45,15 @@ local ramp = params.ramp or 2.5
 local hold = params.hold or 1.0 -- the longer the hold, the higher the decorrelation floor
 local dt = params.dt or 1e-6
 local threshold = params.threshold or 0.1
-local png = params.png or "images/rotation"
+-- images/ only from the default run (docs/analysis.md shows it); any other run writes to out/.
+local figures = require("grainlab.figures")
+local png = params.png or figures.path("rotation", {
+  published = figures.published({ n = n, seed = seed, omega = omega0, ramp = ramp, hold = hold, dt = dt,
+                                  threshold = threshold },
+                                { n = 2827, seed = 1, omega = 0.03, ramp = 2.5, hold = 1.0, dt = 1e-6,
+                                  threshold = 0.1 }) })
 grainlab.threads(1)
-os.execute("mkdir -p out images")
+os.execute("mkdir -p out")
 local c = biax.config{ dt = dt }
 
 local t0 = grainlab.clock()

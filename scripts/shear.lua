@@ -25,14 +25,20 @@
 --
 -- params: scale (fraction of the domain side, the grains keep their size; default 1), shear
 -- (final average shear, default 0.8), mu (0.3), cfl (0.4), seed (5), models ('both' | 'noslip'
--- | 'friction'), out (image prefix, default images/shear).
+-- | 'friction'), out (image prefix, default images/shear for the default run, out/shear for
+-- any other).
 local scale = tonumber(params.scale or 1)
 local shear_end = tonumber(params.shear or 0.8)
 local mu = tonumber(params.mu or 0.3)
 local cfl = tonumber(params.cfl or 0.4)
 local seed = math.tointeger(tonumber(params.seed or 5))
 local models = params.models or "both"
-local out = params.out or "images/shear"
+-- The default run publishes into images/ (docs/mpm.md shows it); any other (scale=0.25 is a
+-- test) writes to out/ (grainlab.figures).
+local figures = require("grainlab.figures")
+local out = params.out or figures.path("shear", {
+  published = figures.published({ scale = scale, shear = shear_end, mu = mu, cfl = cfl, seed = seed, models = models },
+                                { scale = 1, shear = 0.8, mu = 0.3, cfl = 0.4, seed = 5, models = "both" }) })
 
 local L = 1.2e-3 * scale
 local cells = math.max(8, math.floor(150 * scale + 0.5))

@@ -66,7 +66,6 @@
 --                                  [fracs=10,20,50,100,200,500,1000]
 
 local csv_path = params.csv or "out/study_dem.csv"
-local png = params.png or "images/study_dem.png"
 local v0 = params.v0 or 1.0                 -- approach speed, m/s
 local k = params.k or 1e5                   -- linear stiffness, N/m
 local e_lin = params.e or 0.5               -- restitution of the linear case
@@ -81,6 +80,14 @@ for f in tostring(params.fracs or "10,20,50,100,200,500,1000"):gmatch("[^,]+") d
   assert(d and d >= 1, "fracs: a comma-separated list of divisors of t_c (>= 1)")
   fracs[#fracs + 1] = 1 / d
 end
+-- images/ only from the default sweep (docs/dem.md shows it); any other run writes to out/.
+local figures = require("grainlab.figures")
+local png = params.png or figures.path("study_dem.png", {
+  published = figures.published({ v0 = v0, k = k, e = e_lin, T = T_incl, phases = nphases, min_time = min_time,
+                                  ref_div = ref_div, n = tt_n, q = tt_q, m = tt_m,
+                                  fracs = tostring(params.fracs or "10,20,50,100,200,500,1000") },
+                                { v0 = 1.0, k = 1e5, e = 0.5, T = 0.15, phases = 3, min_time = 0.02, ref_div = 2000,
+                                  n = 4, q = 4, m = 1, fracs = "10,20,50,100,200,500,1000" }) })
 table.sort(fracs, function(a, b) return a > b end)
 assert(type(csv_path) == "string", "csv must be a path")
 for name, v in pairs { v0 = v0, k = k, T = T_incl, min_time = min_time } do

@@ -25,7 +25,10 @@
 local N = params.n or 20000
 local seeds = params.seeds or 4
 local csv_path = params.csv or "out/study_dsmc.csv"
-local png = params.png or "images/study_dsmc.png"
+-- images/ only from the default study (docs/dsmc.md shows it); any other run writes to out/.
+local figures = require("grainlab.figures")
+local png = params.png or figures.path("study_dsmc.png", {
+  published = figures.published({ n = N, seeds = seeds }, { n = 20000, seeds = 4 }) })
 local R, e, d, drop = 1e-3, 0.5, 2, 25
 
 local a2 = 16 * (1 - e) * (1 - 2 * e * e) / (9 + 24 * d - e * (41 - 8 * d) + 30 * e * e * (1 - e))

@@ -14,8 +14,10 @@
 -- Output: a table, out/study_mpm.csv (csv=), images/study_mpm.png (png=): |error| against CPU
 -- time, one line per knob.
 local csv_path = params.csv or "out/study_mpm.csv"
-local png = params.png or "images/study_mpm.png"
 local T = tonumber(params.T or 1)
+-- images/ only from the default study; a shorter run writes to out/ (grainlab.figures).
+local figures = require("grainlab.figures")
+local png = params.png or figures.path("study_mpm.png", { published = figures.published({ T = T }, { T = 1 }) })
 local R, g, th, mu = 0.5, 9.8, math.pi / 6, 0.5
 local mat = mpm.material{ density = 3000, shear = 2.5e6, bulk = 10e6 }
 local x_rigid = g * T * T * math.sin(th) / 3

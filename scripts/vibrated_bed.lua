@@ -22,6 +22,10 @@ local f = params.frequency or 60
 local settle = params.settle or 2
 local avg = params.avg or 4
 local csv_path = params.csv or "out/vibrated_bed.csv"
+-- images/ only from the default run (docs/dsmc.md shows it); any other run writes to out/.
+local figures = require("grainlab.figures")
+local fig = { published = figures.published({ n = N, e = e, amplitude = A, frequency = f, settle = settle, avg = avg },
+                                            { n = 900, e = 0.9, amplitude = 1.5e-3, frequency = 60, settle = 2, avg = 4 }) }
 local W, H, R, g = 0.3, 0.3, 0.5e-3, 9.81
 local nx, ny = 100, 100
 local dt = 5e-5
@@ -116,11 +120,11 @@ for i = 1, nb do
     zc[#zc + 1] = 1000 * z[i]; pc[#pc + 1] = packing[i]; tc[#tc + 1] = t_over_m[i]
   end
 end
-render.plot{ file = "images/vibrated_bed_density.png", width = 640, height = 640,
+render.plot{ file = figures.path("vibrated_bed_density.png", fig), width = 640, height = 640,
              title = string.format("Vibrated bed: packing fraction (A = %g mm, f = %g Hz, e = %g)", 1000 * A, f, e),
              xlabel = "packing fraction nu", ylabel = "height z (mm)",
              series = { { x = pc, y = zc, label = "DSMC, time average", style = "both" } } }
-render.plot{ file = "images/vibrated_bed_temperature.png", width = 640, height = 640,
+render.plot{ file = figures.path("vibrated_bed_temperature.png", fig), width = 640, height = 640,
              title = "Vibrated bed: granular temperature against height",
              xlabel = "T/m = <|v - u|^2>/2  (m^2/s^2)", ylabel = "height z (mm)",
              series = { { x = tc, y = zc, label = "DSMC, time average", style = "both" } } }
@@ -139,14 +143,14 @@ for j = 0, rows - 1 do
   for i = 1, nx do dsub[#dsub + 1] = dens[j * nx + i]; tsub[#tsub + 1] = temp[j * nx + i] end
 end
 local ext = { { 0, 0 }, { W, rows * H / ny } }
-render.field{ file = "images/vibrated_bed_density_field.png", nx = nx, ny = rows, values = dsub,
+render.field{ file = figures.path("vibrated_bed_density_field.png", fig), nx = nx, ny = rows, values = dsub,
               extent = ext, title = "Vibrated bed: time-averaged packing fraction",
               label = "packing fraction", interpolation = "bilinear" }
-render.field{ file = "images/vibrated_bed_temperature_field.png", nx = nx, ny = rows, values = tsub,
+render.field{ file = figures.path("vibrated_bed_temperature_field.png", fig), nx = nx, ny = rows, values = tsub,
               extent = ext, title = "Vibrated bed: time-averaged T/m (white: under 10 visits)",
               label = "T/m (m^2/s^2)", interpolation = "bilinear" }
 local pts = s:particles()
-render.points{ file = "images/vibrated_bed_particles.png", x = pts.x, y = pts.y, values = pts.speed,
+render.points{ file = figures.path("vibrated_bed_particles.png", fig), x = pts.x, y = pts.y, values = pts.speed,
                extent = ext, size = 5, title = string.format("Vibrated bed at t = %.2f s", s:info().time),
                label = "speed (m/s)" }
 

@@ -82,4 +82,5 @@ end
 check.near(err["linear velocity_verlet"].e, 0.7 / 200, 0.3, "velocity Verlet e error at t_c/200")
 check.lt(err["linear gear"].e, 1e-4, "Gear e error at t_c/200")
 check.lt(err["hertz velocity_verlet"].tc, 1e-4, "velocity Verlet Hertz t_c error at t_c/200")
-check.lt(grainlab.clock() - t0, 5, "smoke study runs in under 5 s")
+-- Wall time is reported, never checked (it depends on the machine's load).
+print(string.format("smoke study: %.2f s wall", grainlab.clock() - t0))
