@@ -221,13 +221,36 @@ static int load_statement(lua_State *L, int *read_status)
     return status;
 }
 
+/* Pushes the printer of results: grainlab.pretty's show (tables readable and bounded, the rest
+ * as print shows it, all through the global print), or print itself if that cannot be had. */
+static void push_printer(lua_State *L)
+{
+    int top = lua_gettop(L);
+    lua_getglobal(L, "require");
+    lua_pushliteral(L, "grainlab.pretty");
+    if (lua_pcall(L, 1, 1, 0) == LUA_OK && lua_istable(L, -1) &&
+        lua_getfield(L, -1, "show") == LUA_TFUNCTION) {
+        int rows = 0, cols = 0;
+        if (use_readline) /* tables break at the terminal's width */
+            rl_get_screen_size(&rows, &cols);
+        if (cols >= 40) {
+            lua_pushinteger(L, cols - 1);
+            lua_setfield(L, -3, "width");
+        }
+        lua_remove(L, -2);
+        return;
+    }
+    lua_settop(L, top);
+    lua_getglobal(L, "print");
+}
+
 static void print_results(lua_State *L)
 {
     int n = lua_gettop(L);
     if (n == 0)
         return;
     luaL_checkstack(L, LUA_MINSTACK, "too many results to print");
-    lua_getglobal(L, "print");
+    push_printer(L);
     lua_insert(L, 1);
     if (lua_pcall(L, n, 0, 0) != LUA_OK) {
         fprintf(stderr, "grainlab: error calling 'print' (%s)\n", lua_tostring(L, -1));

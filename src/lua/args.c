@@ -382,3 +382,99 @@ long bind_time_steps(lua_State *L, int arg, const char *call, double time, doubl
     }
     return n > 0 ? (long)n : 0;
 }
+
+/* Optimal string alignment distance (edits and adjacent swaps), capped: names are short. */
+static size_t edit_distance(const char *a, const char *b)
+{
+    enum { CAP = 32 };
+    size_t n = strlen(a), m = strlen(b);
+    if (n > CAP || m > CAP)
+        return (size_t)-1;
+    size_t d[CAP + 1][CAP + 1];
+    for (size_t i = 0; i <= n; i++)
+        d[i][0] = i;
+    for (size_t j = 0; j <= m; j++)
+        d[0][j] = j;
+    for (size_t i = 1; i <= n; i++)
+        for (size_t j = 1; j <= m; j++) {
+            size_t sub = d[i - 1][j - 1] + (a[i - 1] != b[j - 1]);
+            size_t del = d[i - 1][j] + 1, ins = d[i][j - 1] + 1;
+            size_t best = sub < del ? sub : del;
+            best = ins < best ? ins : best;
+            if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] &&
+                d[i - 2][j - 2] + 1 < best)
+                best = d[i - 2][j - 2] + 1;
+            d[i][j] = best;
+        }
+    return d[n][m];
+}
+
+const char *bind_closest_name(const char *s, const char *const names[])
+{
+    /* A unique prefix ("temp" for "temperature") is a clear enough intent. */
+    const char *prefix = NULL;
+    int nprefix = 0;
+    size_t len = strlen(s);
+    for (int i = 0; names[i] && len >= 2; i++)
+        if (strncmp(s, names[i], len) == 0) {
+            prefix = names[i];
+            nprefix++;
+        }
+    if (nprefix == 1)
+        return prefix;
+    /* Else the nearest name within a third of its length (at least one edit): "stres", "Stress",
+     * "sterss" -> "stress", but nothing for a word that is merely short. */
+    const char *best = NULL;
+    size_t best_d = (size_t)-1;
+    for (int i = 0; names[i]; i++) {
+        size_t d = edit_distance(s, names[i]), limit = strlen(names[i]) / 3;
+        if (d <= (limit > 1 ? limit : 1) && d < best_d) {
+            best = names[i];
+            best_d = d;
+        }
+    }
+    return best;
+}
+
+int bind_check_option(lua_State *L, int arg, const char *def, const char *const names[])
+{
+    const char *s = def ? luaL_optstring(L, arg, def) : NULL;
+    if (!def && lua_type(L, arg) == LUA_TSTRING)
+        s = lua_tostring(L, arg);
+    if (s)
+        for (int i = 0; names[i]; i++)
+            if (strcmp(s, names[i]) == 0)
+                return i;
+    char got[64]; /* before the buffer goes on the stack */
+    if (s)
+        bind_describe(L, arg, got, sizeof got);
+    else
+        snprintf(got, sizeof got, "%s", lua_isnone(L, arg) ? "no value" : luaL_typename(L, arg));
+    luaL_Buffer b;
+    luaL_buffinit(L, &b);
+    if (s) {
+        luaL_addstring(&b, "invalid option ");
+        luaL_addstring(&b, got);
+        const char *near = bind_closest_name(s, names);
+        if (near) {
+            luaL_addstring(&b, "; did you mean '");
+            luaL_addstring(&b, near);
+            luaL_addstring(&b, "'?");
+        }
+        luaL_addchar(&b, near ? ' ' : ';');
+        luaL_addstring(&b, near ? "Valid options: " : " valid options: ");
+    } else {
+        luaL_addstring(&b, "one of ");
+    }
+    for (int i = 0; names[i]; i++) {
+        luaL_addstring(&b, i ? ", '" : "'");
+        luaL_addstring(&b, names[i]);
+        luaL_addchar(&b, '\'');
+    }
+    if (!s) {
+        luaL_addstring(&b, " expected, got ");
+        luaL_addstring(&b, got);
+    }
+    luaL_pushresult(&b);
+    return luaL_argerror(L, arg, lua_tostring(L, -1));
+}

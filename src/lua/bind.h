@@ -169,4 +169,11 @@ void bind_open_analysis(lua_State *L);
 /* Registers the global `render` module (lua_render.c). */
 void bind_open_render(lua_State *L);
 
+/* luaL_checkoption that helps: the error lists the valid names and suggests the closest one
+ * ("invalid option 'stres'; did you mean 'stress'? Valid options: 'energy', 'stress', ...").
+ * Same arguments and result as luaL_checkoption. */
+int bind_check_option(lua_State *L, int arg, const char *def, const char *const names[]);
+/* The name of `names` closest to s (a unique prefix, or within a few edits), or NULL. */
+const char *bind_closest_name(const char *s, const char *const names[]);
+
 #endif

@@ -563,7 +563,7 @@ static int l_measure(lua_State *L)
                                              "contacts", "displacement", NULL};
     dem_scene *s = check_scene(L, 1);
     const int D = dem_dim(s);
-    int what = luaL_checkoption(L, 2, NULL, what_names);
+    int what = bind_check_option(L, 2, NULL, what_names);
     switch (what) {
     case 0: {
         dem_energy e;
@@ -645,21 +645,51 @@ static int l_measure(lua_State *L)
         if (!lua_isnoneornil(L, 3)) {
             bind_check_table(L, 3, "measure");
             bind_check_fields(L, 3, "measure", DISPLACEMENT_FIELDS);
-            if (lua_getfield(L, 3, "affine") == LUA_TTABLE) {
-                affine = 1;
-                for (int a = 0; a < D; a++) {
-                    lua_rawgeti(L, -1, a + 1);
-                    for (int b = 0; b < D; b++) {
+            /* affine: D rows of D finite numbers, the shape checked before any row is
+             * indexed (a number as a row used to crash lua_rawgeti). */
+            if (lua_getfield(L, 3, "affine") != LUA_TNIL) {
+                lua_Debug ar;
+                int uarg = lua_getstack(L, 0, &ar) && lua_getinfo(L, "n", &ar) && ar.namewhat &&
+                                   strcmp(ar.namewhat, "method") == 0
+                               ? 2
+                               : 3;
+                char got[128] = "", v[64];
+                int ok = lua_type(L, -1) == LUA_TTABLE && lua_rawlen(L, -1) == (size_t)D;
+                if (!ok && lua_type(L, -1) == LUA_TTABLE)
+                    snprintf(got, sizeof got, "%d rows", (int)lua_rawlen(L, -1));
+                else if (!ok)
+                    bind_describe(L, -1, got, sizeof got);
+                for (int a = 0; a < D && ok; a++) {
+                    int rt = lua_rawgeti(L, -1, a + 1);
+                    if (rt != LUA_TTABLE || lua_rawlen(L, -1) != (size_t)D) {
+                        if (rt == LUA_TTABLE)
+                            snprintf(got, sizeof got, "%d entries in row %d",
+                                     (int)lua_rawlen(L, -1), a + 1);
+                        else {
+                            bind_describe(L, -1, v, sizeof v);
+                            snprintf(got, sizeof got, "%s as row %d", v, a + 1);
+                        }
+                        ok = 0;
+                    }
+                    for (int b = 0; b < D && ok; b++) {
                         lua_rawgeti(L, -1, b + 1);
-                        int isnum;
-                        grad[a][b] = lua_tonumberx(L, -1, &isnum);
+                        grad[a][b] = lua_tonumber(L, -1);
+                        if (lua_type(L, -1) != LUA_TNUMBER || !isfinite(grad[a][b])) {
+                            bind_describe(L, -1, v, sizeof v);
+                            snprintf(got, sizeof got, "%s at row %d, column %d", v, a + 1, b + 1);
+                            ok = 0;
+                        }
                         lua_pop(L, 1);
-                        if (!isnum)
-                            return luaL_error(L, "measure: affine must be a %dx%d matrix of "
-                                                 "numbers (displacement gradient)", D, D);
                     }
                     lua_pop(L, 1);
                 }
+                if (!ok)
+                    return luaL_error(L,
+                                      "bad field 'affine' in argument #%d to 'measure' (%dx%d "
+                                      "matrix of finite numbers (displacement gradient) "
+                                      "expected, got %s)",
+                                      uarg, D, D, got);
+                affine = 1;
             }
             lua_pop(L, 1);
             bind_field_vector(L, 3, "measure", "center", D, center, 0);

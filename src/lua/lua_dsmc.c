@@ -547,7 +547,7 @@ static int l_measure(lua_State *L)
     dsmc_scene *s = check_scene(L, 1);
     const dsmc_scene_def *d = dsmc_def(s);
     int D = d->dim;
-    int what = luaL_checkoption(L, 2, NULL, what_names);
+    int what = bind_check_option(L, 2, NULL, what_names);
     int has_opts = !lua_isnoneornil(L, 3);
     if (has_opts)
         bind_check_table(L, 3, "measure");

@@ -528,7 +528,7 @@ static int l_field(lua_State *L)
                                         "displacement", "sxx",   "syy",   "sxy",  "pressure",
                                         "psd",          "eps_p", "grain", "mass", NULL};
     mpm_scene *s = check_scene(L, 1);
-    int kind = luaL_checkoption(L, 2, NULL, names);
+    int kind = bind_check_option(L, 2, NULL, names);
     const mpm_scene_def *d = mpm_def(s);
     size_t n = (size_t)d->cells[0] * (size_t)d->cells[1];
     double *v = lua_newuserdatauv(L, n * sizeof *v, 0);
@@ -660,7 +660,7 @@ static int l_measure(lua_State *L)
 {
     static const char *const what_names[] = {"energy", "momentum", "columns", "shear", NULL};
     mpm_scene *s = check_scene(L, 1);
-    int what = luaL_checkoption(L, 2, NULL, what_names);
+    int what = bind_check_option(L, 2, NULL, what_names);
     if (what == 2) {
         const int nx = mpm_def(s)->cells[0];
         double *c = lua_newuserdatauv(L, (size_t)nx * sizeof *c, 0);

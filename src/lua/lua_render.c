@@ -127,7 +127,7 @@ static const char *const SHOW[] = {"force_chains", "rotation", "walls", "colorba
  * half-way leaks nothing. */
 typedef struct scene_opts {
     render_grains_def def;
-    int want_walls, want_arrows;
+    int want_arrows;
     long frame; /* < 0: none given */
 } scene_opts;
 
@@ -154,9 +154,8 @@ static void read_show(lua_State *L, int arg, const char *call, scene_opts *o)
 {
     render_grains_def *d = &o->def;
     int t = lua_getfield(L, arg, "show");
-    if (t == LUA_TNIL) { /* defaults: walls, box, and a colour bar when a colour map is used */
+    if (t == LUA_TNIL) { /* defaults: box, and a colour bar when a colour map is used */
         lua_pop(L, 1);
-        o->want_walls = 1;
         d->box = true;
         d->colorbar = true;
         return;
@@ -189,7 +188,7 @@ static void read_show(lua_State *L, int arg, const char *call, scene_opts *o)
         switch (k) {
         case 0: d->force_chains = true; break;
         case 1: d->rotation = true; break;
-        case 2: o->want_walls = 1; break;
+        case 2: break; /* walls are drawn unless walls = false; kept for old scripts */
         case 3: d->colorbar = true; break;
         case 4: d->box = true; break;
         default: o->want_arrows = 1; break;
@@ -198,14 +197,22 @@ static void read_show(lua_State *L, int arg, const char *call, scene_opts *o)
     lua_pop(L, 1);
 }
 
+/* walls: nil or true (the default) draws the scene's own walls where they are now (removed
+ * ones not), false none, an array the walls given. */
 static void read_walls(lua_State *L, int arg, const char *call, dem_scene *s, scene_opts *o)
 {
     static const char *const WALL_FIELDS[] = {"point", "normal", NULL};
-    const char *what = "array of { point = {x, y}, normal = {nx, ny} }";
-    if (lua_getfield(L, arg, "walls") == LUA_TNIL) { /* default: the scene's own walls */
+    const int D = dem_dim(s);
+    const char *what = D == 2 ? "false, true or an array of { point = {x, y}, normal = {nx, ny} }"
+                              : "false, true or an array of { point = {x, y, z}, normal = "
+                                "{nx, ny, nz} }";
+    int t = lua_getfield(L, arg, "walls");
+    if (t == LUA_TBOOLEAN && !lua_toboolean(L, -1)) {
         lua_pop(L, 1);
-        if (dem_dim(s) != 2)
-            return;
+        return;
+    }
+    if (t == LUA_TNIL || t == LUA_TBOOLEAN) { /* the scene's own walls */
+        lua_pop(L, 1);
         int count = dem_wall_count(s), k = 0;
         /* left on the stack, alive until the call returns (nothing above it to keep) */
         render_wall *walls = lua_newuserdatauv(L, (size_t)(count ? count : 1) * sizeof *walls, 0);
@@ -213,8 +220,8 @@ static void read_walls(lua_State *L, int arg, const char *call, dem_scene *s, sc
             double p[3], nrm[3];
             int active;
             if (dem_wall_geometry(s, id, p, nrm, &active, NULL) == CORE_OK && active) {
-                memcpy(walls[k].point, p, 2 * sizeof(double));
-                memcpy(walls[k].normal, nrm, 2 * sizeof(double));
+                memcpy(walls[k].point, p, sizeof walls[k].point);
+                memcpy(walls[k].normal, nrm, sizeof walls[k].normal);
                 k++;
             }
         }
@@ -240,10 +247,11 @@ static void read_walls(lua_State *L, int arg, const char *call, dem_scene *s, sc
                 bind_field_error(L, arg, call, "walls", what);
             }
         }
-        double v[2][2];
+        double v[2][3] = {{0, 0, 0}, {0, 0, 0}};
         for (int f = 0; f < 2; f++) {
-            int ok = lua_getfield(L, w, WALL_FIELDS[f]) == LUA_TTABLE && lua_rawlen(L, -1) == 2;
-            for (int d = 0; ok && d < 2; d++) {
+            int ok =
+                lua_getfield(L, w, WALL_FIELDS[f]) == LUA_TTABLE && lua_rawlen(L, -1) == (size_t)D;
+            for (int d = 0; ok && d < D; d++) {
                 lua_rawgeti(L, -1, d + 1);
                 int isnum;
                 v[f][d] = lua_tonumberx(L, -1, &isnum);
@@ -251,7 +259,7 @@ static void read_walls(lua_State *L, int arg, const char *call, dem_scene *s, sc
                 lua_pop(L, 1);
             }
             lua_pop(L, 1);
-            if (!ok || (f == 1 && v[1][0] == 0 && v[1][1] == 0)) {
+            if (!ok || (f == 1 && v[1][0] == 0 && v[1][1] == 0 && v[1][2] == 0)) {
                 lua_pushvalue(L, w);
                 bind_field_error(L, arg, call, "walls", what);
             }
@@ -487,8 +495,6 @@ static void read_scene_opts(lua_State *L, int scene, int arg, const char *call, 
     read_walls(L, arg, call, s, o);
     read_camera(L, arg, call, &d->camera);
     read_arrows(L, arg, call, s, o);
-    if (!o->want_walls)
-        d->nwalls = 0;
 
     t = lua_getfield(L, arg, "stamp");
     if (t == LUA_TSTRING) {
@@ -1123,20 +1129,24 @@ void bind_open_render(lua_State *L)
         {"png", l_png,
          "render.png(scene, 'file.png', { width = 1024, height =, color = 'grain'|'speed'|"
          "'rotation'|{values}, colormap = 'viridis'|'gray', range = {lo, hi}, show = "
-         "{'force_chains', 'rotation', 'walls', 'colorbar', 'box', 'displacement'}, title =, "
+         "{'force_chains', 'rotation', 'colorbar', 'box', 'displacement'}, title =, "
          "stamp = true|'text', displacement = { affine = {{..}, {..}}, center = {x, y}, scale = "
          "k }, "
-         "label =, walls = {{point =, normal =}, ...}, frame = n, camera = { azimuth = -60, "
+         "label =, walls = true|false|{{point =, normal =}, ...}, frame = n, camera = { "
+         "azimuth = -60, "
          "elevation = 25, projection = 'orthographic'|'perspective', fov = 30 } })",
          "Draws a DEM scene into a PNG written whole (temporary file + rename): 2D disks, or 3D "
          "shaded spheres seen by `camera` (degrees; up is against gravity). Width 1024 "
          "by default, height from the box's aspect; sizes in [16, 8192] pixels. color: grain "
          "(well-separated colours by id), speed |v|, rotation (omega), or an array with one "
          "number per grain, through the colour map with limits range (default: min and max). "
-         "show (default walls, box, colorbar): force_chains draws segments between contacting "
+         "walls (default true): the scene's walls where they are now (removed ones not), "
+         "clipped to the box: in 2D a thick line on the wall's outer side, in 3D the outline of "
+         "the wall's section of the box, drawn with the box's edges behind the grains; false: "
+         "none; an array: those walls instead. "
+         "show (default box, colorbar): force_chains draws segments between contacting "
          "centres, width and shade proportional to the normal force; rotation a radius line at "
-         "each grain's angle (integrated from omega between frames); walls the walls given in "
-         "opts.walls; displacement arrows of the displacement since s:set_reference() less the "
+         "each grain's angle (integrated from omega between frames); displacement arrows of the displacement since s:set_reference() less the "
          "affine field affine . (X_ref - center) (Padbidri Figs. 2.6-2.7), k scene metres per "
          "metre (default: longest arrow three mean radii) with a reference arrow; colorbar a bar with ticks and `label`. stamp = true writes the scene time. "
          "A file name with a frame number ('out/frame_%05d.png'; %% for a percent sign) takes "

@@ -193,15 +193,96 @@ static int clip_line(const double p[2], const double t[2], const double lo[2], c
     return 1;
 }
 
+/* The section of the box by the plane through p with normal n: its corners in order around
+ * the polygon (at most 6; 2 when the plane only touches an edge). Returns their number. */
+static int box_section(const double lo[3], const double hi[3], const double p[3], const double n[3],
+                       double poly[6][3])
+{
+    double nn = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]), diag = 0, c[8][3], dist[8];
+    if (!(nn > 0))
+        return 0;
+    for (int d = 0; d < 3; d++)
+        diag += (hi[d] - lo[d]) * (hi[d] - lo[d]);
+    double tol = 1e-9 * sqrt(diag);
+    for (int k = 0; k < 8; k++) {
+        dist[k] = 0;
+        for (int d = 0; d < 3; d++) {
+            c[k][d] = (k >> d) & 1 ? hi[d] : lo[d];
+            dist[k] += (c[k][d] - p[d]) * n[d] / nn;
+        }
+    }
+    double pts[12 + 8][3];
+    int m = 0;
+    for (int k = 0; k < 8; k++) /* corners on the plane (a wall on a face of the box) */
+        if (fabs(dist[k]) <= tol)
+            memcpy(pts[m++], c[k], sizeof c[k]);
+    for (int a = 0; a < 8; a++) /* edges crossing it */
+        for (int bit = 1; bit < 8; bit <<= 1) {
+            int b = a | bit;
+            if (b == a || fabs(dist[a]) <= tol || fabs(dist[b]) <= tol ||
+                (dist[a] > 0) == (dist[b] > 0))
+                continue;
+            double t = dist[a] / (dist[a] - dist[b]);
+            for (int d = 0; d < 3; d++)
+                pts[m][d] = c[a][d] + t * (c[b][d] - c[a][d]);
+            m++;
+        }
+    if (m < 2)
+        return 0;
+    /* order around the centroid, by angle in a basis (u, v) of the plane */
+    double ctr[3] = {0, 0, 0}, u[3], v[3], un[3] = {n[0] / nn, n[1] / nn, n[2] / nn};
+    for (int k = 0; k < m; k++)
+        for (int d = 0; d < 3; d++)
+            ctr[d] += pts[k][d] / m;
+    int least = fabs(un[0]) <= fabs(un[1]) && fabs(un[0]) <= fabs(un[2]) ? 0
+                : fabs(un[1]) <= fabs(un[2])                             ? 1
+                                                                         : 2;
+    double e[3] = {0, 0, 0};
+    e[least] = 1;
+    cross(un, e, u);
+    normalize(u);
+    cross(un, u, v);
+    double ang[20];
+    for (int k = 0; k < m; k++) {
+        double x = 0, y = 0;
+        for (int d = 0; d < 3; d++) {
+            x += (pts[k][d] - ctr[d]) * u[d];
+            y += (pts[k][d] - ctr[d]) * v[d];
+        }
+        ang[k] = atan2(y, x);
+    }
+    for (int i = 1; i < m; i++) /* insertion sort: at most 6 distinct points */
+        for (int j = i; j > 0 && ang[j] < ang[j - 1]; j--) {
+            double t = ang[j];
+            ang[j] = ang[j - 1];
+            ang[j - 1] = t;
+            double q[3];
+            memcpy(q, pts[j], sizeof q);
+            memcpy(pts[j], pts[j - 1], sizeof q);
+            memcpy(pts[j - 1], q, sizeof q);
+        }
+    int out = 0;
+    for (int k = 0; k < m && out < 6; k++) {
+        double d2 = 0;
+        if (out)
+            for (int d = 0; d < 3; d++)
+                d2 += (pts[k][d] - poly[out - 1][d]) * (pts[k][d] - poly[out - 1][d]);
+        if (!out || d2 > tol * tol)
+            memcpy(poly[out++], pts[k], sizeof pts[k]);
+    }
+    return out;
+}
+
 core_status render_dem(render_context *rc, dem_scene *s, const render_grains_def *def,
                        render_image *out, render_view *view, core_error *err)
 {
     out->rgba = NULL;
     out->width = out->height = 0;
     const int D = dem_dim(s);
-    if (D == 3 && (def->force_chains || def->rotation || def->nwalls || def->arrows[0]))
-        return core_fail(err, CORE_ERR_ARG, "force chains, rotation markers, arrows and walls "
-                                            "are drawn in 2D scenes only");
+    if (D == 3 && (def->force_chains || def->rotation || def->arrows[0]))
+        return core_fail(err, CORE_ERR_ARG,
+                         "force chains, rotation markers and arrows are drawn "
+                         "in 2D scenes only");
     if (def->arrows[0] && (!def->arrows[1] || !(def->arrow_scale >= 0) ||
                            !isfinite(def->arrow_scale)))
         return core_fail(err, CORE_ERR_ARG, "arrows need two arrays and a scale >= 0");
@@ -378,7 +459,9 @@ core_status render_dem(render_context *rc, dem_scene *s, const render_grains_def
         return st;
     }
 
-    /* ---- 3D: the box's edges behind the spheres ---- */
+    /* ---- 3D: the box's edges and the walls' outlines behind the spheres ---- */
+    rgba8 wall_c = rgba(60, 60, 60, 255);
+    double ww = fmax(2, lround(0.25 * fs));
     if (D == 3 && def->box) {
         rgba8 bc = rgba(170, 170, 170, 255);
         for (int a = 0; a < 8; a++)
@@ -386,6 +469,24 @@ core_status render_dem(render_context *rc, dem_scene *s, const render_grains_def
                 if (!(a & bit))
                     canvas_segment(rc, PX(box2[a][0]), PY(box2[a][1]), PX(box2[a | bit][0]),
                                    PY(box2[a | bit][1]), 1, 1, bc);
+    }
+    if (D == 3 && def->nwalls) {
+        camera3 cam;
+        camera_setup(&def->camera, box_lo, box_hi, g, &cam);
+        for (int k = 0; k < def->nwalls; k++) {
+            double poly[6][3], P[6][2], R, depth;
+            int nv = box_section(box_lo, box_hi, def->walls[k].point, def->walls[k].normal, poly);
+            int seen = 1;
+            for (int i = 0; i < nv; i++)
+                seen &= project(&cam, poly[i], 0, &P[i][0], &P[i][1], &R, &depth);
+            for (int i = 0; seen && i < nv && nv >= 2; i++) {
+                int j = (i + 1) % nv;
+                if (nv == 2 && i == 1)
+                    break;
+                canvas_segment(rc, PX(P[i][0]), PY(P[i][1]), PX(P[j][0]), PY(P[j][1]), 0.5 * ww, 1,
+                               wall_c);
+            }
+        }
     }
 
     /* ---- grains ---- */
@@ -472,9 +573,7 @@ core_status render_dem(render_context *rc, dem_scene *s, const render_grains_def
     }
 
     /* ---- walls and box ---- */
-    rgba8 wall_c = rgba(60, 60, 60, 255);
-    double ww = fmax(2, lround(0.25 * fs));
-    for (int k = 0; k < def->nwalls; k++) {
+    for (int k = 0; D == 2 && k < def->nwalls; k++) {
         const render_wall *wl = &def->walls[k];
         double nn = hypot(wl->normal[0], wl->normal[1]);
         if (!(nn > 0))

@@ -66,7 +66,8 @@ typedef enum render_color_by {
 } render_color_by;
 
 typedef struct render_wall {
-    double point[2], normal[2]; /* a line through point, normal into the domain */
+    double point[3], normal[3]; /* a line (2D, z ignored) or plane through point, normal into
+                                 * the domain */
 } render_wall;
 
 /* 3D scenes: the camera looks at the box's centre from the direction given by azimuth (degrees,
@@ -96,7 +97,9 @@ typedef struct render_grains_def {
                                  * from its centre; NULL: none */
     double arrow_scale;         /* arrow length per unit of vector; 0: the longest arrow is three
                                  * mean radii. A reference arrow is drawn in the title band. */
-    const render_wall *walls;   /* 2D: drawn as thick lines on their outer side */
+    const render_wall *walls;   /* clipped to the box. 2D: thick lines on their outer side;
+                                 * 3D: the outline of the plane's section of the box, with the
+                                 * box's edges behind the grains (no depth test) */
     int nwalls;
     const char *title;          /* UTF-8 or NULL, top left */
     const char *stamp;          /* UTF-8 or NULL, top right (e.g. "t = 0.125 s") */
@@ -115,7 +118,7 @@ typedef struct render_view {
 } render_view;
 
 /* Draws a scene: 2D disks, or 3D shaded spheres far to near (force chains, rotation markers and
- * walls are 2D only). Fails (CORE_ERR_ARG) on a bad size, camera or missing arrays. */
+ * arrows are 2D only). Fails (CORE_ERR_ARG) on a bad size, camera or missing arrays. */
 core_status render_dem(render_context *rc, dem_scene *s, const render_grains_def *def,
                        render_image *out, render_view *view, core_error *err);
 

@@ -233,8 +233,38 @@ static void test_completion_and_help(void **state)
     assert_true(expect(&s, "Reports a scenario's figures"));
     enter(&s, "help()");
     assert_true(expect(&s, "Modules:"));
+    enter(&s, "help(grainlab.pack.deposit)"); /* Lua-side functions answer help directly */
+    assert_true(expect(&s, "gravity deposition"));
     enter(&s, "help('grainlab.rng')");
     assert_true(expect(&s, "grainlab.rng{ seed = 0, stream = 0 }"));
+    assert_int_equal(finish(&s), 0);
+}
+
+/* Expression results that are tables print readably (grainlab.pretty); print(t) is unchanged. */
+static void test_table_results(void **state)
+{
+    (void)state;
+    session s;
+    start(&s);
+    enter(&s, "t = {3, 0.5, 'x', name = 'q', inner = {k = 1/0}}");
+    enter(&s, "t");
+    assert_true(expect(&s, "{3, 0.5, \"x\", inner = {k = inf}, name = \"q\"}"));
+    enter(&s, "t.inner, 7, 'plain'"); /* several results: tab-separated, strings as print */
+    assert_true(expect(&s, "{k = inf}\t7\tplain"));
+    enter(&s, "long = {} for i = 1, 2000 do long[i] = i end");
+    enter(&s, "long");
+    assert_true(expect(&s, "{1, 2, 3, 4, 5, 6, 7, 8, 9, 10, …(1990 more)}"));
+    enter(&s, "c = {} c.me = c");
+    enter(&s, "c");
+    assert_true(expect(&s, "{me = <cycle>}"));
+    enter(&s, "print(c == c.me and tostring(c):match('^table: ') and 'print unchanged')");
+    assert_true(expect(&s, "print unchanged"));
+    enter(&s, "s = dem.scene{ dim = 2, box = {{0, 0}, {0.1, 0.1}} }");
+    enter(&s, "s:info()");
+    assert_true(expect(&s, "box = {{0.0, 0.0}, {0.1, 0.1}},"));
+    assert_true(expect(&s, "dim = 2,"));
+    enter(&s, "s"); /* userdata keep their __tostring */
+    assert_true(expect(&s, "dem.scene"));
     assert_int_equal(finish(&s), 0);
 }
 
@@ -277,7 +307,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_expressions_and_multiline), cmocka_unit_test(test_error_recovery),
         cmocka_unit_test(test_ctrl_c), cmocka_unit_test(test_completion_and_help),
-        cmocka_unit_test(test_history_persists),
+        cmocka_unit_test(test_table_results), cmocka_unit_test(test_history_persists),
     };
     int failed = cmocka_run_group_tests(tests, NULL, NULL);
     char cmd[128];

@@ -121,7 +121,7 @@ check.errors(function() s:contact{ normal = 3 } end,
   "bad field 'normal' in argument #1 to 'contact' (one of 'linear', 'power', 'hertz' expected, got 3)", "law not a string")
 check.errors(function() s:run{ steps = 1, integrator = "verlet" } end,
   "bad field 'integrator' in argument #1 to 'run' (one of 'velocity_verlet', 'position_verlet', 'gear', 'two_timescales' expected, got 'verlet')", "unknown integrator")
-check.errors(function() s:measure("energie") end, "bad argument #1 to 'measure' (invalid option 'energie')", "unknown measurement")
+check.errors(function() s:measure("energie") end, "bad argument #1 to 'measure' (invalid option 'energie'; did you mean 'energy'? Valid options: 'energy', 'stress',", "unknown measurement")
 
 -- friction < 0, restitution outside (0, 1]
 check.errors(function() grainlab.material{ density = 2650, young = 1e9, friction = -0.1 } end,

@@ -89,7 +89,7 @@ w:wall{ side = "bottom", amplitude = 0.001, frequency = 50 }
 w:wall{ side = "top", kind = "diffuse", temperature = 1e-6 }
 
 -- measurements
-check.errors(function() s:measure("pressure") end, "bad argument #1 to 'measure' (invalid option 'pressure')", "unknown measurement")
+check.errors(function() s:measure("pressure") end, "bad argument #1 to 'measure' (invalid option 'pressure'; valid options: 'temperature', 'a2',", "unknown measurement")
 check.errors(function() s:measure("histogram", { bins = 0 }) end,
   "bad field 'bins' in argument #2 to 'measure' (integer in [1, 100000] expected, got 0)", "zero bins")
 check.errors(function() s:measure("profile", { axis = 3 }) end,

@@ -59,7 +59,7 @@ do
     "bad field 'separation' in argument #1 to 'contact' (number in [0, 1] expected, got 1.5)", "separation above 1")
   check.errors(function() p:contact{ model = "friction", mu = 0.3, normals = "mine" } end,
     "bad field 'normals' in argument #1 to 'contact' (one of 'averaged', 'own', 'linear' expected, got 'mine')", "unknown normals")
-  check.errors(function() p:field("temperature") end, "bad argument #1 to 'field' (invalid option 'temperature')", "unknown field")
+  check.errors(function() p:field("temperature") end, "bad argument #1 to 'field' (invalid option 'temperature'; valid options: 'vx', 'vy',", "unknown field")
   check.errors(function() p:add_disk{ center = { 0.95, 0.5 }, radius = 0.2, material = mpm.material{ density = 1, shear = 1, bulk = 1 } } end,
     "outside the grid", "disk across the edge without clip")
   local c = p:add_disk{ center = { 0.95, 0.5 }, radius = 0.2, clip = true, material = mpm.material{ density = 1, shear = 1, bulk = 1 } }
@@ -124,7 +124,7 @@ check.errors(function() m:run{ steps = 1, cfl = 1.5 } end,
 check.errors(function() m:run{ steps = 1, time = 1 } end, "bad field 'time' in argument #1 to 'run' (nothing when 'steps' is given (give one) expected, got 1)", "steps and time")
 check.errors(function() m:run{ stpes = 1 } end, "bad argument #1 to 'run' (unknown field 'stpes'", "typo in run")
 check.errors(function() m:grain(2) end, "bad argument #1 to 'grain' (grain id in [1, 1] expected, got 2)", "unknown grain")
-check.errors(function() m:measure("stress") end, "bad argument #1 to 'measure' (invalid option 'stress')", "unknown measure")
+check.errors(function() m:measure("stress") end, "bad argument #1 to 'measure' (invalid option 'stress'; valid options: 'energy', 'momentum', 'columns', 'shear')", "unknown measure")
 
 -- a point leaving the grid names the step and the grain
 local open = mpm.scene{ cells = { 10, 10 }, size = { 1, 1 }, walls = "none" }

@@ -118,7 +118,7 @@ check.errors(function() render.png(s, out, { show = "displacement", displacement
 local s3 = dem.scene{ dim = 3, box = { { 0, 0, 0 }, { 1, 1, 1 } } }
 s3:add_sphere{ pos = { 0.5, 0.5, 0.5 }, radius = 0.2 }
 check.errors(function() render.png(s3, out, { show = "force_chains" }) end,
-  "png: force chains, rotation markers, arrows and walls are drawn in 2D scenes only", "chains in 3D")
+  "png: force chains, rotation markers and arrows are drawn in 2D scenes only", "chains in 3D")
 check.errors(function() render.png(s3, out, { camera = { fov = 120 } }) end,
   "bad field 'camera.fov' in argument #3 to 'png' (number in (0, 90) expected, got 120)", "camera fov")
 check.errors(function() render.png(s3, out, { camera = { projection = "fisheye" } }) end,
@@ -216,6 +216,60 @@ do
     if hit then rows = rows + 1 end
   end
   check.ge(rows, 55, "the scene's wall at x = 0.035 is drawn without opts.walls")
+end
+
+-- ---- the scene's walls: by default whatever `show` says, where they are now, removed ones not ---
+do
+  local sw = dem.scene{ dim = 2, box = { { 0, 0 }, { 0.1, 0.1 } }, gravity = { 0, 0 } }
+  sw:add_disk{ pos = { 0.02, 0.02 }, radius = 0.005 }
+  local moving = sw:add_wall{ point = { 0.08, 0 }, normal = { -1, 0 } }
+  local removed = sw:add_wall{ point = { 0, 0.06 }, normal = { 0, -1 } }
+  sw:remove_wall(removed)
+  sw:wall_velocity(moving, { -0.1, 0 })
+  sw:run{ time = 0.2, progress = false } -- the wall moves from x = 0.08 to 0.06
+  check.near_abs(sw:wall_point(moving)[1], 0.06, 1e-6, "the wall moved")
+  local function image(opts)
+    opts.width, opts.height = 400, 400
+    return render.image(sw, opts)
+  end
+  local function darkest(im, y)
+    local best, at = 256, nil
+    for x = 1, 400 do local r = im:pixel(x, y); if r < best then best, at = r, x end end
+    return best, at
+  end
+  -- the box's outline (walls off) gives the frame: first and last grey column and row
+  local frame = image{ show = { "box" }, walls = false }
+  local left, right, top, bottom = 400, 1, 400, 1
+  for i = 1, 400 do
+    if frame:pixel(i, 200) < 250 then left, right = math.min(left, i), math.max(right, i) end
+    if frame:pixel(200, i) < 250 then top, bottom = math.min(top, i), math.max(bottom, i) end
+  end
+  check.gt(right - left, 300, "box found")
+  local plain = image{ show = { "force_chains" } } -- no 'walls' in show: walls still drawn
+  local off = image{ show = { "force_chains" }, walls = false }
+  local v, x = darkest(plain, 200)
+  check.lt(v, 120, "walls drawn by default, whatever show lists")
+  check.eq((darkest(off, 200)), 255, "walls = false: no wall")
+  check.near_abs((x - left) / (right - left), 0.6, 0.02, "the moving wall drawn where it is now (x = 0.06)")
+  -- the removed wall (y = 0.06) leaves its rows clean
+  local row = math.floor(top + 0.4 * (bottom - top))
+  local clean = true
+  for yy = row - 4, row + 4 do
+    for xx = left + 60, left + 200 do if plain:pixel(xx, yy) < 250 then clean = false end end
+  end
+  check.is_true(clean, "a removed wall is not drawn")
+  check.errors(function() image{ walls = 1 } end,
+    "bad field 'walls' in argument #2 to 'image' (false, true or an array of", "walls type")
+
+  -- 3D: the walls' outlines are drawn by default, not with walls = false
+  local s3w = dem.scene{ dim = 3, box = { { 0, 0, 0 }, { 1, 1, 1 } }, gravity = { 0, 0, -9.81 } }
+  s3w:add_sphere{ pos = { 0.5, 0.5, 0.5 }, radius = 0.1 }
+  s3w:add_wall{ point = { 0, 0, 0.25 }, normal = { 0, 0, 1 } }
+  local a = render.image(s3w, { width = 200, height = 200, show = {} })
+  local b = render.image(s3w, { width = 200, height = 200, show = {}, walls = false })
+  local diff = 0
+  for yy = 1, 200 do for xx = 1, 200 do if a:pixel(xx, yy) ~= b:pixel(xx, yy) then diff = diff + 1 end end end
+  check.gt(diff, 200, "3D: the floor wall's outline is drawn")
 end
 -- ---- grid fields and point clouds on plain arrays (MPM, DSMC) ----------------------------------
 do

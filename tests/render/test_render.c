@@ -338,6 +338,87 @@ static void test_sphere_shading(void **state)
     }
 }
 
+/* Walls: in 2D a thick dark line on the outer side of the wall, the inner side clean; in 3D the
+ * outline of the plane's section of the box (seen edge-on here: the camera looks along +y, so a
+ * plane x = c or z = c is a line on the image); a plane that misses the box draws nothing. */
+static int dark_gray(const unsigned char *c)
+{
+    return c[0] < 200 && abs(c[0] - c[1]) < 8 && abs(c[1] - c[2]) < 8;
+}
+
+static void test_walls(void **state)
+{
+    (void)state;
+    core_error err;
+    render_view view;
+    render_image img, none;
+    /* 2D: a wall at x = 0.75 facing -x (the domain is on its left) */
+    dem_scene *s = one_disk(0.1, 2);
+    render_grains_def def = render_default_grains_def();
+    def.width = def.height = 400;
+    def.box = false;
+    render_wall w2[2] = {{.point = {0.75, 0, 0}, .normal = {-1, 0, 0}},
+                         {.point = {2, 0, 0}, .normal = {1, 0, 0}}}; /* outside the box */
+    def.walls = w2;
+    def.nwalls = 2;
+    assert_int_equal(render_dem(rc, s, &def, &img, &view, &err), CORE_OK);
+    double X = view.origin[0] + 0.75 * view.scale;
+    int ymid = (int)(view.origin[1] + 0.5 * view.scale);
+    int dark = 0;
+    for (int x = (int)X; x <= (int)X + 3; x++)
+        dark += dark_gray(px(&img, x, ymid));
+    if (dark < 2)
+        fail_msg("2D wall at column %.1f: only %d dark pixels beside it", X, dark);
+    const unsigned char *inner = px(&img, (int)X - 3, ymid);
+    near_rgb(inner, 255, 255, 255, 0, "inner side of the 2D wall");
+    def.nwalls = 1; /* the wall outside the box adds nothing */
+    assert_int_equal(render_dem(rc, s, &def, &none, NULL, &err), CORE_OK);
+    assert_memory_equal(img.rgba, none.rgba, (size_t)img.width * img.height * 4);
+    render_image_free(&none);
+    def.nwalls = 0;
+    assert_int_equal(render_dem(rc, s, &def, &none, NULL, &err), CORE_OK);
+    near_rgb(px(&none, (int)X + 1, ymid), 255, 255, 255, 0, "no walls: nothing at the wall");
+    render_image_free(&none);
+    render_image_free(&img);
+    dem_destroy(s);
+
+    /* 3D, orthographic, looking along +y: image x = world x, image y = world z */
+    s = one_disk(0.1, 3);
+    def = render_default_grains_def();
+    def.width = def.height = 400;
+    def.box = false;
+    def.camera.azimuth = -90;
+    def.camera.elevation = 0;
+    render_wall w3[3] = {{.point = {0.75, 0, 0}, .normal = {-1, 0, 0}},
+                         {.point = {0, 0, 0.25}, .normal = {0, 0, 1}},
+                         {.point = {0, 0, 5}, .normal = {0, 0, -1}}};
+    def.walls = w3;
+    def.nwalls = 3;
+    assert_int_equal(render_dem(rc, s, &def, &img, &view, &err), CORE_OK);
+    def.nwalls = 0;
+    assert_int_equal(render_dem(rc, s, &def, &none, NULL, &err), CORE_OK);
+    int cx = (int)(view.origin[0] + 0.75 * view.scale),
+        cy = (int)(view.origin[1] + 0.5 * view.scale);
+    int hx = (int)(view.origin[0] + 0.5 * view.scale),
+        hy = (int)(view.origin[1] + 0.75 * view.scale);
+    dark = 0;
+    for (int k = -1; k <= 1; k++)
+        dark += dark_gray(px(&img, cx + k, cy)) + dark_gray(px(&img, hx, hy + k));
+    if (dark < 2)
+        fail_msg("3D walls x = 0.75 and z = 0.25: %d dark pixels at (%d, %d) and (%d, %d)", dark,
+                 cx, cy, hx, hy);
+    near_rgb(px(&none, cx, cy), 255, 255, 255, 0, "3D without walls");
+    near_rgb(px(&none, hx, hy), 255, 255, 255, 0, "3D without walls");
+    long changed = 0;
+    for (size_t i = 0; i < (size_t)img.width * img.height * 4; i++)
+        changed += img.rgba[i] != none.rgba[i];
+    if (changed < 400) /* two lines across the box, each some 300 px long */
+        fail_msg("3D walls changed only %ld channel values", changed);
+    render_image_free(&none);
+    render_image_free(&img);
+    dem_destroy(s);
+}
+
 static void test_errors(void **state)
 {
     (void)state;
@@ -666,12 +747,13 @@ static void test_field_errors(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_disk_area), cmocka_unit_test(test_colormaps),
-        cmocka_unit_test(test_plot_axes), cmocka_unit_test(test_identical),
-        cmocka_unit_test(test_text),      cmocka_unit_test(test_sphere_shading),
-        cmocka_unit_test(test_errors),    cmocka_unit_test(test_field_cells),
-        cmocka_unit_test(test_field_arrows), cmocka_unit_test(test_points),
-        cmocka_unit_test(test_field_identical), cmocka_unit_test(test_field_errors),
+        cmocka_unit_test(test_disk_area),    cmocka_unit_test(test_colormaps),
+        cmocka_unit_test(test_plot_axes),    cmocka_unit_test(test_identical),
+        cmocka_unit_test(test_text),         cmocka_unit_test(test_sphere_shading),
+        cmocka_unit_test(test_errors),       cmocka_unit_test(test_field_cells),
+        cmocka_unit_test(test_walls),        cmocka_unit_test(test_field_arrows),
+        cmocka_unit_test(test_points),       cmocka_unit_test(test_field_identical),
+        cmocka_unit_test(test_field_errors),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
