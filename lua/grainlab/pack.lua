@@ -53,7 +53,6 @@ local SPECS = {
            seed = { "integer", min = 0 }, width = { "range", lo = 1, hi = 1e6, open_lo = true },
            margin = { "nonneg" } },
 }
-pack.specs = SPECS
 
 local function positive_int(call, opts, field, default)
   local v = opts[field]

@@ -24,6 +24,16 @@ void bind_doc(lua_State *L, int idx, const char *name, const char *usage, const 
     push_docs(L);
     lua_pushvalue(L, idx);
     lua_createtable(L, 0, 3);
+    /* A later doc for the same object (a richer text) keeps the field lists recorded with its
+     * registration: they belong to the function's checks, not to its prose. */
+    lua_pushvalue(L, idx);
+    if (lua_rawget(L, -4) == LUA_TTABLE) {
+        lua_getfield(L, -1, "fields");
+        lua_setfield(L, -3, "fields");
+        lua_getfield(L, -1, "modes");
+        lua_setfield(L, -3, "modes");
+    }
+    lua_pop(L, 1);
     lua_pushstring(L, name);
     lua_setfield(L, -2, "name");
     lua_pushstring(L, usage ? usage : name);

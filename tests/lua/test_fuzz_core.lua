@@ -10,6 +10,9 @@ local OPT = { "nil" }
 local TEXT = { "nil", "string" }
 local ALL = {}
 for _, c in ipairs(fuzz.scalar) do ALL[#ALL + 1] = c[1] end
+-- any value at all, including the array-derived classes (pretty prints whatever it is given)
+local ANY = { "short", "long", "entry_nan", "entry_inf", "entry_huge", "entry_string", "entry_table" }
+for _, c in ipairs(ALL) do ANY[#ANY + 1] = c end
 local function self(ctx) return ctx end
 
 local function scene()
@@ -91,6 +94,9 @@ local calls = {
     accept = { size = {}, n = OPT, diameter = OPT, seed = { "nil", "zero" }, width = OPT,
                margin = { "nil", "zero" } },
   },
+  ["grainlab.pretty"] = { args = function() return { { 1, 2 }, { depth = 2 } } end,
+    pos = { ANY, { "nil", "empty" } } },
+  ["grainlab.show"] = { args = function() return { 1 } end, pos = { ALL } },
   ["grainlab.rng:uniform"] = {
     setup = function() return grainlab.rng{ seed = 1 } end, self = self,
     args = function() return { 0, 1 } end, pos = { { "nil", "zero", "negative" }, { "nil", "zero" } },

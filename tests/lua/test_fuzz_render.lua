@@ -26,7 +26,7 @@ local function scene_opts()
 end
 local scene_accept = { width = OPT, height = OPT, color = OPT, colormap = OPT, range = OPT,
   show = { "nil", "empty", "short", "long" }, title = TEXT, stamp = { "nil", "boolean", "string" }, label = TEXT,
-  walls = { "nil", "empty", "short", "long" }, frame = { "nil", "zero" }, camera = { "nil", "empty" },
+  walls = { "nil", "boolean", "empty", "short", "long" }, frame = { "nil", "zero" }, camera = { "nil", "empty" },
   displacement = { "nil", "empty" } }
 
 local calls = {
