@@ -47,6 +47,11 @@ static void law_parameters(const dem_scene *s, const dem_material *a, const dem_
             *gamma = c->gamma_n;
         else /* the linear law's closed form; for other laws it sets the scale */
             *gamma = linear_gamma(*k, m_eff, fmin(a->restitution, b->restitution));
+    } else if (c->damping == DEM_DAMPING_BRILLIANTOV) {
+        /* gamma carries the damping time T. From a restitution each pair gets its own
+         * T = lambda (m_eff / K)^{2/5} v^{-1/5} (dem.h), so a head-on impact at the impact
+         * velocity rebounds with e for every pair; brill_c = lambda v^{-1/5} is set once. */
+        *gamma = c->restitution > 0 ? s->brill_c * pow(m_eff / *k, 0.4) : c->damping_time;
     }
     *mu_out = mu;
 }

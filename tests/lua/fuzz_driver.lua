@@ -20,6 +20,7 @@
 --     pos = { [i] = { "nil", ... } },              -- positional args to fuzz and what they take
 --     strings = { [i or field] = "..." },          -- the "string" class there (a file path)
 --     slow = { field = { class = "why" } },        -- an accepted class printed, not run (cost)
+--     no_opts = true,                              -- a variant without the options table
 --     todo = { field = "why" },                    -- printed, not fuzzed (a fix pending elsewhere)
 --     name = "add_disk" }                          -- the name errors use (default: the key's)
 -- An entry may be a list of such tables (one per mode).
@@ -127,7 +128,10 @@ local function fuzz_entry(key, e, fn, doc)
   else
     fields = doc and doc.fields
   end
-  if fields and not e.opts then fail(key, "the binding records fields but the entry has no opts"); return end
+  if e.no_opts then fields = nil end
+  if fields and not e.opts then
+    fail(key, "the binding records fields but the entry has no opts"); return
+  end
   if e.opts and not fields then fail(key, "the entry has opts but the binding records no fields"); return end
   -- The base call must succeed (else the cases below would test nothing).
   local before = #failures

@@ -110,8 +110,7 @@ local calls = {
     { setup = function() local s = scene2(); s:set_reference(); return s end, self = self,
       mode = "displacement", opts = 2, opts_optional = true,
       args = function() return { "displacement", { affine = { { 0, 0 }, { 0, 0 } }, center = { 0, 0 } } } end,
-      accept = { center = OPT },
-      todo = { affine = "the shape checks come with the delaunay helper's branch (i12-delaunay)" } },
+      accept = { center = OPT, affine = OPT } },
   },
   ["dem.scene:particles"] = { setup = scene2, self = self },
   ["dem.scene:set_reference"] = { setup = scene2, self = self },
@@ -124,6 +123,15 @@ local calls = {
     setup = scene2, self = self, opts = 1,
     args = function() return { { ids = { 1 }, fx = { 1 }, fy = { 0 } } } end,
     accept = { ids = {}, fx = {}, fy = {}, fz = OPT },
+  },
+  ["dem.scene:damping_time"] = {
+    { setup = function() local s = scene2(); s:add_disk{ pos = { 0.7, 0.5 }, radius = 0.01 }
+        s:contact{ damping = "brilliantov", damping_time = 1e-5 }; return s end,
+      self = self, args = function() return { 1, { wall = 1 } } end, opts = 2, pos = { ID },
+      accept = { wall = {} } },
+    { setup = function() local s = scene2(); s:add_disk{ pos = { 0.7, 0.5 }, radius = 0.01 }
+        s:contact{ damping = "brilliantov", damping_time = 1e-5 }; return s end,
+      self = self, args = function() return { 1, 2 } end, no_opts = true, pos = { ID, ID } },
   },
   ["dem.scene:quasistatic"] = {
     setup = scene2, self = self, opts = 1,
