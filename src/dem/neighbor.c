@@ -392,7 +392,8 @@ core_status dem_build_pairs(dem_scene *s, core_error *err)
             dem_free_pairs(&old);
             return core_fail(err, CORE_ERR_NOMEM, "cannot allocate the incidence list");
         }
-        memcpy(fill, p->jstart, n * sizeof *fill);
+        if (n > 0)
+            memcpy(fill, p->jstart, n * sizeof *fill);
         for (size_t q = 0; q < npairs; q++)
             p->jpair[fill[p->j[q]]++] = (uint32_t)q;
         free(fill);
@@ -427,7 +428,7 @@ core_status dem_build_pairs(dem_scene *s, core_error *err)
             wl->point_build[d] = wl->point[d];
     }
 
-    for (int d = 0; d < D; d++)
+    for (int d = 0; d < D && n > 0; d++) /* an empty scene has no arrays yet (memcpy of NULL is UB) */
         memcpy(s->x_build[d], s->x[d], n * sizeof(double));
     dem_free_pairs(&old);
     s->need_rebuild = 0;
