@@ -123,6 +123,7 @@ local calls = {
 -- Not fuzzed here, each with its reason (printed).
 local skip = {
   ["grainlab.report"] = "lua/grainlab/report.lua belongs to the report helper (its entry checks are theirs)",
+  ["grainlab.recorder"] = "new in main at 21:25 (i13-recorder, its refusals in test_recorder.lua); its fields are not recorded for this test yet",
 }
 for k, why in pairs(skip) do print(k .. ": not fuzzed: " .. why) end
 
