@@ -185,17 +185,13 @@ static core_status write_scene(const dem_scene *s, ckpt_writer *w, core_error *e
     }
     for (int d = 0; d < 4; d++)
         put_opt(w, p->hist[d], p->n);
-    return end(w, err);
+    if ((st = end(w, err)))
+        return st;
+    return s->bnd ? dem_boundary_save(s, w, err) : CORE_OK;
 }
 
 core_status dem_save(const dem_scene *s, const char *path, const char *version, core_error *err)
 {
-    if (s->bnd)
-        return core_fail(err, CORE_ERR_STATE,
-                         "cannot save '%s': the scene has boundary conditions (boundary edges, "
-                         "the minimal-boundary penalty, springs, ties or spins), which "
-                         "checkpoints do not store yet",
-                         path);
     ckpt_writer *w;
     core_status st = ckpt_writer_open(&w, path, "dem", version, err);
     if (st)
@@ -453,14 +449,13 @@ static void read_all(reader *r, ckpt_reader *ck, dem_scene **out)
     s->force_evals = (long)i64(r);
     s->last_integrator = (int)i64(r);
     s->tt_phase = (long)i64(r);
-    s->gear_ready = (int)u32(r);
-    s->prev_ready = (int)u32(r);
-    s->forces_ready = (int)u32(r);
+    /* set at the end: restoring the boundary goes through calls that reset them */
+    const int gear_ready = (int)u32(r), prev_ready = (int)u32(r), forces_ready = (int)u32(r);
     s->suspect = (int)u32(r);
-    s->need_rebuild = (int)u32(r);
+    const int need_rebuild = (int)u32(r);
     s->gear_dt = f64(r);
     s->prev_dt = f64(r);
-    s->watch_on = (int)u32(r);
+    const int watch_on = (int)u32(r);
     s->watch_next = (long)i64(r);
     s->watch_min_step = (long)i64(r);
     s->watch_min = f64(r);
@@ -605,6 +600,16 @@ static void read_all(reader *r, ckpt_reader *ck, dem_scene **out)
     open_section(r, ck, "pairs");
     read_pairs(r, s);
     close_section(r);
+    if (!r->st && ckpt_has(ck, "boundary")) {
+        open_section(r, ck, "boundary");
+        if (!r->st)
+            r->st = dem_boundary_load(s, &r->sec, r->err);
+    }
+    s->gear_ready = gear_ready;
+    s->prev_ready = prev_ready;
+    s->forces_ready = forces_ready;
+    s->need_rebuild = need_rebuild;
+    s->watch_on = watch_on;
     if (!r->st)
         r->st = ckpt_reader_finish(ck, r->err);
 }
