@@ -86,6 +86,33 @@ for _, integ in ipairs(C.integrators) do
   end
 end
 
+-- ---- a removed wall stays removed (ids stable); an empty scene ------------------------------
+do
+  local function go(s, steps, remove)
+    C.run(s, "velocity_verlet", steps)
+    if remove then s:remove_wall(2) end
+  end
+  local a = C.build(2)
+  go(a, 200, true)
+  go(a, 400)
+  local b = C.build(2)
+  go(b, 200, true)
+  go(b, 200)
+  b:save(path("removed.ckpt"))
+  local c = dem.load(path("removed.ckpt"))
+  go(c, 200)
+  local function dump(s) -- wall 2 has no point any more
+    local t = {}
+    for l in C.dump(s, 1):gmatch("[^\n]+") do t[#t + 1] = l end
+    return table.concat(t, "\n")
+  end
+  same_bits(dump(a), dump(c), "a removed wall")
+  check.errors(function() c:wall_point(2) end, "no wall 2", "the removed wall is still removed")
+  local e = dem.scene{ dim = 3, box = { { 0, 0, 0 }, { 1, 1, 1 } } }
+  e:save(path("empty.ckpt"))
+  check.eq(dem.load(path("empty.ckpt")):info().count, 0, "an empty scene")
+end
+
 -- ---- s:info() and further use of a loaded scene --------------------------------------------
 do
   local s = C.build(2)
@@ -214,6 +241,14 @@ check.errors(function() dem.load(path("newer.ckpt")) end,
              "); this grainlab reads format versions up to 1", "a newer format")
 check.errors(function() dem.load() end, "bad argument #1 to 'load' (string expected, got no value)",
              "no path")
+-- a file with a valid checksum whose contents contradict themselves (Gear state marked ready in a
+-- velocity-Verlet scene: gear_ready is the uint32 at byte 276, 180 bytes into the 'scene'
+-- payload) is refused before a step could read what is not there
+check.eq(bytes:sub(65, 69), "scene", "the first section")
+check.eq(string.unpack("=I4", bytes, 277), 0, "gear_ready in the file")
+spit(path("forged.ckpt"), reseal(bytes:sub(1, 276) .. string.pack("=I4", 1) .. bytes:sub(281)))
+check.errors(function() dem.load(path("forged.ckpt")) end,
+             "is corrupt (inconsistent state: Gear state marked ready but absent)", "forged state")
 
 -- ---- failed writes ------------------------------------------------------------------------
 local function listing()
