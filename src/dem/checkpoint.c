@@ -185,17 +185,13 @@ static core_status write_scene(const dem_scene *s, ckpt_writer *w, core_error *e
     }
     for (int d = 0; d < 4; d++)
         put_opt(w, p->hist[d], p->n);
-    return end(w, err);
+    if ((st = end(w, err)))
+        return st;
+    return s->bnd ? dem_boundary_save(s, w, err) : CORE_OK;
 }
 
 core_status dem_save(const dem_scene *s, const char *path, const char *version, core_error *err)
 {
-    if (s->bnd)
-        return core_fail(err, CORE_ERR_STATE,
-                         "cannot save '%s': the scene has boundary conditions (boundary edges, "
-                         "the minimal-boundary penalty, springs, ties or spins), which "
-                         "checkpoints do not store yet",
-                         path);
     ckpt_writer *w;
     core_status st = ckpt_writer_open(&w, path, "dem", version, err);
     if (st)
@@ -418,6 +414,43 @@ static void read_pairs(reader *r, dem_scene *s)
         r->st = index_pairs(p, r->err);
 }
 
+/* A file that passed the checksum but was not written by dem_save (forged, or a bug) must not
+ * make a step read arrays that are not there: the kernels allocate their state in whole sets,
+ * and a list in use covers every particle. Returns what is wrong, or NULL. */
+static const char *inconsistent(const dem_scene *s, int gear_ready, int prev_ready,
+                                int need_rebuild)
+{
+    const int D = s->dim, d0 = D == 2 ? 2 : 0;
+    if (gear_ready && !s->gear[0][0])
+        return "Gear state marked ready but absent";
+    for (int k = 0; k < 6 && s->gear[0][0]; k++)
+        for (int d = d0; s->rot && d < 3; d++)
+            if (!s->gear_w[k][d])
+                return "Gear rotation state missing";
+    if (prev_ready && !s->x_prev[0])
+        return "position Verlet state marked ready but absent";
+    for (int w = 0; w < s->nwalls; w++)
+        for (int d = 1; d < 4; d++)
+            if ((d < D || d == 3) && !s->walls[w].hist[d] != !s->walls[w].hist[0])
+                return "incomplete wall history";
+    const dem_pairs *p = &s->pairs;
+    if (!need_rebuild) {
+        if (!p->start || p->np != s->n)
+            return "the pair list in use does not cover every particle";
+        for (int d = 0; d < 3 && p->n > 0; d++) { /* an empty list allocates nothing */
+            if (d < D && !p->f[d])
+                return "pair forces missing";
+            if (s->rot && (D == 3 || d == 2) && !p->c[d])
+                return "pair torques missing";
+            if (s->contact.tangential == DEM_TANGENT_SPRING && d < D && !p->hist[d])
+                return "contact history missing";
+        }
+        if (s->contact.tangential == DEM_TANGENT_SPRING && p->n > 0 && !p->hist[3])
+            return "contact history missing";
+    }
+    return NULL;
+}
+
 static void read_all(reader *r, ckpt_reader *ck, dem_scene **out)
 {
     dem_scene_def def = dem_default_scene_def();
@@ -453,14 +486,13 @@ static void read_all(reader *r, ckpt_reader *ck, dem_scene **out)
     s->force_evals = (long)i64(r);
     s->last_integrator = (int)i64(r);
     s->tt_phase = (long)i64(r);
-    s->gear_ready = (int)u32(r);
-    s->prev_ready = (int)u32(r);
-    s->forces_ready = (int)u32(r);
+    /* set at the end: restoring the boundary goes through calls that reset them */
+    const int gear_ready = (int)u32(r), prev_ready = (int)u32(r), forces_ready = (int)u32(r);
     s->suspect = (int)u32(r);
-    s->need_rebuild = (int)u32(r);
+    const int need_rebuild = (int)u32(r);
     s->gear_dt = f64(r);
     s->prev_dt = f64(r);
-    s->watch_on = (int)u32(r);
+    const int watch_on = (int)u32(r);
     s->watch_next = (long)i64(r);
     s->watch_min_step = (long)i64(r);
     s->watch_min = f64(r);
@@ -605,6 +637,20 @@ static void read_all(reader *r, ckpt_reader *ck, dem_scene **out)
     open_section(r, ck, "pairs");
     read_pairs(r, s);
     close_section(r);
+    if (!r->st && ckpt_has(ck, "boundary")) {
+        open_section(r, ck, "boundary");
+        if (!r->st)
+            r->st = dem_boundary_load(s, &r->sec, r->err);
+    }
+    const char *wrong = r->st ? NULL : inconsistent(s, gear_ready, prev_ready, need_rebuild);
+    if (wrong)
+        r->st = core_fail(r->err, CORE_ERR_IO, "'%s' is corrupt (inconsistent state: %s)",
+                          ckpt_reader_path(ck), wrong);
+    s->gear_ready = gear_ready;
+    s->prev_ready = prev_ready;
+    s->forces_ready = forces_ready;
+    s->need_rebuild = need_rebuild;
+    s->watch_on = watch_on;
     if (!r->st)
         r->st = ckpt_reader_finish(ck, r->err);
 }

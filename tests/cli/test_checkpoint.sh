@@ -28,6 +28,14 @@ for dim in 2 3; do
   done
 done
 
+# boundary conditions (fixed edges, pressure, penalty with its integral, springs, tie, spin)
+c="bnd=true integ=gear n=300 m=300"
+f="$tmp/bnd.ckpt"
+"$G" --quiet ckpt_dem.lua mode=full $c >"$tmp/full" || bad "boundary full run"
+"$G" --quiet ckpt_dem.lua mode=save $c file="$f" || bad "boundary save"
+"$G" --quiet ckpt_dem.lua mode=load $c file="$f" >"$tmp/load" || bad "boundary load"
+cmp -s "$tmp/full" "$tmp/load" && ok || bad "boundary: N + M differs from N, save, load in a new process, M"
+
 # saved from on_step, continued in a new process
 f="$tmp/onstep.ckpt"
 "$G" --quiet ckpt_dem.lua mode=onstep dim=2 integ=gear n=300 m=300 file="$f" >"$tmp/onstep" || bad "onstep run"

@@ -61,6 +61,30 @@ function M.build(dim)
   return s
 end
 
+-- The 2D scene with boundary conditions: pressure on the closed loop of the outer particles, the
+-- minimal-boundary penalty with its integral term, springs along the top row, the bottom-left
+-- particle tied to the moving wall, one prescribed spin.
+function M.build_boundary()
+  local s = M.build(2)
+  local loop = {}
+  for a = 0, 6 do loop[#loop + 1] = a * 7 + 1 end          -- bottom, left to right
+  for b = 1, 6 do loop[#loop + 1] = 6 * 7 + b + 1 end      -- right, upwards
+  for a = 5, 0, -1 do loop[#loop + 1] = a * 7 + 7 end      -- top, right to left
+  for b = 5, 1, -1 do loop[#loop + 1] = b + 1 end          -- left, downwards
+  local ea, eb = {}, {}
+  for k = 1, #loop do ea[k], eb[k] = loop[k], loop[k % #loop + 1] end
+  s:boundary{ mode = "edges", edges = { a = ea, b = eb }, closed = true, pressure = 20,
+              depth = 0.002,
+              mbc = { strain_rate = { { -1, 0 }, { 0, 1 } }, rate = 1, kappa = 1, dt = M.dt[2],
+                      tau = 50 * M.dt[2] } }
+  local si, sj = {}, {}
+  for a = 0, 5 do si[#si + 1], sj[#sj + 1] = a * 7 + 7, (a + 1) * 7 + 7 end
+  s:springs{ i = si, j = sj, k = 5 }
+  s:tie{ ids = { 1 }, wall = 2, axis = 1 }
+  s:spin{ id = 25, omega = 5 }
+  return s
+end
+
 function M.run(s, integrator, steps, every, on_step)
   local dt = M.dt[s:info().dim] / (integrator == "two_timescales" and 2 or 1)
   return s:run{ steps = steps, dt = dt, integrator = integrator, m = 2, n = 2,

@@ -1,7 +1,8 @@
 -- DEM checkpoints (s:save, dem.load): run N + M steps, or N, save, load, M: the same bits for
 -- every position, velocity, angular velocity and angle (printed with %a), in 2D and 3D with each
 -- integrator, friction with spring history, a moving and a servo wall, Brilliantov damping
--- (ckpt_dem_case.lua); saved with 1 thread and loaded with 2 on a scene large enough for the
+-- (ckpt_dem_case.lua), and with boundary conditions (fixed edges, pressure, the minimal-boundary
+-- penalty, springs, ties, spins); saved with 1 thread and loaded with 2 on a scene large enough for the
 -- threads to work; saved from on_step; s:info() survives; bad files and failed writes give
 -- clear errors and leave nothing behind. The same in separate processes: tests/cli.
 local check = grainlab.check
@@ -59,6 +60,57 @@ for _, dim in ipairs({ 2, 3 }) do
     for k = 1, #co.i do if co.ft[k] > 0 then sliding = sliding + 1 end end
     check.gt(sliding, 10, what .. ": contacts with a tangential spring force")
   end
+end
+
+-- ---- boundary conditions: pressure loop, minimal-boundary penalty and its integral, springs,
+-- a tie, a spin (ckpt_dem_case.lua) ------------------------------------------------------------
+for _, integ in ipairs(C.integrators) do
+  local what = "boundary, " .. integ
+  local a = C.build_boundary()
+  C.run(a, integ, N + M)
+  local b = C.build_boundary()
+  C.run(b, integ, N)
+  b:save(path("bnd.ckpt"))
+  local c = dem.load(path("bnd.ckpt"))
+  C.run(c, integ, M)
+  same_bits(C.dump(a), C.dump(c), what .. ": N + M against N, save, load, M")
+  local x, y = a:boundary_info(), c:boundary_info()
+  check.eq(y.edges, 24, what .. ": edges")
+  check.eq(y.springs, 6, what .. ": springs")
+  check.eq(y.ties, 1, what .. ": ties")
+  check.gt(y.penalty_max, 0, what .. ": the penalty acts")
+  for k, v in pairs(x) do
+    if k ~= "apply_seconds" and k ~= "update_seconds" then -- CPU times
+      check.eq(deep(v), deep(y[k]), what .. ": boundary_info." .. k)
+    end
+  end
+end
+
+-- ---- a removed wall stays removed (ids stable); an empty scene ------------------------------
+do
+  local function go(s, steps, remove)
+    C.run(s, "velocity_verlet", steps)
+    if remove then s:remove_wall(2) end
+  end
+  local a = C.build(2)
+  go(a, 200, true)
+  go(a, 400)
+  local b = C.build(2)
+  go(b, 200, true)
+  go(b, 200)
+  b:save(path("removed.ckpt"))
+  local c = dem.load(path("removed.ckpt"))
+  go(c, 200)
+  local function dump(s) -- wall 2 has no point any more
+    local t = {}
+    for l in C.dump(s, 1):gmatch("[^\n]+") do t[#t + 1] = l end
+    return table.concat(t, "\n")
+  end
+  same_bits(dump(a), dump(c), "a removed wall")
+  check.errors(function() c:wall_point(2) end, "no wall 2", "the removed wall is still removed")
+  local e = dem.scene{ dim = 3, box = { { 0, 0, 0 }, { 1, 1, 1 } } }
+  e:save(path("empty.ckpt"))
+  check.eq(dem.load(path("empty.ckpt")):info().count, 0, "an empty scene")
 end
 
 -- ---- s:info() and further use of a loaded scene --------------------------------------------
@@ -189,6 +241,14 @@ check.errors(function() dem.load(path("newer.ckpt")) end,
              "); this grainlab reads format versions up to 1", "a newer format")
 check.errors(function() dem.load() end, "bad argument #1 to 'load' (string expected, got no value)",
              "no path")
+-- a file with a valid checksum whose contents contradict themselves (Gear state marked ready in a
+-- velocity-Verlet scene: gear_ready is the uint32 at byte 276, 180 bytes into the 'scene'
+-- payload) is refused before a step could read what is not there
+check.eq(bytes:sub(65, 69), "scene", "the first section")
+check.eq(string.unpack("=I4", bytes, 277), 0, "gear_ready in the file")
+spit(path("forged.ckpt"), reseal(bytes:sub(1, 276) .. string.pack("=I4", 1) .. bytes:sub(281)))
+check.errors(function() dem.load(path("forged.ckpt")) end,
+             "is corrupt (inconsistent state: Gear state marked ready but absent)", "forged state")
 
 -- ---- failed writes ------------------------------------------------------------------------
 local function listing()
@@ -209,12 +269,13 @@ do
   check.is_true(not listing():find("%.tmp%."), "no *.tmp.* files")
   check.errors(function() s:save() end, "bad argument #1 to 'save' (string expected, got no value)",
                "no path")
-  -- boundary conditions are refused by name, not saved incomplete
-  s:springs{ i = { 1 }, j = { 2 }, k = 10 }
-  check.errors(function() s:save(path("bnd.ckpt")) end,
-               "the scene has boundary conditions (boundary edges, the minimal-boundary penalty, "
-               .. "springs, ties or spins), which checkpoints do not store yet", "boundary")
-  check.is_true(io.open(path("bnd.ckpt")) == nil, "nothing written for a refused scene")
+  -- a boundary rebuilt by a Delaunay triangulation is refused by name, not saved incomplete
+  s:boundary{ mode = "delaunay", pressure = 10, depth = 0.002 }
+  check.errors(function() s:save(path("delaunay.ckpt")) end,
+               "save: the scene's boundary edges are rebuilt by a Delaunay triangulation every 250 "
+               .. "steps (s:boundary{ mode = 'delaunay' }), which checkpoints do not store yet", "delaunay")
+  check.is_true(io.open(path("delaunay.ckpt")) == nil, "nothing written for a refused scene")
+  check.eq(listing(), before, "no temporary file left after a refused save")
 end
 
 os.execute("rm -rf '" .. dir .. "'")
