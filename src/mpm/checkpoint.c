@@ -384,8 +384,9 @@ static core_status read_points(reader *rd, mpm_scene *s)
     const size_t np = s->ngrains ? s->gstart[s->ngrains - 1] + s->gcount[s->ngrains - 1] : 0;
     size_t n;
     TRY(ckpt_peek_count(&rd->sec, (size_t)INT32_MAX, &n, rd->err));
-    if (n != np)
-        return corrupt(rd, "the point count does not match the grains");
+    /* 21 arrays of doubles must fit the section before anything is allocated for them */
+    if (n != np || np > rd->sec.size / (21 * sizeof(double)))
+        return corrupt(rd, "the point count does not match the grains or the file");
     TRY(mpm_reserve_points(s, np, rd->err));
     double *a[21];
     point_arrays(s, a);

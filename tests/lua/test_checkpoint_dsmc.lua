@@ -168,6 +168,21 @@ write(bad, reseal(put(s, #s - 24 - 8, string.pack("=d", 1 / 0))))
 check.errors(function() dsmc.load(bad) end,
              "corrupt dsmc checkpoint: a particle is outside the box",
              "infinite velocity")
+-- The first and the last particle's positions swapped: no longer in cell order. The section is
+-- x, vx, y, vy as arrays of a count and n doubles, ending at the trailer.
+do
+  local n = 50
+  local function at(array, i) return #s - 24 - (4 - array) * (8 + 8 * n) + 8 + 8 * (i - 1) end
+  local t = s
+  for _, array in ipairs({ 0, 2 }) do -- x, y
+    local first = t:sub(at(array, 1) + 1, at(array, 1) + 8)
+    local last = t:sub(at(array, n) + 1, at(array, n) + 8)
+    t = put(put(t, at(array, 1), last), at(array, n), first)
+  end
+  write(bad, reseal(t))
+  check.errors(function() dsmc.load(bad) end,
+               "corrupt dsmc checkpoint: the particles are not in cell order", "out of cell order")
+end
 write(bad, reseal(s))
 check.eq(dsmc.load(bad):info().steps, 3, "a resealed copy loads")
 
