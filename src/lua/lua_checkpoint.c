@@ -6,11 +6,23 @@
 #include "dem/dem.h"
 #include "lua/bind.h"
 
+/* The file name at arg, a string: a number is refused rather than read as a file name (the
+ * generated binding test, tests/lua/fuzz_driver.lua, requires the argument to be named). */
+static const char *check_path(lua_State *L, int arg, int shown, const char *call)
+{
+    if (lua_type(L, arg) != LUA_TSTRING) {
+        char got[64];
+        bind_describe(L, arg, got, sizeof got);
+        luaL_error(L, "bad argument #%d to '%s' (string expected, got %s)", shown, call, got);
+    }
+    return lua_tostring(L, arg);
+}
+
 /* ---- DEM ------------------------------------------------------------------------------------ */
 static int l_dem_save(lua_State *L)
 {
     dem_scene *s = bind_check_dem_scene(L, 1, "save");
-    const char *path = luaL_checkstring(L, 2);
+    const char *path = check_path(L, 2, 1, "save");
     core_error err;
     if (dem_save(s, path, GRAINLAB_VERSION, &err) != CORE_OK)
         return bind_raise(L, "save", &err);
@@ -23,7 +35,7 @@ static int l_dem_save(lua_State *L)
  * bind_check_dem_scene confirms before the swap. */
 static int l_dem_load(lua_State *L)
 {
-    const char *path = luaL_checkstring(L, 1);
+    const char *path = check_path(L, 1, 1, "load");
     core_error err;
     dem_scene *loaded;
     if (dem_load(path, &loaded, &err) != CORE_OK)

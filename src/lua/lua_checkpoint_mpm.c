@@ -11,7 +11,7 @@ static const char *check_path(lua_State *L, int arg, int shown, const char *call
     if (lua_type(L, arg) != LUA_TSTRING) {
         char got[64];
         bind_describe(L, arg, got, sizeof got);
-        luaL_error(L, "bad argument #%d to '%s' (file name expected, got %s)", shown, call, got);
+        luaL_error(L, "bad argument #%d to '%s' (string expected, got %s)", shown, call, got);
     }
     return lua_tostring(L, arg);
 }

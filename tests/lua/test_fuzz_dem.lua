@@ -21,7 +21,18 @@ local OPT = { "nil" }
 local BOOL = { "nil", "boolean" }
 local ID = {} -- a particle or wall id: nothing but a valid id
 
+-- A checkpoint file for the save and load entries (removed at the end).
+local ckpt = os.tmpname()
+
 local calls = {
+  ["dem.scene:save"] = {
+    setup = scene2, self = self, args = function() return { ckpt } end,
+    pos = { { "string" } }, strings = { ckpt },
+  },
+  ["dem.load"] = {
+    setup = function() scene2():save(ckpt) end, args = function() return { ckpt } end,
+    pos = { { "string" } }, strings = { ckpt },
+  },
   ["dem.scene"] = {
     args = function() return { { dim = 2, box = { { 0, 0 }, { 1, 1 } }, gravity = { 0, -9.81 },
                                  periodic = { false, false }, thickness = 0.01, skin = 0.001 } } end,
@@ -163,4 +174,5 @@ check.errors(function() scene2():set_velocity(1, { 0, 0, 1 }) end,
   "bad argument #2 to 'set_velocity' (array of 2 finite numbers expected, got table)", "3 components in 2D")
 check.errors(function() scene2():wall_velocity(1, { 0, 0, 1 }) end,
   "bad argument #2 to 'wall_velocity' (array of 2 finite numbers expected, got table)", "wall velocity in 3 components")
+os.remove(ckpt)
 check.done()
