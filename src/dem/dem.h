@@ -340,7 +340,8 @@ typedef struct dem_lammps_data {
     long long *id;
     int *type;
     double *radius, *density;
-    double *x[3], *v[3], *w[3];
+    double *x[3], *v[3], *w[3];  /* x as in the file */
+    int *image[3];         /* image flags (0 when the file has none) */
     long *line;            /* the Atoms line of each atom */
 } dem_lammps_data;
 

@@ -167,7 +167,8 @@ static core_status alloc_atoms(dem_lammps_data *d, size_t n, core_error *err)
         d->x[a] = calloc(m, sizeof(double));
         d->v[a] = calloc(m, sizeof(double));
         d->w[a] = calloc(m, sizeof(double));
-        ok = ok && d->x[a] && d->v[a] && d->w[a];
+        d->image[a] = calloc(m, sizeof(int));
+        ok = ok && d->x[a] && d->v[a] && d->w[a] && d->image[a];
     }
     if (!ok)
         return core_fail(err, CORE_ERR_NOMEM, "cannot allocate %zu atoms", n);
@@ -178,7 +179,7 @@ void dem_lammps_free(dem_lammps_data *d)
 {
     free(d->path), free(d->id), free(d->type), free(d->radius), free(d->density), free(d->line);
     for (int a = 0; a < 3; a++)
-        free(d->x[a]), free(d->v[a]), free(d->w[a]);
+        free(d->x[a]), free(d->v[a]), free(d->w[a]), free(d->image[a]);
     memset(d, 0, sizeof *d);
 }
 
@@ -262,10 +263,8 @@ static core_status read_atoms(reader *r, dem_lammps_data *d, size_t *count, core
         d->radius[k] = diam / 2;
         d->density[k] = dens;
         for (int a = 0; a < 3; a++) {
-            double len = d->hi[a] - d->lo[a];
-            d->x[a][k] = img[a] ? x[a] + (double)img[a] * len : x[a]; /* unwrapped */
-            if (!isfinite(d->x[a][k]))
-                return bad_line(err, r, "image flags put the atom at infinity");
+            d->x[a][k] = x[a];
+            d->image[a][k] = (int)img[a];
         }
         d->line[k] = r->line;
     }
@@ -355,15 +354,16 @@ static core_status sort_atoms(const reader *r, dem_lammps_data *d, id_index **or
         t.id[k] = s.id[j], t.type[k] = s.type[j], t.radius[k] = s.radius[j];
         t.density[k] = s.density[j], t.line[k] = s.line[j];
         for (int a = 0; a < 3; a++)
-            t.x[a][k] = s.x[a][j], t.v[a][k] = s.v[a][j], t.w[a][k] = s.w[a][j];
+            t.x[a][k] = s.x[a][j], t.v[a][k] = s.v[a][j], t.w[a][k] = s.w[a][j],
+            t.image[a][k] = s.image[a][j];
         order[k].k = k;
     }
     free(s.id), free(s.type), free(s.radius), free(s.density), free(s.line);
     for (int a = 0; a < 3; a++)
-        free(s.x[a]), free(s.v[a]), free(s.w[a]);
+        free(s.x[a]), free(s.v[a]), free(s.w[a]), free(s.image[a]);
     d->id = t.id, d->type = t.type, d->radius = t.radius, d->density = t.density, d->line = t.line;
     for (int a = 0; a < 3; a++)
-        d->x[a] = t.x[a], d->v[a] = t.v[a], d->w[a] = t.w[a];
+        d->x[a] = t.x[a], d->v[a] = t.v[a], d->w[a] = t.w[a], d->image[a] = t.image[a];
     *order_out = order;
     return CORE_OK;
 }
@@ -639,6 +639,12 @@ core_status dem_lammps_add(dem_scene *s, const dem_lammps_data *d, const dem_lam
                              d->w[1][k]);
         for (int a = 0; a < D; a++) {
             double x = d->x[a][k];
+            if (!s->periodic[a] && d->image[a][k] != 0)
+                return core_fail(err, CORE_ERR_ARG,
+                                 "%s:%ld: atom %lld has image flag %d on axis %c, which is not "
+                                 "periodic in this scene (periodic = {...} as in the LAMMPS "
+                                 "run's boundary?)",
+                                 d->path, d->line[k], d->id[k], d->image[a][k], 'x' + a);
             if (!s->periodic[a] && (x < s->lo[a] || x > s->hi[a]))
                 return core_fail(err, CORE_ERR_ARG,
                                  "%s:%ld: atom %lld: %c = %.17g is outside the scene's box [%g, "
@@ -715,13 +721,11 @@ core_status dem_lammps_add(dem_scene *s, const dem_lammps_data *d, const dem_lam
     for (size_t k = 0; k < d->n && st == CORE_OK; k++) {
         dem_particle_def p;
         memset(&p, 0, sizeof p);
-        double unwrapped[3] = {0, 0, 0};
         for (int a = 0; a < D; a++) {
             double x = d->x[a][k];
-            unwrapped[a] = x;
             if (s->periodic[a] && (x < s->lo[a] || x >= s->hi[a])) {
-                /* grainlab keeps periodic positions unwrapped; the particle enters at its image
-                 * in the box and then takes its file position */
+                /* into the box, as grainlab keeps periodic positions (image flags say nothing
+                 * more: grainlab does not count crossings) */
                 double len = s->hi[a] - s->lo[a];
                 x -= floor((x - s->lo[a]) / len) * len;
                 if (!(x >= s->lo[a] && x <= s->hi[a]))
@@ -743,12 +747,6 @@ core_status dem_lammps_add(dem_scene *s, const dem_lammps_data *d, const dem_lam
                            d->id[k], why);
             break;
         }
-        for (int a = 0; a < D; a++)
-            if (unwrapped[a] != p.x[a]) {
-                s->x[a][i] = s->x_build[a][i] = unwrapped[a];
-                if (s->x_ref[a])
-                    s->x_ref[a][i] = unwrapped[a];
-            }
     }
     free(mat);
     if (st != CORE_OK) {
@@ -930,8 +928,8 @@ core_status dem_write_lammps_dump(const dem_scene *s, const char *path,
     strbuf b = {0};
     double lo[3], hi[3];
     box3(s, lo, hi);
-    sb_printf(&b, "ITEM: TIMESTEP\n%ld\nITEM: TIME\n%.17g\nITEM: NUMBER OF ATOMS\n%zu\n", s->steps,
-              s->time, s->n);
+    /* No "ITEM: TIME": read_dump and rerun of LAMMPS 29 Sep 2021 (Debian 12) refuse it. */
+    sb_printf(&b, "ITEM: TIMESTEP\n%ld\nITEM: NUMBER OF ATOMS\n%zu\n", s->steps, s->n);
     char bc[3];
     for (int a = 0; a < 3; a++)
         bc[a] = (a >= s->dim || s->periodic[a]) ? 'p' : 'f';
