@@ -272,9 +272,12 @@ static int l_read(lua_State *L)
     int dim = d->flat ? 2 : 3;
     if (opts)
         dim = (int)bind_field_integer(L, opts, call, "dim", dim, 2, 3, 0);
-    if (dim == 2 && !(d->lo[2] < 0 && d->hi[2] > 0))
-        luaL_error(L, "%s: %s: a 2D file needs zlo < 0 < zhi (as LAMMPS does), got %g %g", call,
-                   path, d->lo[2], d->hi[2]);
+    if (dim == 2 && !(d->lo[2] < 0 && d->hi[2] > 0)) {
+        char msg[160];
+        snprintf(msg, sizeof msg, "a 2D file needs zlo < 0 < zhi (as LAMMPS does), got %g %g",
+                 d->lo[2], d->hi[2]);
+        luaL_error(L, "%s: %s: %s", call, path, msg);
+    }
     /* The scene through dem.scene{...}, so that it is made and checked as any other. */
     lua_getglobal(L, "dem");
     lua_getfield(L, -1, "scene");
