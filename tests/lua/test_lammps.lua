@@ -174,5 +174,15 @@ local sfix = dem.read_lammps_data(ok, { fixed_types = { 1 }, gravity = { 0, 0, -
 sfix:run{ steps = 10 }
 check.eq(sfix:particles().z[1], 0.5, "fixed atoms stay")
 
+-- a failure after atoms went in (the third overlaps a wall of the scene) takes them out again
+local walled = dem.scene{ dim = 3, box = { { 0, 0, 0 }, { 1, 1, 1 } } }
+walled:add_wall{ point = { 0.75, 0, 0 }, normal = { -1, 0, 0 } }
+walled:add_sphere{ pos = { 0.1, 0.1, 0.1 }, radius = 0.05 }
+check.errors(function() walled:read_lammps_data(ok) end, ":14: atom 3: particle at pos", "wall overlap")
+check.eq(walled:particles().count, 1, "rolled back: only the particle from before")
+walled:add_sphere{ pos = { 0.3, 0.3, 0.3 }, radius = 0.05 }
+check.eq(walled:particles().count, 2, "the scene still takes particles")
+walled:run{ steps = 5 }
+
 for _, p in ipairs(made) do os.remove(p) end
 check.done()
