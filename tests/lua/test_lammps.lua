@@ -63,6 +63,10 @@ check.contains(text, "\nVelocities\n\n1 ", "Velocities section")
 -- the same scene through the types it was written with: type 2 is g, and g's density
 local t3b = dem.read_lammps_data(p3, { types = { [1] = q, [2] = g }, periodic = { true, false, false } })
 check.eq(t3b:particles().mass[2], s:particles().mass[2], "type 2 carries g")
+-- without types, each type keeps the file's density (a copy of the default material): the density
+-- column round-trips exactly, so the masses do
+local t3c = dem.read_lammps_data(p3, { periodic = { true, false, false } })
+for i = 1, 6 do check.eq(t3c:particles().mass[i], s:particles().mass[i], "file density, mass of " .. i) end
 -- a second read into the same scene adds, all or nothing (the box is the scene's)
 local before = t3:particles().count
 check.errors(function() t3:read_lammps_data(p3, { types = { [1] = q } }) end,
