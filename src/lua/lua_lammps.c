@@ -241,6 +241,9 @@ static int l_scene_read(lua_State *L)
     static const char *const fields[] = {"types", "material", "density", "fixed_types", NULL};
     const char *call = "read_lammps_data";
     bind_check_dem_scene(L, 1, call);
+    bind_refuse_running(L, 1, call,
+                        "new particles can shorten the stability limit the run's dt was checked "
+                        "at: read the file between runs");
     const char *path = luaL_checkstring(L, 2);
     int opts = 0;
     if (!lua_isnoneornil(L, 3)) {

@@ -178,6 +178,15 @@ local sfix = dem.read_lammps_data(ok, { fixed_types = { 1 }, gravity = { 0, 0, -
 sfix:run{ steps = 10 }
 check.eq(sfix:particles().z[1], 0.5, "fixed atoms stay")
 
+-- not from on_step: a packing can shorten the stability limit the run's dt was checked at; a
+-- dump frame can be written there
+scene:run{ steps = 2, every = 1, on_step = function(sc)
+  check.errors(function() sc:read_lammps_data(ok) end,
+    "read_lammps_data: this dem.scene is running (called from its on_step)", "read from on_step")
+  sc:write_lammps_dump(path("on_step.dump"), { append = true })
+end }
+made[#made + 1] = path("on_step.dump")
+check.eq(select(2, slurp(path("on_step.dump")):gsub("ITEM: TIMESTEP", "")), 2, "frames from on_step")
 -- a failure after atoms went in (the third overlaps a wall of the scene) takes them out again
 local walled = dem.scene{ dim = 3, box = { { 0, 0, 0 }, { 1, 1, 1 } } }
 walled:add_wall{ point = { 0.75, 0, 0 }, normal = { -1, 0, 0 } }
