@@ -11,6 +11,23 @@
 void bind_open_lammps(lua_State *L);
 
 static const char *const DENSITY_NAMES[] = {"strict", "file", "material", NULL};
+static const char *const SCENE_READ_FIELDS[] = {"types", "material", "density", "fixed_types",
+                                                NULL};
+static const char *const READ_FIELDS[] = {"types",   "material", "density",   "fixed_types", "dim",
+                                          "gravity", "periodic", "thickness", "skin",        NULL};
+static const char *const DATA_FIELDS[] = {"types", "title", NULL};
+static const char *const DUMP_FIELDS[] = {"types", "append", NULL};
+
+/* The file name: a string, nothing else (a number would name a file after itself). */
+static const char *path_arg(lua_State *L, int idx, int shown, const char *call)
+{
+    if (lua_type(L, idx) != LUA_TSTRING) {
+        char got[64];
+        bind_describe(L, idx, got, sizeof got);
+        luaL_error(L, "bad argument #%d to '%s' (file name expected, got %s)", shown, call, got);
+    }
+    return lua_tostring(L, idx);
+}
 
 /* The parsed file lives in a userdata so that a Lua error anywhere frees it. */
 static int data_gc(lua_State *L)
@@ -118,7 +135,14 @@ static void read_type_options(lua_State *L, int opts, const char *call, int ntyp
     if (lua_getfield(L, opts, "fixed_types") != LUA_TNIL) {
         if (lua_type(L, -1) != LUA_TTABLE)
             bind_field_error(L, opts, call, "fixed_types", "array of atom types");
-        lua_Integer n = luaL_len(L, -1);
+        lua_Integer n = luaL_len(L, -1), keys = 0;
+        lua_pushnil(L);
+        while (lua_next(L, -2)) {
+            lua_pop(L, 1);
+            keys++;
+        }
+        if (keys != n)
+            bind_field_error(L, opts, call, "fixed_types", "array of atom types");
         for (lua_Integer k = 1; k <= n; k++) {
             lua_rawgeti(L, -1, k);
             lua_Integer t = lua_isinteger(L, -1) ? lua_tointeger(L, -1) : 0;
@@ -218,6 +242,16 @@ static void load(lua_State *L, int scene, int opts, const char *call, dem_lammps
     int *type_material = lua_newuserdatauv(L, nt * sizeof *type_material, 0);
     int types_idx, mat_idx;
     read_type_options(L, opts, call, d->ntypes, types, &types_idx, &mat_idx);
+    for (size_t k = 0; k < d->n; k++)
+        if (!types[d->type[k] - 1].mapped) {
+            char expected[160];
+            snprintf(expected, sizeof expected,
+                     "a grainlab.material for atom type %d (atom %lld, %s line %ld), or the "
+                     "field 'material'",
+                     d->type[k], d->id[k], d->path, d->line[k]);
+            lua_pushvalue(L, types_idx);
+            bind_field_error(L, opts, call, "types", expected);
+        }
     size_t first;
     core_error err;
     if (dem_lammps_add(s, d, types, type_material, &first, &err) != CORE_OK)
@@ -238,17 +272,16 @@ static dem_lammps_data *parse_file(lua_State *L, const char *path, const char *c
 /* s:read_lammps_data(path, opts) -> info */
 static int l_scene_read(lua_State *L)
 {
-    static const char *const fields[] = {"types", "material", "density", "fixed_types", NULL};
     const char *call = "read_lammps_data";
     bind_check_dem_scene(L, 1, call);
     bind_refuse_running(L, 1, call,
                         "new particles can shorten the stability limit the run's dt was checked "
                         "at: read the file between runs");
-    const char *path = luaL_checkstring(L, 2);
+    const char *path = path_arg(L, 2, 1, call);
     int opts = 0;
     if (!lua_isnoneornil(L, 3)) {
         bind_check_table(L, 3, call);
-        bind_check_fields(L, 3, call, fields);
+        bind_check_fields(L, 3, call, SCENE_READ_FIELDS);
         opts = 3;
     }
     lua_settop(L, 3);
@@ -260,14 +293,12 @@ static int l_scene_read(lua_State *L)
 /* dem.read_lammps_data(path, opts) -> scene, info */
 static int l_read(lua_State *L)
 {
-    static const char *const fields[] = {"types",   "material", "density",   "fixed_types", "dim",
-                                         "gravity", "periodic", "thickness", "skin",        NULL};
     const char *call = "read_lammps_data";
-    const char *path = luaL_checkstring(L, 1);
+    const char *path = path_arg(L, 1, 1, call);
     int opts = 0;
     if (!lua_isnoneornil(L, 2)) {
         bind_check_table(L, 2, call);
-        bind_check_fields(L, 2, call, fields);
+        bind_check_fields(L, 2, call, READ_FIELDS);
         opts = 2;
     }
     lua_settop(L, 2);
@@ -302,7 +333,14 @@ static int l_read(lua_State *L)
         lua_getfield(L, opts, pass[k]);
         lua_setfield(L, -2, pass[k]);
     }
-    lua_call(L, 1, 1);
+    if (lua_pcall(L, 1, 1, 0) != LUA_OK) {
+        /* dem.scene's checks of gravity, periodic, thickness, skin, said as this call's */
+        const char *m = luaL_tolstring(L, -1, NULL);
+        m = luaL_gsub(L, m, "argument #1 to 'scene'", "argument #2 to 'read_lammps_data'");
+        if (strncmp(m, "scene: ", 7) == 0)
+            lua_pushfstring(L, "%s: %s", call, m + 7);
+        return lua_error(L);
+    }
     int scene = lua_gettop(L);
     load(L, scene, opts, call, d);
     lua_pushvalue(L, scene);
@@ -347,15 +385,28 @@ static void write_options(lua_State *L, dem_scene *s, int opts, const char *call
         if (lua_rawget(L, map) == LUA_TNUMBER) { /* a material the scene knows */
             int m = (int)lua_tointeger(L, -1);
             if (m >= 0 && m < nmat) {
-                if (tom[m] && tom[m] != t)
-                    luaL_error(L, "%s: types[%d] and types[%d] are the same material", call, tom[m],
-                               (int)t);
+                if (tom[m] && tom[m] != t) {
+                    char expected[96];
+                    snprintf(expected, sizeof expected,
+                             "a material other than types[%d]'s (one type per material)", tom[m]);
+                    bind_field_error(L, opts, call, field, expected);
+                }
                 tom[m] = (int)t;
             }
         }
         lua_pop(L, 2);
     }
     lua_pop(L, 1); /* map */
+    /* Every particle's material needs a type: say so here, naming the field. */
+    const int *pm = dem_particle_materials(s);
+    for (size_t i = 0; i < dem_count(s); i++)
+        if (tom[pm[i]] == 0) {
+            char expected[128];
+            snprintf(expected, sizeof expected,
+                     "a type for every particle's material (particle %zu's has none)", i + 1);
+            lua_pushvalue(L, tmap);
+            bind_field_error(L, opts, call, "types", expected);
+        }
     lua_remove(L, tmap);
     def->type_of_material = tom;
     def->ntypes = top;
@@ -364,14 +415,12 @@ static void write_options(lua_State *L, dem_scene *s, int opts, const char *call
 static int write_common(lua_State *L, int dump)
 {
     const char *call = dump ? "write_lammps_dump" : "write_lammps_data";
-    static const char *const data_fields[] = {"types", "title", NULL};
-    static const char *const dump_fields[] = {"types", "append", NULL};
     dem_scene *s = bind_check_dem_scene(L, 1, call);
-    const char *path = luaL_checkstring(L, 2);
+    const char *path = path_arg(L, 2, 1, call);
     int opts = 0;
     if (!lua_isnoneornil(L, 3)) {
         bind_check_table(L, 3, call);
-        bind_check_fields(L, 3, call, dump ? dump_fields : data_fields);
+        bind_check_fields(L, 3, call, dump ? DUMP_FIELDS : DATA_FIELDS);
         opts = 3;
     }
     lua_settop(L, 3);
@@ -420,6 +469,11 @@ void bind_open_lammps(lua_State *L)
     lua_getfield(L, -1, "__index");
     bind_register(L, lua_gettop(L), methods);
     lua_pop(L, 2);
+    static const bind_fields method_fields[] = {{"read_lammps_data", NULL, SCENE_READ_FIELDS},
+                                                {"write_lammps_data", NULL, DATA_FIELDS},
+                                                {"write_lammps_dump", NULL, DUMP_FIELDS},
+                                                {NULL, NULL, NULL}};
+    bind_type_fields(L, "dem.scene", method_fields);
     static const bind_fn fns[] = {
         {"read_lammps_data", l_read,
          "dem.read_lammps_data(path, { dim =, gravity =, periodic =, thickness =, skin =, types "
@@ -431,5 +485,8 @@ void bind_open_lammps(lua_State *L)
         {NULL, NULL, NULL, NULL}};
     lua_getglobal(L, "dem");
     bind_register(L, lua_gettop(L), fns);
+    static const bind_fields fn_fields[] = {{"read_lammps_data", NULL, READ_FIELDS},
+                                            {NULL, NULL, NULL}};
+    bind_register_fields(L, -1, fn_fields);
     lua_pop(L, 1);
 }

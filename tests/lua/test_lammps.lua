@@ -70,7 +70,7 @@ for i = 1, 6 do check.eq(t3c:particles().mass[i], s:particles().mass[i], "file d
 -- a second read into the same scene adds, all or nothing (the box is the scene's)
 local before = t3:particles().count
 check.errors(function() t3:read_lammps_data(p3, { types = { [1] = q } }) end,
-  "atom 2 has type 2, which has no material", "unmapped type")
+  "bad field 'types' in argument #2 to 'read_lammps_data' (a grainlab.material for atom type 2 (atom 2,", "unmapped type")
 check.eq(t3:particles().count, before, "nothing added after the refusal")
 
 -- ---- 2D round trip: z = 0, zlo < 0 < zhi, disks with spin -------------------------------------
@@ -119,7 +119,7 @@ s:write_lammps_dump(pd, { types = types })
 local _, again = slurp(pd):gsub("ITEM: TIMESTEP\n", "")
 check.eq(again, 1, "without append the file starts anew")
 check.errors(function() s:write_lammps_dump(pd, { types = { [1] = q } }) end,
-  "has no atom type", "a material without a type")
+  "bad field 'types' in argument #2 to 'write_lammps_dump' (a type for every particle's material (particle 2's has none)", "a material without a type")
 check.errors(function() s:write_lammps_dump(pd, { typo = 1 }) end,
   "bad argument #2 to 'write_lammps_dump' (unknown field 'typo'", "unknown option")
 
