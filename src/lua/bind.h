@@ -182,6 +182,8 @@ void bind_open_dsmc(lua_State *L);
 /* Registers the global `analysis` module and the boundary-condition methods of dem.scene
  * (lua_analysis.c); after bind_open_dem. */
 void bind_open_analysis(lua_State *L);
+/* s:save and dem.load (lua_checkpoint.c); after bind_open_dem. */
+void bind_open_checkpoint(lua_State *L);
 
 /* Registers the global `render` module (lua_render.c). */
 void bind_open_render(lua_State *L);
