@@ -239,7 +239,7 @@ spit(path("newer.ckpt"), reseal(bytes:sub(1, 12) .. string.pack("=I4", 99) .. by
 check.errors(function() dem.load(path("newer.ckpt")) end,
              "has checkpoint format version 99 (written by grainlab " .. grainlab.version ..
              "); this grainlab reads format versions up to 1", "a newer format")
-check.errors(function() dem.load() end, "bad argument #1 to 'load' (string expected, got no value)",
+check.errors(function() dem.load() end, "bad argument #1 to 'load' (file path (string) expected, got no value)",
              "no path")
 -- a file with a valid checksum whose contents contradict themselves (Gear state marked ready in a
 -- velocity-Verlet scene: gear_ready is the uint32 at byte 276, 180 bytes into the 'scene'
