@@ -267,7 +267,7 @@ do
   check.errors(function() s:save(path("adir")) end, "save: cannot", "a directory as the target")
   check.eq(listing(), before, "no temporary file left after a failed save")
   check.is_true(not listing():find("%.tmp%."), "no *.tmp.* files")
-  check.errors(function() s:save() end, "bad argument #1 to 'save' (string expected, got no value)",
+  check.errors(function() s:save() end, "bad argument #1 to 'save' (file path (string) expected, got no value)",
                "no path")
   -- a boundary rebuilt by a Delaunay triangulation is refused by name, not saved incomplete
   s:boundary{ mode = "delaunay", pressure = 10, depth = 0.002 }
