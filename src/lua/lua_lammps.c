@@ -18,17 +18,6 @@ static const char *const READ_FIELDS[] = {"types",   "material", "density",   "f
 static const char *const DATA_FIELDS[] = {"types", "title", NULL};
 static const char *const DUMP_FIELDS[] = {"types", "append", NULL};
 
-/* The file name: a string, nothing else (a number would name a file after itself). */
-static const char *path_arg(lua_State *L, int idx, int shown, const char *call)
-{
-    if (lua_type(L, idx) != LUA_TSTRING) {
-        char got[64];
-        bind_describe(L, idx, got, sizeof got);
-        luaL_error(L, "bad argument #%d to '%s' (file name expected, got %s)", shown, call, got);
-    }
-    return lua_tostring(L, idx);
-}
-
 /* The parsed file lives in a userdata so that a Lua error anywhere frees it. */
 static int data_gc(lua_State *L)
 {
@@ -277,7 +266,7 @@ static int l_scene_read(lua_State *L)
     bind_refuse_running(L, 1, call,
                         "new particles can shorten the stability limit the run's dt was checked "
                         "at: read the file between runs");
-    const char *path = path_arg(L, 2, 1, call);
+    const char *path = bind_arg_path(L, 2, call);
     int opts = 0;
     if (!lua_isnoneornil(L, 3)) {
         bind_check_table(L, 3, call);
@@ -294,7 +283,7 @@ static int l_scene_read(lua_State *L)
 static int l_read(lua_State *L)
 {
     const char *call = "read_lammps_data";
-    const char *path = path_arg(L, 1, 1, call);
+    const char *path = bind_arg_path(L, 1, call);
     int opts = 0;
     if (!lua_isnoneornil(L, 2)) {
         bind_check_table(L, 2, call);
@@ -416,7 +405,7 @@ static int write_common(lua_State *L, int dump)
 {
     const char *call = dump ? "write_lammps_dump" : "write_lammps_data";
     dem_scene *s = bind_check_dem_scene(L, 1, call);
-    const char *path = path_arg(L, 2, 1, call);
+    const char *path = bind_arg_path(L, 2, call);
     int opts = 0;
     if (!lua_isnoneornil(L, 3)) {
         bind_check_table(L, 3, call);

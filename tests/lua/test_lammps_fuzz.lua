@@ -68,7 +68,7 @@ end
 fuzz.run{ modules = { dem = dem }, types = { ["dem.scene"] = s }, calls = calls, skip = skip }
 -- A number is not a file name (luaL_checkstring would take 5 and write a file called "5").
 check.errors(function() s:write_lammps_data(5) end,
-  "bad argument #1 to 'write_lammps_data' (file name expected, got 5)", "a number as the path")
+  "bad argument #1 to 'write_lammps_data' (file path (string) expected, got 5)", "a number as the path")
 check.errors(function() dem.read_lammps_data(data, { gravity = { 0, 0, 0 / 0 } }) end,
   "bad field 'gravity' in argument #2 to 'read_lammps_data'", "dem.scene's checks, as this call's")
 for _, p in ipairs{ data, out .. ".data", out .. ".dump", base } do os.remove(p) end
