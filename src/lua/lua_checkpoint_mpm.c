@@ -4,23 +4,11 @@
 #include "lua/bind.h"
 #include "mpm/mpm.h"
 
-/* The file name at arg, a string (a number is refused, not converted); `shown` is the argument
- * number the user sees. */
-static const char *check_path(lua_State *L, int arg, int shown, const char *call)
-{
-    if (lua_type(L, arg) != LUA_TSTRING) {
-        char got[64];
-        bind_describe(L, arg, got, sizeof got);
-        luaL_error(L, "bad argument #%d to '%s' (string expected, got %s)", shown, call, got);
-    }
-    return lua_tostring(L, arg);
-}
-
 /* m:save(path) and s:save(path) may run from on_step: between steps the scene is whole. */
 static int l_mpm_save(lua_State *L)
 {
     mpm_scene *s = bind_check_mpm_scene(L, 1, "save");
-    const char *path = check_path(L, 2, 1, "save");
+    const char *path = bind_arg_path(L, 2, "save");
     core_error err;
     if (mpm_save(s, path, GRAINLAB_VERSION, &err))
         return bind_raise(L, "save", &err);
@@ -29,7 +17,7 @@ static int l_mpm_save(lua_State *L)
 
 static int l_mpm_load(lua_State *L)
 {
-    const char *path = check_path(L, 1, 1, "load");
+    const char *path = bind_arg_path(L, 1, "load");
     mpm_scene **slot = bind_new_mpm_scene(L); /* closed until filled: safe on any error */
     core_error err;
     if (mpm_load(path, slot, &err))
@@ -40,7 +28,7 @@ static int l_mpm_load(lua_State *L)
 static int l_dsmc_save(lua_State *L)
 {
     dsmc_scene *s = bind_check_dsmc_scene(L, 1, "save");
-    const char *path = check_path(L, 2, 1, "save");
+    const char *path = bind_arg_path(L, 2, "save");
     core_error err;
     if (dsmc_save(s, path, GRAINLAB_VERSION, &err))
         return bind_raise(L, "save", &err);
@@ -49,7 +37,7 @@ static int l_dsmc_save(lua_State *L)
 
 static int l_dsmc_load(lua_State *L)
 {
-    const char *path = check_path(L, 1, 1, "load");
+    const char *path = bind_arg_path(L, 1, "load");
     dsmc_scene **slot = bind_new_dsmc_scene(L);
     core_error err;
     if (dsmc_load(path, slot, &err))

@@ -239,7 +239,7 @@ spit(path("newer.ckpt"), reseal(bytes:sub(1, 12) .. string.pack("=I4", 99) .. by
 check.errors(function() dem.load(path("newer.ckpt")) end,
              "has checkpoint format version 99 (written by grainlab " .. grainlab.version ..
              "); this grainlab reads format versions up to 1", "a newer format")
-check.errors(function() dem.load() end, "bad argument #1 to 'load' (string expected, got no value)",
+check.errors(function() dem.load() end, "bad argument #1 to 'load' (file path (string) expected, got no value)",
              "no path")
 -- a file with a valid checksum whose contents contradict themselves (Gear state marked ready in a
 -- velocity-Verlet scene: gear_ready is the uint32 at byte 276, 180 bytes into the 'scene'
@@ -267,7 +267,7 @@ do
   check.errors(function() s:save(path("adir")) end, "save: cannot", "a directory as the target")
   check.eq(listing(), before, "no temporary file left after a failed save")
   check.is_true(not listing():find("%.tmp%."), "no *.tmp.* files")
-  check.errors(function() s:save() end, "bad argument #1 to 'save' (string expected, got no value)",
+  check.errors(function() s:save() end, "bad argument #1 to 'save' (file path (string) expected, got no value)",
                "no path")
   -- a boundary rebuilt by a Delaunay triangulation is refused by name, not saved incomplete
   s:boundary{ mode = "delaunay", pressure = 10, depth = 0.002 }

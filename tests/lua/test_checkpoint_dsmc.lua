@@ -186,7 +186,8 @@ end
 write(bad, reseal(s))
 check.eq(dsmc.load(bad):info().steps, 3, "a resealed copy loads")
 
-check.errors(function() g:save(42) end, "bad argument #1 to 'save' (string expected, got 42)",
+check.errors(function() g:save(42) end,
+             "bad argument #1 to 'save' (file path (string) expected, got 42)",
              "save with a number")
 check.errors(function() g:save(dir .. "/no/such/dir/x.ckpt") end, "save:", "unwritable path")
 check.eq(dsmc.load(good):info().steps, 3, "the file is intact after failed saves")

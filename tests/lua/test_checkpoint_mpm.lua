@@ -212,7 +212,7 @@ check.eq(mpm.load(bad):info().steps, 2, "a resealed copy loads")
 
 -- save: argument errors and an unwritable place; the old file stays whole.
 check.errors(function() m:save() end,
-             "bad argument #1 to 'save' (string expected, got no value)",
+             "bad argument #1 to 'save' (file path (string) expected, got no value)",
              "save without a path")
 check.errors(function() m:save(dir .. "/no/such/dir/x.ckpt") end, "save:", "unwritable path")
 check.errors(function() mpm.load() end, "bad argument #1 to 'load'", "load without a path")
