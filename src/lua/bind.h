@@ -137,4 +137,10 @@ int bind_check_option(lua_State *L, int arg, const char *def, const char *const 
 /* The name of `names` closest to s (a unique prefix, or within a few edits), or NULL. */
 const char *bind_closest_name(const char *s, const char *const names[]);
 
+/* The mpm_scene / dsmc_scene at idx, or a Lua error naming `call` (for other bindings). */
+struct mpm_scene *bind_check_mpm_scene(lua_State *L, int idx, const char *call);
+struct dsmc_scene *bind_check_dsmc_scene(lua_State *L, int idx, const char *call);
+/* Adds write_vtk to the scene and mesh types and grainlab.vtk (lua_vtk.c); after the engines. */
+void bind_open_vtk(lua_State *L);
+
 #endif

@@ -54,6 +54,7 @@ static int open_grainlab(lua_State *L)
     bind_open_mpm(L);
     bind_open_dsmc(L);
     bind_open_render(L);
+    bind_open_vtk(L); /* after the engines: adds write_vtk to their scene types */
 
     /* The Lua-side library completes the table: report, check, help. */
     lua_getglobal(L, "require");
