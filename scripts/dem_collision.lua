@@ -373,15 +373,16 @@ end
 metrics.brilliantov_sweep = bri_rows
 metrics.brilliantov_first_order_ratio_at_0_01 = first_order_ratio
 
--- T solved by the binding from a restitution (restitution = 0.8 at impact_velocity = 1 m/s, for
--- the mean pair: two equal quartz spheres here, so the mean pair is the pair) against RK4.
+-- T solved by the binding from a restitution (restitution = 0.8 at impact_velocity = 1 m/s; each
+-- pair gets its own T, read back with s:damping_time) against RK4.
 local T_solved, e_at_solved
 do
   local s = dem.scene{ dim = 3, box = { { -0.01, -0.01, -0.01 }, { 0.01, 0.01, 0.01 } } }
   local mq = grainlab.material(quartz)
   s:add_sphere{ pos = { -r1, 0, 0 }, radius = r1, material = mq }
   s:add_sphere{ pos = { r1 + 1e-4, 0, 0 }, radius = r1, material = mq }
-  T_solved = s:contact{ normal = "hertz", damping = "brilliantov", restitution = 0.8, impact_velocity = 1 }
+  s:contact{ normal = "hertz", damping = "brilliantov", restitution = 0.8, impact_velocity = 1 }
+  T_solved = s:damping_time(1, 2)
   local m = mass(quartz, r1)
   local K = 4 / 3 * e_star(quartz, quartz) * math.sqrt(r1 / 2)
   local dmax = (5 * (m / 2) * 1 / (4 * K)) ^ 0.4

@@ -11,7 +11,7 @@
 --    density 2650, nu = 0.3, Coulomb friction mu, also against the walls and the floor (the
 --    walls carry no material of their own, so a disk-wall pair uses the disk's mu).
 --  * Contact law: Hertz normal force with Brilliantov (viscoelastic) damping, its time solved for
---    restitution 0.5 at 1 m/s for the mean pair, and the Cundall-Strack tangential spring capped
+--    restitution 0.5 at 1 m/s for every pair (its own T), and the Cundall-Strack tangential spring capped
 --    at mu f_n (Herrmann Eq. 2b; kt = 2/7 of the normal tangent stiffness).
 --    The model has no rolling resistance: disks roll freely over each other, so once mu is large
 --    enough to stop sliding a pile fails by rolling, and theta_r levels off near 19-20 deg from
@@ -201,7 +201,6 @@ local function run_one(mu, sd)
   end
   grainlab.pack.deposit(s, { n = n, radius = { rmin, rmax }, seed = sd, material = mat,
                              region = { { 0, -2 * rf }, { W, top - 2 * rmax } }, relax_steps = 0 })
-  -- Brilliantov damping needs the particles (its time is solved for their mean pair).
   s:contact{ normal = "hertz", damping = "brilliantov", restitution = e_rest, impact_velocity = v_e,
              tangential = "spring" }
   local dt = dt_factor * s:timestep{ impact_velocity = v_imp }.limit

@@ -16,6 +16,7 @@ local OPS = {
 
 local function describe(v)
   if type(v) == "string" then return "'" .. v .. "'" end
+  if v ~= v then return "nan" end
   if type(v) == "number" or type(v) == "boolean" then return tostring(v) end
   return type(v)
 end
@@ -44,11 +45,35 @@ end
 
 local function is_name(s) return type(s) == "string" and s:match("^[a-z][a-z0-9_]*$") ~= nil end
 
-local function check_value(v, field)
+-- A figure is a finite number, a string, a boolean, or a table of figures that JSON can hold
+-- (an array 1..n, or string keys), checked here at the call so that nothing is printed or
+-- written before the whole report is known to be valid. NaN and infinities have no JSON form
+-- (they would turn into null unnoticed): a figure that can be NaN belongs in a check, which a NaN
+-- value fails.
+local function check_value(v, field, seen)
   local tv = type(v)
-  if tv == "number" or tv == "string" or tv == "boolean" then return end
+  if tv == "number" then
+    if v ~= v or v == math.huge or v == -math.huge then
+      bad(field, "finite number (a NaN or infinite figure belongs in a check, where it fails)", v)
+    end
+    return
+  end
+  if tv == "string" or tv == "boolean" then return end
   if tv == "table" then
-    for k, x in pairs(v) do check_value(x, field .. "." .. tostring(k)) end
+    seen = seen or {}
+    if seen[v] then bad(field, "table that does not contain itself", v) end
+    seen[v] = true
+    local n, strings, others = #v, 0, 0
+    for k in pairs(v) do
+      if type(k) == "string" then strings = strings + 1
+      elseif math.type(k) == "integer" and k >= 1 and k <= n then others = others + 1
+      else bad(field, "array 1..n or table with string keys (found key " .. describe(k) .. ")", v) end
+    end
+    if strings > 0 and others > 0 then
+      bad(field, "array 1..n or table with string keys (not both)", v)
+    end
+    for k, x in pairs(v) do check_value(x, field .. "." .. tostring(k), seen) end
+    seen[v] = nil
     return
   end
   bad(field, "number, string, boolean or table", v)
@@ -167,16 +192,17 @@ local function report_impl(t)
   local r = { scenario = t.scenario, params = params, metrics = metrics,
               checks = normalise_checks(t.checks), wall_s = grainlab.elapsed(),
               version = grainlab.version }
-  M.written = t.scenario
+  -- Encoded before anything is printed: a report is refused whole or reported whole.
+  local path = grainlab.options.report or os.getenv("GRAINLAB_REPORT")
+  local text = path and path ~= "" and json.encode(r)
 
   local failed = 0
   for _, c in ipairs(r.checks) do if not c.pass then failed = failed + 1 end end
   M.failed = M.failed + failed
+  M.written = t.scenario
   print_table(r)
-
-  local path = grainlab.options.report or os.getenv("GRAINLAB_REPORT")
-  if path and path ~= "" then
-    local ok, msg = grainlab.write_file(path, json.encode(r))
+  if text then
+    local ok, msg = grainlab.write_file(path, text)
     if not ok then error("report: " .. msg, 0) end
   end
   return failed == 0, r
@@ -197,7 +223,10 @@ GRAINLAB_REPORT=FILE, writes them as JSON (written whole; keys sorted):
   {"scenario", "params", "metrics", "checks": [{"name","value","limit","op","pass"}], "wall_s", "version"}
 Metric and check names are snake_case with the unit in the name where useful (wall_s,
 particle_steps_per_s). A check passes when `value op limit` holds (op defaults to '<='; a NaN
-value fails), or give pass = true/false directly. Any failed check makes grainlab exit with
+value fails), or give pass = true/false directly. Metrics and params are finite numbers, strings,
+booleans, or tables of them (arrays, or string keys); anything else (NaN, infinity, a function,
+a mixed or self-containing table, a name that is not snake_case) is refused at the call, before
+anything is printed or written. Any failed check makes grainlab exit with
 status 1 at the end of the run. One report per run. Returns all_passed, record.]] })
 
 return M

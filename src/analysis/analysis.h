@@ -26,16 +26,20 @@ typedef struct analysis_mesh {
     size_t nloop;      /* boundary loop: particle indices, counter-clockwise, not repeated */
     long *loop;
     size_t ndelaunay;  /* triangles of the full Delaunay triangulation */
-    size_t npeeled;    /* of them removed by the alpha rule */
+    size_t npeeled;    /* of them removed by the alpha rule (flat ones included) */
     double area;       /* sum of the kept cells' areas in the build configuration */
     double *x0, *y0;   /* the build configuration (copies) */
 } analysis_mesh;
+
+#define ANALYSIS_FLAT 1e-12 /* relative flatness of a triangle peeled whatever alpha */
 
 typedef struct analysis_delaunay_def {
     /* Alpha rule: a triangle with one edge (a, b) on the boundary is peeled off while that edge
      * is longer than alpha (r_a + r_b) and its third particle is not on the boundary yet (so the
      * outline never pinches and no particle ever leaves the mesh: every particle stays a vertex).
-     * 0 = keep the convex hull. */
+     * 0 = keep the convex hull. Whatever alpha, boundary triangles flat to rounding (twice
+     * the area <= ANALYSIS_FLAT x the longest edge squared: centres in a row along a wall) are
+     * peeled by the same rule, so every kept cell has a usable area. */
     double alpha;
     const double *radius; /* np radii; NULL: every radius is half the median Delaunay edge */
 } analysis_delaunay_def;

@@ -49,6 +49,9 @@ static core_status check_points(const double *x, const double *y, size_t np, cor
             far = i;
         }
     }
+    if (d2max == 0)
+        return core_fail(err, CORE_ERR_ARG, "all %zu particles have the same position (%g, %g)", np,
+                         x[0], y[0]);
     scale = sqrt(d2max);
     double ux = (x[far] - x[0]) / scale, uy = (y[far] - y[0]) / scale, off = 0;
     for (size_t i = 0; i < np; i++)
@@ -63,6 +66,20 @@ static core_status check_points(const double *x, const double *y, size_t np, cor
 static double tri_area(const double *x, const double *y, long a, long b, long c)
 {
     return 0.5 * ((x[b] - x[a]) * (y[c] - y[a]) - (x[c] - x[a]) * (y[b] - y[a]));
+}
+
+/* A triangle flat to rounding: twice its area below ANALYSIS_FLAT times its longest edge
+ * squared. qhull makes them of points collinear up to rounding on the hull (three grains in a
+ * row along a wall); they only ever lie on the outline, and a strain over such a cell is noise
+ * amplified 1e12 times, so the peeling removes them whatever alpha. */
+static int flat(const double *x, const double *y, const long *v)
+{
+    double l2 = 0;
+    for (int k = 0; k < 3; k++) {
+        double dx = x[v[(k + 1) % 3]] - x[v[k]], dy = y[v[(k + 1) % 3]] - y[v[k]];
+        l2 = fmax(l2, dx * dx + dy * dy);
+    }
+    return 2 * fabs(tri_area(x, y, v[0], v[1], v[2])) <= ANALYSIS_FLAT * l2;
 }
 
 /* qhull's Delaunay triangles of the points, counter-clockwise: *tri (3 per triangle). */
@@ -231,6 +248,12 @@ core_status analysis_delaunay(const double *x, const double *y, size_t np,
     core_status st = check_points(x, y, np, err);
     if (st)
         return st;
+    for (size_t i = 0; d.radius && i < np; i++)
+        if (!(d.radius[i] > 0) || !isfinite(d.radius[i]))
+            return core_fail(err, CORE_ERR_ARG,
+                             "particle %zu has radius %g: the alpha rule needs "
+                             "positive finite radii",
+                             i + 1, d.radius[i]);
     long *tri = NULL;
     size_t nt = 0;
     if ((st = run_qhull(x, y, np, &tri, &nt, err)))
@@ -243,10 +266,11 @@ core_status analysis_delaunay(const double *x, const double *y, size_t np,
     size_t *inc_start = calloc(np + 1, sizeof *inc_start), *fill = calloc(np, sizeof *fill);
     long *inc = malloc(3 * nt * sizeof *inc);
     long *nb = malloc(3 * nt * sizeof *nb);
-    unsigned char *alive = malloc(nt);
+    unsigned char *alive = malloc(nt), *queued = calloc(nt ? nt : 1, 1);
     long *stack = malloc(nt * sizeof *stack);
     analysis_mesh *m = calloc(1, sizeof *m);
-    if (!used || !bcount || !inc_start || !fill || !inc || !nb || !alive || !stack || !m) {
+    if (!used || !bcount || !inc_start || !fill || !inc || !nb || !alive || !queued || !stack ||
+        !m) {
         st = core_fail(err, CORE_ERR_NOMEM, "out of memory for the mesh of %zu particles", np);
         goto done;
     }
@@ -285,47 +309,67 @@ core_status analysis_delaunay(const double *x, const double *y, size_t np,
                 bcount[tri[3 * t + (k + 1) % 3]]++;
             }
 
-    /* The alpha rule: peel boundary triangles whose outer edge is too long for its pair. */
+    /* The alpha rule: peel boundary triangles whose outer edge is too long for its pair, and
+     * (whatever alpha) those flat to rounding (see flat()). A triangle can only become
+     * peelable when a neighbour is peeled (bcount never decreases), so the stack holds the
+     * boundary triangles, then the neighbours of each peeled one. A triangle waits on the stack
+     * at most once (queued), which bounds the stack by nt: without that, a small mesh whose
+     * triangles all touch the hull (a square and its centre) pushes nt + 2 x peeled entries and
+     * overflowed it. */
     size_t peeled = 0;
-    if (d.alpha > 0) {
-        double rdef = d.radius ? 0 : 0.5 * median_edge(x, y, tri, nt);
+    double rdef = 0;
+    if (d.alpha > 0 && !d.radius && !((rdef = 0.5 * median_edge(x, y, tri, nt)) > 0)) {
+        st = core_fail(err, CORE_ERR_NOMEM, "out of memory for the edges of %zu particles", np);
+        goto done;
+    }
+    /* Two passes: the flat triangles first, else an alpha peel next to one can put its third
+     * particle on the outline and leave it stuck (a row of centres on a wall). */
+    for (int pass = 0; pass < (d.alpha > 0 ? 2 : 1); pass++) {
         size_t top = 0;
         for (size_t t = 0; t < nt; t++)
-            for (int k = 0; k < 3; k++)
-                if (nb[3 * t + k] < 0) {
+            for (int k = 0; k < 3 && alive[t]; k++) {
+                long o = nb[3 * t + k];
+                if (o < 0 || !alive[o]) {
                     stack[top++] = (long)t;
+                    queued[t] = 1;
                     break;
                 }
+            }
         while (top > 0) {
             long t = stack[--top];
+            queued[t] = 0;
             if (!alive[t])
                 continue;
-            int nbnd = 0, longk = -1;
+            int nbnd = 0, bk = -1;
             for (int k = 0; k < 3; k++) {
                 long o = nb[3 * t + k];
                 if (o < 0 || !alive[o]) {
                     nbnd++;
-                    long a = tri[3 * t + k], b = tri[3 * t + (k + 1) % 3];
-                    double ra = d.radius ? d.radius[a] : rdef, rb = d.radius ? d.radius[b] : rdef;
-                    if (hypot(x[b] - x[a], y[b] - y[a]) > d.alpha * (ra + rb))
-                        longk = k;
+                    bk = k;
                 }
             }
             /* Only a triangle with one boundary edge and its third particle inside: peeling it
              * neither pinches the outline nor drops a particle from the mesh (a stray particle
              * stays attached by long edges, so pressure on them pulls it back). */
-            if (longk < 0 || nbnd != 1 || bcount[tri[3 * t + (longk + 2) % 3]] > 0)
+            if (nbnd != 1 || bcount[tri[3 * t + (bk + 2) % 3]] > 0)
+                continue;
+            long a = tri[3 * t + bk], b = tri[3 * t + (bk + 1) % 3];
+            double ra = d.radius ? d.radius[a] : rdef, rb = d.radius ? d.radius[b] : rdef;
+            int too_long = pass == 1 && hypot(x[b] - x[a], y[b] - y[a]) > d.alpha * (ra + rb);
+            if (!too_long && !flat(x, y, tri + 3 * t))
                 continue;
             alive[t] = 0;
             peeled++;
             for (int k = 0; k < 3; k++) {
                 long o = nb[3 * t + k];
-                long a = tri[3 * t + k], b = tri[3 * t + (k + 1) % 3];
+                long p = tri[3 * t + k], q = tri[3 * t + (k + 1) % 3];
                 int delta = (o < 0 || !alive[o]) ? -1 : 1;
-                bcount[a] += delta;
-                bcount[b] += delta;
-                if (o >= 0 && alive[o])
+                bcount[p] += delta;
+                bcount[q] += delta;
+                if (o >= 0 && alive[o] && !queued[o]) {
                     stack[top++] = o;
+                    queued[o] = 1;
+                }
             }
         }
     }
@@ -411,6 +455,7 @@ done:
     free(inc);
     free(nb);
     free(alive);
+    free(queued);
     free(stack);
     return st;
 }

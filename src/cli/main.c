@@ -1,5 +1,6 @@
 /* grainlab's command line: options, name=value params, then -e chunks, a script, standard input
- * or the REPL. Exit status: 0 ok, 1 a Lua error or a failed report check, 2 bad usage. */
+ * or the REPL. Exit status: 0 ok, 1 a Lua error or a failed report check, 2 bad usage, 143 ended
+ * by SIGTERM. */
 #define _POSIX_C_SOURCE 200809L
 #include <ctype.h>
 #include <errno.h>
@@ -12,6 +13,7 @@
 #include <lauxlib.h>
 
 #include "cli/cli.h"
+#include "core/fileio.h"
 #include "core/interrupt.h"
 #include "core/progress.h"
 #include "core/threads.h"
@@ -38,7 +40,8 @@ static const char *USAGE =
     "  --               end of options\n"
     "\n"
     "In the REPL, help() gives an overview and help(x) documents any API object.\n"
-    "Exit status: 0 success, 1 Lua error or failed report check, 2 bad command line.\n";
+    "Exit status: 0 success, 1 Lua error or failed report check, 2 bad command line,\n"
+    "143 ended by SIGTERM (the run stops between steps, unfinished output files are removed).\n";
 
 typedef struct cli_args {
     int interactive, quiet, version, help;
@@ -134,17 +137,73 @@ static lua_State *running_L;
 static void stop_hook(lua_State *L, lua_Debug *ar)
 {
     (void)ar;
+    if (interrupt_terminating()) /* stays set: a script's pcall cannot swallow a termination */
+        luaL_error(L, "terminated (SIGTERM)");
     lua_sethook(L, NULL, 0, 0);
     luaL_error(L, "interrupted by Ctrl-C");
 }
 
+/* A second Ctrl-C before the first is handled ends the process, without leaving the temporary
+ * files of writes in progress behind. */
+static void on_second_sigint(int sig)
+{
+    fileio_remove_temporaries();
+    signal(sig, SIG_DFL);
+    raise(sig);
+}
+
 /* Only async-signal-safe work: a flag for the kernels and a hook for the Lua VM (lua.c does the
- * same). A second Ctrl-C before the first is handled ends the process. */
+ * same). */
 static void on_sigint(int sig)
 {
-    signal(sig, SIG_DFL);
+    signal(sig, on_second_sigint);
     interrupt_request();
     lua_sethook(running_L, stop_hook, LUA_MASKCALL | LUA_MASKRET | LUA_MASKCOUNT, 1);
+}
+
+/* SIGTERM (a batch scheduler's time limit) stops the run between steps like Ctrl-C, then ends the
+ * process (main: cleanup, message, status 128 + 15), also from the REPL. A second SIGTERM before
+ * that ends it at once, removing the temporary files of writes in progress. */
+volatile sig_atomic_t cli_wake_fd = -1;
+
+static void on_sigterm(int sig)
+{
+    if (cli_wake_fd >= 0) {
+        int saved = errno;
+        ssize_t w = write(cli_wake_fd, "t", 1);
+        (void)w;
+        errno = saved;
+    }
+    if (interrupt_terminating()) {
+        fileio_remove_temporaries();
+        _exit(128 + sig);
+    }
+    interrupt_terminate(sig);
+    if (running_L)
+        lua_sethook(running_L, stop_hook, LUA_MASKCALL | LUA_MASKRET | LUA_MASKCOUNT, 1);
+}
+
+static void catch_sigterm(lua_State *L)
+{
+    running_L = L;
+    struct sigaction sa = {0};
+    sa.sa_handler = on_sigterm; /* no SA_RESTART: a prompt waiting for input wakes up */
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGTERM, &sa, NULL);
+}
+
+/* After SIGTERM: removes what was being written, says where the work stopped, and returns the
+ * exit status (128 + signal). */
+static int terminated(void)
+{
+    int sig = interrupt_terminating(), n = fileio_remove_temporaries();
+    const char *where = interrupt_where();
+    char files[48];
+    snprintf(files, sizeof files, n ? "%d file%s" : "none was open", n, n == 1 ? "" : "s");
+    fprintf(stderr, "grainlab: terminated (%s)%s%s; partial outputs removed (%s)\n",
+            sig == SIGTERM ? "SIGTERM" : "signal", *where ? " at " : "", where, files);
+    fflush(stderr);
+    return 128 + sig;
 }
 
 static int message_handler(lua_State *L)
@@ -161,6 +220,11 @@ static int message_handler(lua_State *L)
 
 int cli_docall(lua_State *L, int narg, int nres)
 {
+    if (interrupt_terminating()) { /* nothing more runs once the process is ending */
+        lua_pop(L, narg + 1);
+        lua_pushliteral(L, "terminated (SIGTERM)");
+        return LUA_ERRRUN;
+    }
     int base = lua_gettop(L) - narg;
     lua_pushcfunction(L, message_handler);
     lua_insert(L, base);
@@ -180,6 +244,10 @@ int cli_docall(lua_State *L, int narg, int nres)
 
 void cli_print_error(lua_State *L)
 {
+    if (interrupt_terminating()) { /* main says it once, with where the work stopped */
+        lua_pop(L, 1);
+        return;
+    }
     const char *msg = lua_tostring(L, -1);
     fprintf(stderr, "grainlab: %s\n", msg ? msg : "(error object is not a string)");
     fflush(stderr);
@@ -293,6 +361,7 @@ int main(int argc, char **argv)
     lua_State *L = bind_newstate(&opt);
     if (!L)
         return 1;
+    catch_sigterm(L);
     set_params(L, &a, argv[0]);
 
     for (int i = 0; i < a.nchunks && status == 0; i++)
@@ -306,8 +375,15 @@ int main(int argc, char **argv)
         else
             status = run_chunk(L, luaL_loadfilex(L, NULL, "t"));
     }
-    if (a.interactive) /* also after an error: the state is there to inspect */
+    if (a.interactive && !interrupt_terminating()) /* also after an error: state to inspect */
         repl_run(L);
+    if (interrupt_terminating()) {
+        status = terminated();
+        lua_close(L);
+        free(a.chunks);
+        free(a.params);
+        return status;
+    }
 
     int failed = bind_failed_checks(L);
     if (failed) {

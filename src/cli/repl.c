@@ -17,6 +17,7 @@
 #include <readline/readline.h>
 
 #include "cli/cli.h"
+#include "core/interrupt.h"
 
 enum { READ_EOF = 0, READ_LINE = 1, READ_INTERRUPTED = -1 };
 
@@ -77,7 +78,9 @@ static int read_tty(const char *prompt, char **out)
             FD_SET(sigint_pipe[0], &fds);
             maxfd = sigint_pipe[0] > maxfd ? sigint_pipe[0] : maxfd;
         }
-        int n = prompt_sigint ? -1 : select(maxfd + 1, &fds, NULL, NULL, NULL);
+        int n = prompt_sigint || interrupt_terminating()
+                    ? -1
+                    : select(maxfd + 1, &fds, NULL, NULL, NULL);
         if (prompt_sigint) {
             drain_sigint_pipe();
             rl_free_line_state();
@@ -86,6 +89,11 @@ static int read_tty(const char *prompt, char **out)
             fputs("^C\n", stdout);
             fflush(stdout);
             result = READ_INTERRUPTED;
+            break;
+        }
+        if (interrupt_terminating()) { /* SIGTERM ends the session, unlike Ctrl-C */
+            rl_callback_handler_remove();
+            result = READ_EOF;
             break;
         }
         if (n < 0 && errno == EINTR)
@@ -347,6 +355,7 @@ void repl_run(lua_State *L)
     if (use_readline && pipe(sigint_pipe) == 0) {
         for (int k = 0; k < 2; k++)
             fcntl(sigint_pipe[k], F_SETFL, fcntl(sigint_pipe[k], F_GETFL) | O_NONBLOCK);
+        cli_wake_fd = sigint_pipe[1]; /* SIGTERM wakes the prompt too */
     }
     if (use_readline)
         setup_readline(L);
@@ -359,6 +368,8 @@ void repl_run(lua_State *L)
             continue;
         if (status == LUA_OK)
             status = cli_docall(L, 0, LUA_MULTRET);
+        if (interrupt_terminating())
+            break;
         if (status == LUA_OK)
             print_results(L);
         else
@@ -370,6 +381,7 @@ void repl_run(lua_State *L)
         close_readline();
     }
     sigaction(SIGINT, &old, NULL);
+    cli_wake_fd = -1;
     for (int k = 0; k < 2; k++)
         if (sigint_pipe[k] >= 0) {
             close(sigint_pipe[k]);

@@ -8,6 +8,48 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+/* The temporary files being written now, so that a process ended by a signal can remove them
+ * (an unfinished file is never renamed into place, and must not stay beside the outputs). */
+enum { MAX_LIVE = 64 };
+static const char *volatile live[MAX_LIVE];
+
+static void track(const char *tmp)
+{
+    for (int k = 0; k < MAX_LIVE; k++)
+        if (!live[k]) {
+            live[k] = tmp;
+            return;
+        }
+}
+
+static void untrack(const char *tmp)
+{
+    for (int k = 0; k < MAX_LIVE; k++)
+        if (live[k] == tmp)
+            live[k] = NULL;
+}
+
+int fileio_remove_temporaries(void)
+{
+    int n = 0;
+    for (int k = 0; k < MAX_LIVE; k++) {
+        const char *t = live[k];
+        if (t) {
+            live[k] = NULL;
+            n += unlink(t) == 0;
+        }
+    }
+    return n;
+}
+
+int fileio_live_temporaries(void)
+{
+    int n = 0;
+    for (int k = 0; k < MAX_LIVE; k++)
+        n += live[k] != NULL;
+    return n;
+}
+
 core_status atomic_open(atomic_file *f, const char *path, core_error *err)
 {
     f->fp = NULL;
@@ -27,6 +69,7 @@ core_status atomic_open(atomic_file *f, const char *path, core_error *err)
         unlink(f->tmp);
         return core_fail(err, CORE_ERR_IO, "cannot write '%s': %s", path, strerror(e));
     }
+    track(f->tmp);
     return CORE_OK;
 }
 
@@ -48,6 +91,7 @@ core_status atomic_commit(atomic_file *f, core_error *err)
         bad = 1;
         e = errno;
     }
+    untrack(f->tmp); /* after the rename: a signal in between removes a name that is gone */
     if (bad) {
         unlink(f->tmp);
         return core_fail(err, CORE_ERR_IO, "cannot write '%s': %s", f->path, strerror(e));
@@ -60,6 +104,7 @@ void atomic_abort(atomic_file *f)
     if (f->fp) {
         fclose(f->fp);
         f->fp = NULL;
+        untrack(f->tmp);
         unlink(f->tmp);
     }
 }

@@ -8,8 +8,8 @@
 #include "core/error.h"
 
 typedef struct atomic_file {
-    FILE *fp;           /* write here */
-    char path[4096];    /* final name */
+    FILE *fp;        /* write here */
+    char path[4096]; /* final name */
     char tmp[4096 + 32];
 } atomic_file;
 
@@ -21,6 +21,14 @@ core_status atomic_commit(atomic_file *f, core_error *err);
 
 /* Closes and removes the temporary file (for a writer that failed half-way). */
 void atomic_abort(atomic_file *f);
+
+/* Removes the temporary files of writes still open (committed or aborted ones are gone already)
+ * and forgets them; returns how many were removed. Async-signal-safe (unlink only): the CLI
+ * calls it on its way out after SIGTERM. */
+int fileio_remove_temporaries(void);
+
+/* Number of writes open now (tests). */
+int fileio_live_temporaries(void);
 
 /* Writes len bytes to path whole. */
 core_status atomic_write(const char *path, const void *data, size_t len, core_error *err);

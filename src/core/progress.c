@@ -3,6 +3,7 @@
 #include "core/progress.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/ioctl.h>
 #include <unistd.h>
@@ -15,6 +16,14 @@ static const double LINE_INTERVAL_S = 30.0;
 
 void progress_set_default_style(progress_style style) { default_style = style; }
 progress_style progress_default_style(void) { return default_style; }
+
+double progress_unasked_delay(void)
+{
+    const char *env = getenv("GRAINLAB_PROGRESS_DELAY");
+    char *end;
+    double d = env && *env ? strtod(env, &end) : 2.0;
+    return env && *env && (*end || !(d >= 0)) ? 2.0 : d;
+}
 
 void progress_format_duration(char *buf, size_t size, double s)
 {
@@ -58,16 +67,19 @@ static int terminal_width(FILE *out)
     return 80;
 }
 
+/* An estimated total (a time-based run at a varying dt) can be passed: then the work shows as
+ * an amount without percentage, never as 104%. */
+static int known_total(const progress *p) { return p->total > 0 && p->done <= p->total; }
+
 static void draw_bar(progress *p, double now)
 {
     double elapsed = now - p->t_start;
     double rate = elapsed > 0 ? p->done / elapsed : 0;
     char tail[96], eta[32];
-    if (p->total > 0) {
-        progress_format_duration(eta, sizeof eta,
-                                 rate > 0 ? (p->total - p->done) / rate : -1);
-        snprintf(tail, sizeof tail, " %5.1f%% %9.3g %s/s ETA %s",
-                 100 * p->done / p->total, rate, p->unit, eta);
+    if (known_total(p)) {
+        progress_format_duration(eta, sizeof eta, rate > 0 ? (p->total - p->done) / rate : -1);
+        snprintf(tail, sizeof tail, " %5.1f%% %9.3g %s/s ETA %s", 100 * p->done / p->total, rate,
+                 p->unit, eta);
     } else {
         progress_format_duration(eta, sizeof eta, elapsed);
         snprintf(tail, sizeof tail, " %.0f %s %9.3g %s/s %s", p->done, p->unit, rate, p->unit, eta);
@@ -75,7 +87,7 @@ static void draw_bar(progress *p, double now)
     int width = terminal_width(p->out) - 1;
     int room = width - (int)strlen(p->label) - (int)strlen(tail) - 3;
     fprintf(p->out, "\r%s ", p->label);
-    if (p->total > 0 && room >= 10) {
+    if (known_total(p) && room >= 10) {
         int fill = (int)(room * fmin(1.0, p->done / p->total));
         fputc('[', p->out);
         for (int i = 0; i < room; i++)
@@ -93,7 +105,7 @@ static void print_line(progress *p, double now)
     double rate = elapsed > 0 ? p->done / elapsed : 0;
     char el[32], eta[32];
     progress_format_duration(el, sizeof el, elapsed);
-    if (p->total > 0) {
+    if (known_total(p)) {
         progress_format_duration(eta, sizeof eta, rate > 0 ? (p->total - p->done) / rate : -1);
         fprintf(p->out, "%s: %3.0f%% (%.0f/%.0f %s) %.3g %s/s, elapsed %s, ETA %s\n", p->label,
                 100 * p->done / p->total, p->done, p->total, p->unit, rate, p->unit, el, eta);
@@ -106,18 +118,21 @@ static void print_line(progress *p, double now)
 
 void progress_update(progress *p, double done)
 {
+    p->done = p->base + done;
     if (!p->active || p->style == PROGRESS_QUIET)
         return;
-    p->done = done;
+    done = p->done;
     double now = clock_wall();
+    int waiting = now - p->t_start < p->delay;
     if (p->style == PROGRESS_BAR) {
-        if (now - p->t_last_print >= BAR_INTERVAL_S) {
+        if (!waiting && (!p->shown || now - p->t_last_print >= BAR_INTERVAL_S)) {
             draw_bar(p, now);
             p->t_last_print = now;
+            p->shown = 1;
         }
         return;
     }
-    int due = now - p->t_last_print >= LINE_INTERVAL_S;
+    int due = now - p->t_last_print >= LINE_INTERVAL_S || (!p->shown && p->delay > 0);
     if (p->total > 0) {
         int tenth = (int)floor(10 * done / p->total);
         if (tenth >= p->next_tenth && tenth < 10) {
@@ -125,20 +140,46 @@ void progress_update(progress *p, double done)
             due = 1;
         }
     }
-    if (due) {
+    if (due && !waiting) {
         print_line(p, now);
         p->t_last_print = now;
+        p->shown = 1;
     }
+}
+
+/* Nothing is printed for a reporter still in its silent start. */
+static int closing_silent(progress *p, double now)
+{
+    p->active = 0;
+    return p->style == PROGRESS_QUIET || (p->delay > 0 && now - p->t_start < p->delay);
+}
+
+void progress_end_early(progress *p, const char *why)
+{
+    if (!p->active)
+        return;
+    double now = clock_wall();
+    if (closing_silent(p, now))
+        return;
+    char el[32];
+    progress_format_duration(el, sizeof el, now - p->t_start);
+    if (p->style == PROGRESS_BAR)
+        fputs("\r\033[K", p->out);
+    int steps = strcmp(p->unit, "steps") == 0;
+    fprintf(p->out, "%s: %s at %s%.0f", p->label, why, steps ? "step " : "", p->done);
+    if (known_total(p))
+        fprintf(p->out, " of %.0f", p->total);
+    fprintf(p->out, "%s%s after %s\n", steps ? "" : " ", steps ? "" : p->unit, el);
+    fflush(p->out);
 }
 
 void progress_end(progress *p)
 {
     if (!p->active)
         return;
-    p->active = 0;
-    if (p->style == PROGRESS_QUIET)
-        return;
     double now = clock_wall(), elapsed = now - p->t_start;
+    if (closing_silent(p, now))
+        return;
     char el[32];
     progress_format_duration(el, sizeof el, elapsed);
     if (p->style == PROGRESS_BAR)

@@ -75,7 +75,10 @@ typedef struct dem_contact_def {
     double beta;             /* POWER exponent */
     dem_damping_law damping;
     double gamma_n;          /* VISCOUS: N s/m; < 0 = from the materials' restitution */
-    double damping_time;     /* BRILLIANTOV: T in seconds */
+    double damping_time;     /* BRILLIANTOV: a fixed T in seconds (used when restitution < 0) */
+    double restitution;      /* BRILLIANTOV: < 0 = unset; in (0, 1] = every pair (walls too)
+                              * rebounds with e from a head-on impact at impact_velocity */
+    double impact_velocity;  /* BRILLIANTOV with restitution: m/s */
     dem_tangential_law tangential;
     double gamma_t;          /* VISCOUS tangential, N s/m */
     double kt;               /* SPRING stiffness, N/m; < 0 = 2/7 of the normal stiffness scale */
@@ -238,15 +241,24 @@ core_status dem_set_reference(dem_scene *s, core_error *err);
 core_status dem_measure_displacement(const dem_scene *s, const double grad_u[3][3],
                                      const double center[3], double *out[3], core_error *err);
 
-/* Brilliantov damping time T that gives restitution e for a head-on impact at speed v between
- * particles of effective mass m_eff under f = K d^{3/2} + T K d^{1/2} d' (solved by bisection on
- * an RK4 integration of the contact ODE). */
+/* Brilliantov damping, f = K d^{3/2} + T K d^{1/2} d'. In lengths d* = (m_eff v^2 / K)^{2/5}
+ * and times d* / v the head-on contact is x'' = -x^{3/2} - lambda x^{1/2} x', x(0) = 0,
+ * x'(0) = 1, with lambda = T v / d* = T (K / m_eff)^{2/5} v^{1/5}: the restitution depends on the
+ * pair (m_eff, K = 4/3 E* sqrt(R*)) and the speed only through lambda. dem_brilliantov_lambda
+ * solves lambda(e) once (bisection on an RK4 integration; clip: the force is never attractive,
+ * as the contact law's clip); a pair's damping time is then T = lambda (m_eff / K)^{2/5} v^{-1/5}.
+ */
+core_status dem_brilliantov_lambda(double e, bool clip, double *lambda, core_error *err);
+/* The restitution of the dimensionless contact for a given lambda (the inverse of the above). */
+double dem_brilliantov_restitution(double lambda, bool clip);
+/* T for one pair of effective mass m_eff and stiffness K at speed v (clipped law). */
 core_status dem_brilliantov_time(double e, double m_eff, double K, double v, double *T,
                                  core_error *err);
-
-/* The same for the scene's mean pair (mean radius and mass, the first particle's material). */
-core_status dem_damping_time_for(const dem_scene *s, double e, double v, double *T,
-                                 core_error *err);
+/* The normal damping the force loop uses for particles i and j (0-based), or, when wall >= 0,
+ * for particle i against wall `wall` (j ignored): the Brilliantov time T in s, or the viscous
+ * gamma in N s/m (0 without damping). */
+core_status dem_pair_damping(const dem_scene *s, size_t i, size_t j, int wall, double *out,
+                             core_error *err);
 
 /* ---- boundary conditions of the biaxial laboratory (Padbidri Ch. 3) ----------------------- *
  * 2D only. A pressure boundary is a list of directed edges a -> b between particles, outward

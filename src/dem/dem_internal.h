@@ -77,6 +77,7 @@ struct dem_scene {
     dem_material *mats;
     int nmat, cap_mat;
     dem_contact_def contact;
+    double brill_c;        /* Brilliantov from a restitution: lambda(e) v^{-1/5} (dem.h) */
     dem_power slip_pow;    /* x^(1/exponent) of the regularised Coulomb law */
 
     dem_wall *walls;
@@ -97,6 +98,13 @@ struct dem_scene {
     long tt_phase;
 
     struct dem_boundary *bnd; /* boundary conditions (boundary.c); NULL when none */
+
+    /* Energy watch (integrate.c): in a scene without drivers the mechanical energy must not
+     * grow; checked every DEM_WATCH_EVERY steps against the lowest energy since the reference,
+     * which any change to the scene from outside a step resets (dem_invalidate). */
+    int watch_on;
+    long watch_next, watch_min_step;
+    double watch_min, watch_min_t, watch_scale;
 };
 
 /* neighbor.c */

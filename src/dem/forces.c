@@ -7,7 +7,8 @@
 
 #include "dem/dem_internal.h"
 
-/* Normal force magnitude, positive when repulsive. ddelta is the rate of overlap, positive while
+/* Normal force magnitude, positive when repulsive. gamma is the pair's viscous coefficient, or
+ * its Brilliantov damping time. ddelta is the rate of overlap, positive while
  * the particles approach: ddelta = -(v_i - v_j).n with n from j to i. (Padbidri's Eq. 2.A3 prints
  * +(v^k - v^j).n; with that sign the damping would push separating grains together.) */
 static inline double normal_force(const dem_contact_def *c, double k, double gamma, double delta,
@@ -28,7 +29,7 @@ static inline double normal_force(const dem_contact_def *c, double k, double gam
     if (c->damping == DEM_DAMPING_VISCOUS)
         f += gamma * ddelta; /* Eq. 1b */
     else if (c->damping == DEM_DAMPING_BRILLIANTOV)
-        f += c->damping_time * k * sqrt_delta * ddelta; /* Eq. 2.16 */
+        f += gamma * k * sqrt_delta * ddelta; /* Eq. 2.16; gamma = the pair's damping time T */
     if (c->clip && f < 0)
         f = 0;
     return f;

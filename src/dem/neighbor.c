@@ -47,6 +47,11 @@ static void law_parameters(const dem_scene *s, const dem_material *a, const dem_
             *gamma = c->gamma_n;
         else /* the linear law's closed form; for other laws it sets the scale */
             *gamma = linear_gamma(*k, m_eff, fmin(a->restitution, b->restitution));
+    } else if (c->damping == DEM_DAMPING_BRILLIANTOV) {
+        /* gamma carries the damping time T. From a restitution each pair gets its own
+         * T = lambda (m_eff / K)^{2/5} v^{-1/5} (dem.h), so a head-on impact at the impact
+         * velocity rebounds with e for every pair; brill_c = lambda v^{-1/5} is set once. */
+        *gamma = c->restitution > 0 ? s->brill_c * pow(m_eff / *k, 0.4) : c->damping_time;
     }
     *mu_out = mu;
 }
@@ -387,7 +392,8 @@ core_status dem_build_pairs(dem_scene *s, core_error *err)
             dem_free_pairs(&old);
             return core_fail(err, CORE_ERR_NOMEM, "cannot allocate the incidence list");
         }
-        memcpy(fill, p->jstart, n * sizeof *fill);
+        if (n > 0)
+            memcpy(fill, p->jstart, n * sizeof *fill);
         for (size_t q = 0; q < npairs; q++)
             p->jpair[fill[p->j[q]]++] = (uint32_t)q;
         free(fill);
@@ -422,7 +428,7 @@ core_status dem_build_pairs(dem_scene *s, core_error *err)
             wl->point_build[d] = wl->point[d];
     }
 
-    for (int d = 0; d < D; d++)
+    for (int d = 0; d < D && n > 0; d++) /* an empty scene has no arrays yet (memcpy of NULL is UB) */
         memcpy(s->x_build[d], s->x[d], n * sizeof(double));
     dem_free_pairs(&old);
     s->need_rebuild = 0;

@@ -22,10 +22,21 @@ dem_material dem_default_material(void)
 
 dem_contact_def dem_default_contact_def(void)
 {
-    return (dem_contact_def){.normal = DEM_NORMAL_HERTZ, .stiffness = 0, .beta = 1.5,
-                             .damping = DEM_DAMPING_NONE, .gamma_n = -1, .damping_time = 0,
-                             .tangential = DEM_TANGENT_NONE, .gamma_t = 0, .kt = -1,
-                             .v_r = 1e-3, .exponent = 10, .clip = true, .rolling = false};
+    return (dem_contact_def){.normal = DEM_NORMAL_HERTZ,
+                             .stiffness = 0,
+                             .beta = 1.5,
+                             .damping = DEM_DAMPING_NONE,
+                             .gamma_n = -1,
+                             .damping_time = 0,
+                             .restitution = -1,
+                             .impact_velocity = 1,
+                             .tangential = DEM_TANGENT_NONE,
+                             .gamma_t = 0,
+                             .kt = -1,
+                             .v_r = 1e-3,
+                             .exponent = 10,
+                             .clip = true,
+                             .rolling = false};
 }
 
 void dem_invalidate(dem_scene *s, int list)
@@ -33,6 +44,7 @@ void dem_invalidate(dem_scene *s, int list)
     s->forces_ready = 0;
     s->gear_ready = 0;
     s->prev_ready = 0;
+    s->watch_on = 0; /* the energy may change from outside: a new reference */
     if (list)
         s->need_rebuild = 1;
 }
@@ -147,9 +159,21 @@ core_status dem_set_contact(dem_scene *s, const dem_contact_def *c, core_error *
     if (c->damping == DEM_DAMPING_BRILLIANTOV) {
         if (c->normal != DEM_NORMAL_HERTZ)
             return core_fail(err, CORE_ERR_ARG, "brilliantov damping needs the hertz normal law");
-        if (!(c->damping_time >= 0) || !isfinite(c->damping_time))
+        if (c->restitution < 0 && (!(c->damping_time >= 0) || !isfinite(c->damping_time)))
             return core_fail(err, CORE_ERR_ARG, "damping_time must be >= 0, got %g",
                              c->damping_time);
+        if (c->restitution >= 0 && !(c->impact_velocity > 0 && isfinite(c->impact_velocity)))
+            return core_fail(err, CORE_ERR_ARG, "impact_velocity must be > 0, got %g",
+                             c->impact_velocity);
+    }
+    /* Solved once here; each pair's damping time is then a power of its m_eff / K (neighbor.c). */
+    double brill_c = 0;
+    if (c->damping == DEM_DAMPING_BRILLIANTOV && !(c->restitution < 0)) {
+        double lambda;
+        core_status st = dem_brilliantov_lambda(c->restitution, c->clip, &lambda, err);
+        if (st != CORE_OK)
+            return st;
+        brill_c = lambda * pow(c->impact_velocity, -0.2);
     }
     if (c->damping == DEM_DAMPING_VISCOUS && !(c->gamma_n < 0 || isfinite(c->gamma_n)))
         return core_fail(err, CORE_ERR_ARG, "gamma_n must be finite, got %g", c->gamma_n);
@@ -165,6 +189,7 @@ core_status dem_set_contact(dem_scene *s, const dem_contact_def *c, core_error *
     }
     int spring_before = s->contact.tangential == DEM_TANGENT_SPRING;
     s->contact = *c;
+    s->brill_c = brill_c;
     dem_power_init(&s->slip_pow, c->tangential == DEM_TANGENT_REGULARIZED ? 1 / c->exponent : 0);
     if (c->tangential != DEM_TANGENT_NONE || c->rolling) {
         core_status st = dem_ensure_rotation(s, err);

@@ -71,19 +71,37 @@ int bind_field_error(lua_State *L, int arg, const char *call, const char *field,
 void bind_describe(lua_State *L, int idx, char *buf, size_t size);
 
 /* ---- running and bulk results ------------------------------------------------------------ */
+struct progress;
 typedef struct bind_run {
     const char *label; /* progress label, e.g. "dem run" */
     long steps;        /* at most this many steps (LUA_MAXINTEGER: until advance stops short) */
     long expect;       /* the expected number, for progress and the default `every` */
-    /* Advances up to n steps, setting *done to those taken (fewer: the run reached its end). */
-    core_status (*advance)(void *ctx, long n, long *done, core_error *err);
+    /* Advances up to n steps, setting *done to those taken (fewer: the run reached its end, or
+     * an error). A kernel with kernel_progress set calls progress_update(p, k) after its k-th
+     * step; others are advanced in pieces and p is updated between them. */
+    core_status (*advance)(void *ctx, long n, struct progress *p, long *done, core_error *err);
     void *ctx;
+    int kernel_progress;
+    double dt;         /* the run's fixed time step, checked at its start (0: chosen every step) */
+    int forced;        /* force = true: dt was accepted beyond the stability limit */
 } bind_run;
 
 /* Reads `every`, `on_step` and `progress` from the options table at arg and advances in chunks
  * of `every` steps, calling on_step(scene) after each; kernel errors are raised named after call.
+ * While it runs the scene is marked running (bind_running). Progress: asked (progress = true) from
+ * the start, unasked after progress_unasked_delay() seconds and only for the outermost run, none
+ * with --quiet; the closing line says "done", or "interrupted|stopped|failed at step k of N".
  * Returns 1 when on_step returned false. */
 int bind_run_chunks(lua_State *L, int scene, int arg, const char *call, const bind_run *r);
+
+/* The run in progress of the scene at idx (its on_step is calling), or NULL. */
+const bind_run *bind_running(lua_State *L, int idx);
+
+/* When the scene at idx is running, raises
+ *   "CALL: this dem.scene is running (called from its on_step); WHY"
+ * ("already running" for call "run"). A binding puts it first in each call that a run in
+ * progress cannot take. */
+void bind_refuse_running(lua_State *L, int idx, const char *call, const char *why);
 
 /* Sets field `name` of the table on top to an array of the n values. */
 void bind_push_array(lua_State *L, const double *a, size_t n, const char *name);

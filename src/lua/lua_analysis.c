@@ -31,12 +31,44 @@ static double *scratch(lua_State *L, size_t n)
     return lua_newuserdatauv(L, (n ? n : 1) * sizeof(double), 0);
 }
 
-/* Reads field `name` of the table at arg as an array of exactly n finite numbers (n = 0: any
- * length, returned in *len). */
-static double *read_array(lua_State *L, int arg, const char *call, const char *name, size_t *n,
-                          int required)
+/* The argument number the user sees (a method's self does not count), as args.c does. */
+static int user_argn(lua_State *L, int arg)
 {
-    int t = lua_getfield(L, arg, name);
+    lua_Debug ar;
+    if (lua_getstack(L, 0, &ar) && lua_getinfo(L, "n", &ar) && ar.namewhat &&
+        strcmp(ar.namewhat, "method") == 0)
+        return arg - 1;
+    return arg;
+}
+
+/* "bad field 'F' in argument #N to 'call' (EXPECTED expected, got GOT)" with GOT given. */
+static int field_fail(lua_State *L, int arg, const char *call, const char *name,
+                      const char *expected, const char *got)
+{
+    return luaL_error(L, "bad field '%s' in argument #%d to '%s' (%s expected, got %s)", name,
+                      user_argn(L, arg), call, expected, got);
+}
+
+static void nested_check_fields(lua_State *L, int tab, int arg, const char *call, const char *name,
+                                const char *const fields[]);
+
+/* The field error for the value on top, entry k (1-based) of the array `name`. */
+static int entry_error(lua_State *L, int arg, const char *call, const char *name,
+                       const char *expected, size_t k)
+{
+    char val[64], got[96];
+    bind_describe(L, -1, val, sizeof val);
+    snprintf(got, sizeof got, "%s at entry %zu", val, k);
+    return field_fail(L, arg, call, name, expected, got);
+}
+
+/* Reads field `key` of the table at tab as an array of exactly n finite numbers (n = 0: any
+ * length, returned in *n); errors name field `name` of argument arg. The buffer stays on the
+ * stack (freed by the GC, also on errors). */
+static double *read_array_at(lua_State *L, int tab, const char *key, int arg, const char *call,
+                             const char *name, size_t *n, int required)
+{
+    int t = lua_getfield(L, tab, key);
     if (t == LUA_TNIL && !required) {
         lua_pop(L, 1);
         return NULL;
@@ -46,22 +78,92 @@ static double *read_array(lua_State *L, int arg, const char *call, const char *n
         snprintf(what, sizeof what, "array of %zu finite numbers", *n);
     else
         snprintf(what, sizeof what, "array of finite numbers");
-    if (t != LUA_TTABLE || (*n && lua_rawlen(L, -1) != *n))
+    if (t != LUA_TTABLE)
         bind_field_error(L, arg, call, name, what);
     size_t len = lua_rawlen(L, -1);
-    double *v = scratch(L, len);
-    lua_insert(L, -2);
-    for (size_t i = 0; i < len; i++) {
-        lua_rawgeti(L, -1, (lua_Integer)i + 1);
-        int isnum;
-        v[i] = lua_tonumberx(L, -1, &isnum);
-        lua_pop(L, 1);
-        if (!isnum || !isfinite(v[i]))
-            bind_field_error(L, arg, call, name, what);
+    if (*n && len != *n) {
+        char got[64];
+        snprintf(got, sizeof got, "%zu values", len);
+        field_fail(L, arg, call, name, what, got);
     }
-    lua_pop(L, 1); /* the table; the buffer stays */
+    int arr = lua_gettop(L);
+    double *v = scratch(L, len);
+    lua_insert(L, arr); /* the buffer below the array */
+    arr++;
+    for (size_t i = 0; i < len; i++) {
+        lua_rawgeti(L, arr, (lua_Integer)i + 1);
+        int isnum = lua_type(L, -1) == LUA_TNUMBER;
+        v[i] = lua_tonumber(L, -1);
+        if (!isnum || !isfinite(v[i]))
+            entry_error(L, arg, call, name, what, i + 1);
+        lua_pop(L, 1);
+    }
+    lua_pop(L, 1); /* the array; the buffer stays */
     *n = len;
     return v;
+}
+
+static double *read_array(lua_State *L, int arg, const char *call, const char *name, size_t *n,
+                          int required)
+{
+    return read_array_at(L, arg, name, arg, call, name, n, required);
+}
+
+/* Reads field `key` of the table at tab as an array of particle ids, integers in [1, max],
+ * into a 0-based buffer left on the stack; distinct: a repeated id is refused, naming both
+ * entries. Errors name field `label` of argument arg. Absent and not required: NULL. The
+ * length goes to *n. */
+static long *read_ids_at(lua_State *L, int tab, const char *key, int arg, const char *call,
+                         const char *label, size_t max, int distinct, int required, size_t *n)
+{
+    tab = lua_absindex(L, tab);
+    int t = lua_getfield(L, tab, key);
+    if (t == LUA_TNIL && !required) {
+        lua_pop(L, 1);
+        return NULL;
+    }
+    if (t != LUA_TTABLE) {
+        char got[64];
+        bind_describe(L, -1, got, sizeof got);
+        field_fail(L, arg, call, label, "array of particle ids", got);
+    }
+    int arr = lua_gettop(L);
+    size_t len = lua_rawlen(L, arr);
+    long *ids = lua_newuserdatauv(L, (len ? len : 1) * sizeof *ids, 0);
+    lua_insert(L, arr); /* the buffer below the array */
+    arr++;
+    /* first[id - 1] = the entry that first named id (1-based), for distinct */
+    size_t *first = distinct ? lua_newuserdatauv(L, (max ? max : 1) * sizeof *first, 0) : NULL;
+    if (first)
+        memset(first, 0, (max ? max : 1) * sizeof *first);
+    char expected[64];
+    snprintf(expected, sizeof expected, "particle ids in [1, %zu]", max);
+    for (size_t k = 0; k < len; k++) {
+        lua_rawgeti(L, arr, (lua_Integer)k + 1);
+        int isint = 0;
+        lua_Integer id = lua_type(L, -1) == LUA_TNUMBER ? lua_tointegerx(L, -1, &isint) : 0;
+        if (!isint || id < 1 || (lua_Unsigned)id > max)
+            entry_error(L, arg, call, label, expected, k + 1);
+        if (first && first[id - 1]) {
+            char got[96];
+            snprintf(got, sizeof got, "%lld at entries %zu and %zu", (long long)id, first[id - 1],
+                     k + 1);
+            field_fail(L, arg, call, label, "distinct particle ids", got);
+        }
+        if (first)
+            first[id - 1] = k + 1;
+        lua_pop(L, 1);
+        ids[k] = (long)id - 1;
+    }
+    lua_pop(L, first ? 2 : 1); /* the marks and the array; the ids stay */
+    *n = len;
+    return ids;
+}
+
+static long *read_ids(lua_State *L, int arg, const char *call, const char *name, size_t max,
+                      int distinct, int required, size_t *n)
+{
+    return read_ids_at(L, arg, name, arg, call, name, max, distinct, required, n);
 }
 
 static void push_tensor(lua_State *L, const double t[4])
@@ -126,29 +228,19 @@ static int l_delaunay(lua_State *L)
         for (size_t i = 0; r && i < n; i++)
             if (!(r[i] > 0)) {
                 lua_getfield(L, 1, "radius");
-                return bind_field_error(L, 1, call, "radius", "array of positive radii");
+                lua_rawgeti(L, -1, (lua_Integer)i + 1);
+                return entry_error(L, 1, call, "radius", "array of positive radii", i + 1);
             }
     }
-    if (has_opts && lua_getfield(L, 2, "ids") != LUA_TNIL) {
-        if (lua_type(L, -1) != LUA_TTABLE)
-            return bind_field_error(L, 2, call, "ids", "array of particle ids");
-        nids = lua_rawlen(L, -1);
-        ids = lua_newuserdatauv(L, (nids ? nids : 1) * sizeof *ids, 0);
-        lua_insert(L, -2);
+    /* ids: entries of the table (or scene particles), distinct, so that the mesh's vertices
+     * map back to one particle each. */
+    if (has_opts && (ids = read_ids(L, 2, call, "ids", n, 1, 0, &nids))) {
         double *sx = scratch(L, nids), *sy = scratch(L, nids), *sr = r ? scratch(L, nids) : NULL;
         for (size_t k = 0; k < nids; k++) {
-            lua_rawgeti(L, -4, (lua_Integer)k + 1);
-            lua_Integer id = lua_tointeger(L, -1);
-            lua_pop(L, 1);
-            if (id < 1 || (size_t)id > n) {
-                lua_rawgeti(L, -4, (lua_Integer)k + 1);
-                return bind_field_error(L, 2, call, "ids", "array of particle ids in range");
-            }
-            ids[k] = (long)id - 1;
-            sx[k] = x[id - 1];
-            sy[k] = y[id - 1];
+            sx[k] = x[ids[k]];
+            sy[k] = y[ids[k]];
             if (sr)
-                sr[k] = r[id - 1];
+                sr[k] = r[ids[k]];
         }
         x = sx;
         y = sy;
@@ -164,7 +256,7 @@ static int l_delaunay(lua_State *L)
     luaL_setmetatable(L, MESH);
     core_error err;
     if (ids) {
-        u->ids = malloc(nids * sizeof *u->ids);
+        u->ids = malloc((nids ? nids : 1) * sizeof *u->ids);
         if (!u->ids)
             return luaL_error(L, "%s: out of memory", call);
         memcpy(u->ids, ids, nids * sizeof *ids);
@@ -176,8 +268,19 @@ static int l_delaunay(lua_State *L)
 
 /* Current positions (and velocities) of the mesh's vertices from a dem.scene or a table
  * {x =, y = [, vx =, vy =]} at arg; buffers stay on the stack. Without arg: the build positions. */
+static void config_at(lua_State *L, lmesh *u, int arg, int uarg, const char *nest, const char *call,
+                      const double **x, const double **y, const double **vx, const double **vy);
+
 static void config(lua_State *L, lmesh *u, int arg, const char *call, const double **x,
                    const double **y, const double **vx, const double **vy)
+{
+    config_at(L, u, arg, arg, NULL, call, x, y, vx, vy);
+}
+
+/* config() of the state at stack index arg, which is argument uarg itself (nest NULL) or its
+ * field `nest` (raster's state): errors name 'x' or 'state.x' of argument uarg. */
+static void config_at(lua_State *L, lmesh *u, int arg, int uarg, const char *nest, const char *call,
+                      const double **x, const double **y, const double **vx, const double **vy)
 {
     const analysis_mesh *m = u->m;
     size_t n = m->np;
@@ -193,8 +296,13 @@ static void config(lua_State *L, lmesh *u, int arg, const char *call, const doub
         size_t need = 0;
         for (size_t k = 0; k < n; k++)
             need = u->ids ? (size_t)u->ids[k] + 1 > need ? (size_t)u->ids[k] + 1 : need : n;
-        if (dem_count(s) < need || (!u->ids && dem_count(s) != n))
-            luaL_error(L, "%s: the mesh has %zu particles, the scene %zu", call, n, dem_count(s));
+        /* lua_pushfstring knows %I (lua_Integer), not %zu */
+        if (!u->ids && dem_count(s) != n)
+            luaL_error(L, "%s: the mesh has %I particles, the scene %I", call, (lua_Integer)n,
+                       (lua_Integer)dem_count(s));
+        if (dem_count(s) < need)
+            luaL_error(L, "%s: the mesh uses particle %I, the scene has %I", call,
+                       (lua_Integer)need, (lua_Integer)dem_count(s));
         const double *src[4] = {dem_positions(s, 0), dem_positions(s, 1), dem_velocities(s, 0),
                                 dem_velocities(s, 1)};
         double *dst[4];
@@ -212,17 +320,27 @@ static void config(lua_State *L, lmesh *u, int arg, const char *call, const doub
         return;
     }
     static const char *const fields[] = {"x", "y", "vx", "vy", NULL};
-    bind_check_table(L, arg, call);
-    bind_check_fields(L, arg, call, fields);
-    size_t len = n;
-    *x = read_array(L, arg, call, "x", &len, 1);
-    *y = read_array(L, arg, call, "y", &len, 1);
-    if (vx) {
-        *vx = read_array(L, arg, call, "vx", &len, 0);
-        *vy = read_array(L, arg, call, "vy", &len, 0);
-        if (!*vx || !*vy)
-            luaL_error(L, "%s: give vx and vy (or a dem.scene)", call);
+    if (nest) {
+        if (!lua_istable(L, arg)) {
+            char got[64];
+            bind_describe(L, arg, got, sizeof got);
+            field_fail(L, uarg, call, nest, "dem.scene or {x =, y =}", got);
+        }
+        nested_check_fields(L, arg, uarg, call, nest, fields);
+    } else {
+        bind_check_table(L, arg, call);
+        bind_check_fields(L, arg, call, fields);
     }
+    static const char *const keys[4] = {"x", "y", "vx", "vy"};
+    const double **out[4] = {x, y, vx, vy};
+    size_t len = n;
+    for (int q = 0; q < (vx ? 4 : 2); q++) {
+        char label[48];
+        snprintf(label, sizeof label, "%s%s%s", nest ? nest : "", nest ? "." : "", keys[q]);
+        *out[q] = read_array_at(L, arg, keys[q], uarg, call, label, &len, q < 2);
+    }
+    if (vx && (!*vx || !*vy))
+        luaL_error(L, "%s: give vx and vy (or a dem.scene)", call);
 }
 
 static int l_mesh_info(lua_State *L)
@@ -480,37 +598,42 @@ static int l_mesh_raster(lua_State *L)
     lmesh *u = check_mesh(L, 1);
     const analysis_mesh *m = u->m;
     luaL_checktype(L, 2, LUA_TTABLE);
+    /* lua_pushfstring knows %I (lua_Integer), not %zu */
     if (lua_rawlen(L, 2) != m->ncells)
-        return luaL_error(L, "bad argument #1 to '%s' (array of %zu cell values expected, got "
-                             "%zu values)", call, m->ncells, (size_t)lua_rawlen(L, 2));
+        return luaL_error(L,
+                          "bad argument #1 to '%s' (array of %I cell values expected, got "
+                          "%I values)",
+                          call, (lua_Integer)m->ncells, (lua_Integer)lua_rawlen(L, 2));
     static const char *const fields[] = {"nx", "ny", "extent", "state", NULL};
     bind_check_table(L, 3, call);
     bind_check_fields(L, 3, call, fields);
     int nx = (int)bind_field_integer(L, 3, call, "nx", 0, 1, 8192, BIND_REQUIRED);
     int ny = (int)bind_field_integer(L, 3, call, "ny", 0, 1, 8192, BIND_REQUIRED);
-    double ext[4];
-    if (lua_getfield(L, 3, "extent") != LUA_TTABLE)
-        return bind_field_error(L, 3, call, "extent", "{{x0, y0}, {x1, y1}}");
-    for (int c = 0; c < 2; c++) {
-        lua_rawgeti(L, -1, c + 1);
-        for (int d = 0; d < 2; d++) {
-            lua_rawgeti(L, -1, d + 1);
-            ext[2 * c + d] = lua_tonumber(L, -1);
-            lua_pop(L, 1);
-        }
-        lua_pop(L, 1);
-    }
-    lua_pop(L, 1);
+    double ext[4], lo[2], hi[2];
+    bind_field_box(L, 3, call, "extent", 2, lo, hi);
+    ext[0] = lo[0];
+    ext[1] = lo[1];
+    ext[2] = hi[0];
+    ext[3] = hi[1];
+    /* Cell values: numbers; NaN is a value (no data), as the rasterizer writes outside cells. */
     double *vals = scratch(L, m->ncells);
     for (size_t c = 0; c < m->ncells; c++) {
         lua_rawgeti(L, 2, (lua_Integer)c + 1);
+        if (lua_type(L, -1) != LUA_TNUMBER) {
+            char got[64];
+            bind_describe(L, -1, got, sizeof got);
+            return luaL_error(L,
+                              "bad argument #1 to '%s' (array of numbers expected, got %s at "
+                              "entry %I)",
+                              call, got, (lua_Integer)c + 1);
+        }
         vals[c] = lua_tonumber(L, -1);
         lua_pop(L, 1);
     }
     lua_getfield(L, 3, "state");
     int state = lua_gettop(L);
     const double *x, *y;
-    config(L, u, state, call, &x, &y, NULL, NULL);
+    config_at(L, u, state, 3, "state", call, &x, &y, NULL, NULL);
     double *out = scratch(L, (size_t)nx * (size_t)ny);
     core_error err;
     if (analysis_rasterize(m, x, y, vals, nx, ny, ext, out, &err))
@@ -718,28 +841,91 @@ static core_status delaunay_update(void *ctxp, dem_scene *s, core_error *err)
     return st;
 }
 
-static void read_matrix(lua_State *L, int arg, const char *call, const char *field, double out[4])
+/* Field `key` of the table at tab as a 2x2 matrix {{xx, xy}, {yx, yy}} of finite numbers;
+ * errors name field `label` of argument arg (mbc is a table inside argument #1). */
+static void read_matrix(lua_State *L, int tab, const char *key, int arg, const char *call,
+                        const char *label, double out[4])
 {
-    if (lua_getfield(L, arg, field) != LUA_TTABLE)
-        bind_field_error(L, arg, call, field, "2x2 matrix {{xx, xy}, {yx, yy}}");
+    const char *want = "2x2 matrix {{xx, xy}, {yx, yy}} of finite numbers";
+    char got[128];
+    tab = lua_absindex(L, tab);
+    if (lua_getfield(L, tab, key) != LUA_TTABLE || lua_rawlen(L, -1) != 2) {
+        if (lua_type(L, -1) == LUA_TTABLE)
+            snprintf(got, sizeof got, "%d rows", (int)lua_rawlen(L, -1));
+        else
+            bind_describe(L, -1, got, sizeof got);
+        field_fail(L, arg, call, label, want, got);
+    }
     for (int r = 0; r < 2; r++) {
-        if (lua_rawgeti(L, -1, r + 1) != LUA_TTABLE) {
-            lua_pop(L, 1);
-            bind_field_error(L, arg, call, field, "2x2 matrix {{xx, xy}, {yx, yy}}");
+        if (lua_rawgeti(L, -1, r + 1) != LUA_TTABLE || lua_rawlen(L, -1) != 2) {
+            char row[64];
+            bind_describe(L, -1, row, sizeof row);
+            if (lua_type(L, -1) == LUA_TTABLE)
+                snprintf(got, sizeof got, "%d entries in row %d", (int)lua_rawlen(L, -1), r + 1);
+            else
+                snprintf(got, sizeof got, "%s as row %d", row, r + 1);
+            field_fail(L, arg, call, label, want, got);
         }
         for (int c = 0; c < 2; c++) {
             lua_rawgeti(L, -1, c + 1);
-            int isnum;
-            out[2 * r + c] = lua_tonumberx(L, -1, &isnum);
-            lua_pop(L, 1);
-            if (!isnum || !isfinite(out[2 * r + c])) {
-                lua_pop(L, 1);
-                bind_field_error(L, arg, call, field, "2x2 matrix of finite numbers");
+            out[2 * r + c] = lua_tonumber(L, -1);
+            if (lua_type(L, -1) != LUA_TNUMBER || !isfinite(out[2 * r + c])) {
+                char v[48];
+                bind_describe(L, -1, v, sizeof v);
+                snprintf(got, sizeof got, "%s at row %d, column %d", v, r + 1, c + 1);
+                field_fail(L, arg, call, label, want, got);
             }
+            lua_pop(L, 1);
         }
         lua_pop(L, 1);
     }
     lua_pop(L, 1);
+}
+
+/* Readers for a table nested in argument arg (mbc): errors name the field as 'mbc.K' of that
+ * argument (args.c's readers would number the nested table by its stack slot). */
+static void nested_check_fields(lua_State *L, int tab, int arg, const char *call, const char *name,
+                                const char *const fields[])
+{
+    tab = lua_absindex(L, tab);
+    lua_pushnil(L);
+    while (lua_next(L, tab)) {
+        lua_pop(L, 1);
+        int known = 0;
+        for (int i = 0; fields[i] && !known && lua_type(L, -1) == LUA_TSTRING; i++)
+            known = strcmp(lua_tostring(L, -1), fields[i]) == 0;
+        if (!known) {
+            char key[64], list[256] = "";
+            bind_describe(L, -1, key, sizeof key);
+            for (int i = 0; fields[i]; i++) {
+                if (i)
+                    strncat(list, ", ", sizeof list - strlen(list) - 1);
+                strncat(list, fields[i], sizeof list - strlen(list) - 1);
+            }
+            luaL_error(L,
+                       "bad field '%s' in argument #%d to '%s' (unknown field %s; valid "
+                       "fields: %s)",
+                       name, user_argn(L, arg), call, key, list);
+        }
+    }
+}
+
+/* Field key of the nested table at tab: a finite number, > 0 (positive) or >= 0, def if absent. */
+static double nested_number(lua_State *L, int tab, const char *key, int arg, const char *call,
+                            const char *label, double def, int positive)
+{
+    if (lua_getfield(L, tab, key) == LUA_TNIL) {
+        lua_pop(L, 1);
+        return def;
+    }
+    double v = lua_tonumber(L, -1);
+    if (lua_type(L, -1) != LUA_TNUMBER || !isfinite(v) || (positive ? !(v > 0) : !(v >= 0))) {
+        char got[64];
+        bind_describe(L, -1, got, sizeof got);
+        field_fail(L, arg, call, label, positive ? "positive number" : "non-negative number", got);
+    }
+    lua_pop(L, 1);
+    return v;
 }
 
 static void push_boundary_info(lua_State *L, dem_scene *s)
@@ -823,23 +1009,28 @@ static int l_boundary(lua_State *L)
     int has_mbc = lua_getfield(L, 2, "mbc") != LUA_TNIL;
     int mbc = lua_gettop(L);
     if (has_mbc) {
-        bind_check_table(L, mbc, call);
-        bind_check_fields(L, mbc, call, mfields);
+        if (!lua_istable(L, mbc)) {
+            char got[64];
+            bind_describe(L, mbc, got, sizeof got);
+            return field_fail(L, 2, call, "mbc", "table", got);
+        }
+        nested_check_fields(L, mbc, 2, call, "mbc", mfields);
         int has_e = lua_getfield(L, mbc, "strain_rate") != LUA_TNIL;
         int has_g = lua_getfield(L, mbc, "gradient") != LUA_TNIL;
         lua_pop(L, 2);
         if (has_e == has_g)
             return luaL_error(L, "%s: mbc needs exactly one of strain_rate and gradient", call);
         def.gradient = has_g;
-        read_matrix(L, mbc, call, has_g ? "gradient" : "strain_rate", def.target);
+        read_matrix(L, mbc, has_g ? "gradient" : "strain_rate", 2, call,
+                    has_g ? "mbc.gradient" : "mbc.strain_rate", def.target);
         if (lua_getfield(L, mbc, "mask") != LUA_TNIL)
-            read_matrix(L, mbc, call, "mask", def.mask);
+            read_matrix(L, mbc, "mask", 2, call, "mbc.mask", def.mask);
         lua_pop(L, 1);
-        K = bind_field_number(L, mbc, call, "K", 0, BIND_POSITIVE);
-        kappa = bind_field_number(L, mbc, call, "kappa", 20, BIND_POSITIVE);
-        rate = bind_field_number(L, mbc, call, "rate", 0, BIND_POSITIVE);
-        mdt = bind_field_number(L, mbc, call, "dt", 0, BIND_POSITIVE);
-        def.tau = bind_field_number(L, mbc, call, "tau", mdt > 0 ? 1000 * mdt : 0, BIND_NONNEG);
+        K = nested_number(L, mbc, "K", 2, call, "mbc.K", 0, 1);
+        kappa = nested_number(L, mbc, "kappa", 2, call, "mbc.kappa", 20, 1);
+        rate = nested_number(L, mbc, "rate", 2, call, "mbc.rate", 0, 1);
+        mdt = nested_number(L, mbc, "dt", 2, call, "mbc.dt", 0, 1);
+        def.tau = nested_number(L, mbc, "tau", 2, call, "mbc.tau", mdt > 0 ? 1000 * mdt : 0, 0);
         if (rate == 0)
             for (int q = 0; q < 4; q++)
                 rate = fmax(rate, fabs(def.target[q]) * (def.mask[q] != 0));
@@ -852,51 +1043,36 @@ static int l_boundary(lua_State *L)
         lua_getfield(L, et, "b");
         if (!lua_istable(L, -1) || !lua_istable(L, -2) || lua_rawlen(L, -1) != lua_rawlen(L, -2))
             return bind_field_error(L, 2, call, "edges", "{a = {ids}, b = {ids}} of equal length");
-        size_t n = lua_rawlen(L, -1);
-        long *a = lua_newuserdatauv(L, (n ? 2 * n : 1) * sizeof *a, 0), *b = a + n;
-        for (size_t k = 0; k < n; k++) {
-            lua_rawgeti(L, et + 1, (lua_Integer)k + 1);
-            lua_rawgeti(L, et + 2, (lua_Integer)k + 1);
-            a[k] = (long)lua_tointeger(L, -2) - 1;
-            b[k] = (long)lua_tointeger(L, -1) - 1;
-            lua_pop(L, 2);
-        }
+        lua_pop(L, 2);
+        /* Each id an integer in range before it becomes a C index. */
+        size_t n = 0, nb2 = 0;
+        const long *a = read_ids_at(L, et, "a", 2, call, "edges.a", dem_count(s), 0, 1, &n);
+        const long *b = read_ids_at(L, et, "b", 2, call, "edges.b", dem_count(s), 0, 1, &nb2);
         int closed = bind_field_boolean(L, 2, call, "closed", 0);
         def.update = NULL;
         core_error err;
         if (dem_set_boundary(s, &def, &err) || dem_set_boundary_edges(s, n, a, b, NULL, closed, &err))
             return bind_raise(L, call, &err);
     } else { /* Delaunay, rebuilt every `every` steps */
+        /* Read everything that can raise before the context is allocated. */
+        int band = bind_field_boolean(L, 2, call, "band", 1);
+        size_t nids = 0;
+        const long *ids = read_ids(L, 2, call, "ids", dem_count(s), 1, 0, &nids);
         delaunay_ctx *c = calloc(1, sizeof *c);
         if (!c)
             return luaL_error(L, "%s: out of memory", call);
         c->alpha = alpha;
         c->lateral = lateral;
-        c->band = bind_field_boolean(L, 2, call, "band", 1);
-        if (lua_getfield(L, 2, "ids") != LUA_TNIL) {
-            if (!lua_istable(L, -1)) {
-                free(c);
-                return bind_field_error(L, 2, call, "ids", "array of particle ids");
-            }
-            c->nids = lua_rawlen(L, -1);
-            c->ids = malloc((c->nids ? c->nids : 1) * sizeof *c->ids);
+        c->band = band;
+        if (ids) {
+            c->nids = nids;
+            c->ids = malloc((nids ? nids : 1) * sizeof *c->ids);
             if (!c->ids) {
                 free(c);
                 return luaL_error(L, "%s: out of memory", call);
             }
-            for (size_t k = 0; k < c->nids; k++) {
-                lua_rawgeti(L, -1, (lua_Integer)k + 1);
-                lua_Integer id = lua_tointeger(L, -1);
-                lua_pop(L, 1);
-                if (id < 1 || (size_t)id > dem_count(s)) {
-                    free_delaunay_ctx(c);
-                    lua_rawgeti(L, -1, (lua_Integer)k + 1);
-                    return bind_field_error(L, 2, call, "ids", "array of particle ids in range");
-                }
-                c->ids[k] = (long)id - 1;
-            }
+            memcpy(c->ids, ids, nids * sizeof *ids);
         }
-        lua_pop(L, 1);
         def.update = delaunay_update;
         def.ctx = c;
         def.free_ctx = free_delaunay_ctx;
@@ -996,15 +1172,17 @@ static int l_springs(lua_State *L)
     bind_check_table(L, 2, call);
     bind_check_fields(L, 2, call, fields);
     double k = bind_field_number(L, 2, call, "k", 0, BIND_REQUIRED | BIND_POSITIVE);
-    size_t n = 0;
-    double *i = read_array(L, 2, call, "i", &n, 1);
-    double *j = read_array(L, 2, call, "j", &n, 1);
-    double *rest = read_array(L, 2, call, "rest", &n, 0);
-    long *li = lua_newuserdatauv(L, (n ? 2 * n : 1) * sizeof *li, 0), *lj = li + n;
-    for (size_t q = 0; q < n; q++) {
-        li[q] = (long)i[q] - 1;
-        lj[q] = (long)j[q] - 1;
+    /* Ids checked as integers in range before they become C indices. */
+    size_t n = 0, nj = 0;
+    const long *li = read_ids(L, 2, call, "i", dem_count(s), 0, 1, &n);
+    const long *lj = read_ids(L, 2, call, "j", dem_count(s), 0, 1, &nj);
+    if (nj != n) {
+        char got[64], want[64];
+        snprintf(got, sizeof got, "%zu values", nj);
+        snprintf(want, sizeof want, "as many ids as i (%zu)", n);
+        return field_fail(L, 2, call, "j", want, got);
     }
+    double *rest = read_array(L, 2, call, "rest", &n, 0);
     core_error err;
     if (dem_add_springs(s, n, li, lj, k, rest, &err))
         return bind_raise(L, call, &err);
@@ -1021,14 +1199,11 @@ static int l_tie(lua_State *L)
     int wall = (int)bind_field_integer(L, 2, call, "wall", 0, 1, 1 << 30, BIND_REQUIRED) - 1;
     int axis = (int)bind_field_integer(L, 2, call, "axis", 2, 1, 2, 0) - 1;
     size_t n = 0;
-    double *ids = read_array(L, 2, call, "ids", &n, 1);
+    const long *ids = read_ids(L, 2, call, "ids", dem_count(s), 0, 1, &n);
     for (size_t q = 0; q < n; q++) {
         core_error err;
-        if (!(ids[q] >= 1) || dem_tie_to_wall(s, (size_t)ids[q] - 1, wall, axis, &err)) {
-            if (!(ids[q] >= 1))
-                return luaL_error(L, "%s: entry %d: particle ids start at 1", call, (int)q + 1);
+        if (dem_tie_to_wall(s, (size_t)ids[q], wall, axis, &err))
             return bind_raise(L, call, &err);
-        }
     }
     return 0;
 }
@@ -1092,8 +1267,11 @@ void bind_open_analysis(lua_State *L)
          "Delaunay triangulation of 2D particle centres (qhull), with the boundary triangles "
          "peeled while their outer edge (a, b) is longer than alpha (r_a + r_b) and their third "
          "particle is inside (so the outline never pinches and every particle stays in the mesh; "
-         "alpha = 0: the convex hull; without radii, r is half the median edge). ids: triangulate only these particles. Refuses fewer than 3 particles, "
-         "collinear centres and duplicate positions. Returns an analysis.mesh."},
+         "alpha = 0: the convex hull; without radii, r is half the median edge). Triangles "
+         "flat to rounding on the outline (centres in a row along a wall) are peeled whatever "
+         "alpha. ids: triangulate only these particles (distinct ids, entries of x/y or of the "
+         "scene). Refuses fewer than 3 particles, collinear centres, duplicate positions and "
+         "non-positive radii. Returns an analysis.mesh."},
         {NULL, NULL, NULL, NULL}};
     lua_newtable(L);
     bind_register(L, -1, fns);

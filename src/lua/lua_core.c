@@ -1,5 +1,6 @@
 /* grainlab.* functions backed by core/: version, clocks, threads, random streams, progress
  * reporters and whole-file writes. */
+#include <math.h>
 #include <stdint.h>
 #include <string.h>
 
@@ -130,10 +131,24 @@ static int l_progress_new(lua_State *L)
     return 1;
 }
 
+/* The amount done at arg: a finite number >= 0 (NaN would print as "nan%" and stop the 10%
+ * marks for good). */
+static double check_done(lua_State *L, int arg, const char *call)
+{
+    double done = luaL_checknumber(L, arg);
+    if (!(done >= 0) || !isfinite(done)) {
+        char got[64];
+        bind_describe(L, arg, got, sizeof got);
+        luaL_error(L, "bad argument #1 to '%s' (finite non-negative number expected, got %s)",
+                   call, got);
+    }
+    return done;
+}
+
 static int l_progress_update(lua_State *L)
 {
     progress *p = luaL_checkudata(L, 1, PROGRESS);
-    double done = luaL_checknumber(L, 2);
+    double done = check_done(L, 2, "update");
     luaL_argcheck(L, p->active, 1, "progress reporter already finished");
     progress_update(p, done);
     return 0;
@@ -150,7 +165,7 @@ static int l_progress_finish(lua_State *L)
 {
     progress *p = luaL_checkudata(L, 1, PROGRESS);
     if (!lua_isnoneornil(L, 2) && p->active)
-        p->done = luaL_checknumber(L, 2);
+        p->done = check_done(L, 2, "finish");
     progress_end(p);
     return 0;
 }

@@ -145,6 +145,8 @@ static int l_contact(lua_State *L)
         "impact_velocity", "tangential", "gamma_t", "kt", "v_r", "exponent", "clip", "rolling",
         NULL};
     dem_scene *s = check_scene(L, 1);
+    bind_refuse_running(L, 1, "contact", "the contact law cannot change under the time step its "
+                                         "run was checked at: change it between runs");
     bind_check_table(L, 2, "contact");
     bind_check_fields(L, 2, "contact", fields);
     dem_contact_def c = dem_default_contact_def();
@@ -175,6 +177,10 @@ static int l_contact(lua_State *L)
         lua_pop(L, 1);
     }
     double v_imp = bind_field_number(L, 2, "contact", "impact_velocity", 1, BIND_POSITIVE);
+    if (e < 0 && lua_getfield(L, 2, "impact_velocity") != LUA_TNIL)
+        return bind_field_error(
+            L, 2, "contact", "impact_velocity",
+            "nothing unless restitution is given (the speed at which it holds)");
     c.tangential = (dem_tangential_law)bind_field_option(L, 2, "contact", "tangential",
                                                          TANGENT_NAMES, DEM_TANGENT_NONE, 0);
     c.gamma_t = bind_field_number(L, 2, "contact", "gamma_t", 0, BIND_NONNEG);
@@ -189,22 +195,55 @@ static int l_contact(lua_State *L)
         if (c.damping_time < 0 && e < 0)
             return luaL_error(L, "contact: brilliantov damping needs damping_time (s) or "
                                  "restitution (with impact_velocity, default 1 m/s)");
-        if (e >= 0) {
-            core_error err;
-            double T;
-            if (dem_damping_time_for(s, e, v_imp, &T, &err) != CORE_OK)
-                return bind_raise(L, "contact", &err);
-            c.damping_time = T;
-        }
+        if (c.damping_time >= 0 && e >= 0)
+            return luaL_error(L, "contact: give damping_time (one T for every pair) or "
+                                 "restitution (a T per pair), not both");
+        /* From a restitution each pair gets its own T when the pair list is built: nothing
+         * depends on the particles present now. */
+        c.restitution = e;
+        c.impact_velocity = v_imp;
     }
     core_error err;
     if (dem_set_contact(s, &c, &err) != CORE_OK)
         return bind_raise(L, "contact", &err);
-    lua_pushnumber(L, c.damping_time);
-    return 1;
+    if (c.damping == DEM_DAMPING_BRILLIANTOV && e < 0) {
+        lua_pushnumber(L, c.damping_time);
+        return 1;
+    }
+    return 0;
 }
 
 /* ---- particles ------------------------------------------------------------------------------ */
+/* From the on_step of a run (not forced), a particle may join only if the stability limit that
+ * run's dt was checked against still holds: the limit comes from the smallest particle of each
+ * material (contact times grow with size), so the new one must be no smaller than those. */
+static void refuse_smaller_during_run(lua_State *L, dem_scene *s, const char *call,
+                                      const dem_particle_def *p)
+{
+    const bind_run *r = bind_running(L, 1);
+    if (!r || r->forced)
+        return;
+    const double *rad = dem_radii(s);
+    const int *mat = dem_particle_materials(s);
+    double rmin = INFINITY;
+    for (size_t i = 0; i < dem_count(s); i++)
+        if (mat[i] == p->material && rad[i] < rmin)
+            rmin = rad[i];
+    if (p->radius >= rmin)
+        return;
+    char why[320];
+    if (isinf(rmin))
+        snprintf(why, sizeof why, "a particle of a material new to the scene could shorten the "
+                 "stability limit the run's dt = %g s was checked at: add it between runs, or run "
+                 "with force = true", r->dt);
+    else
+        snprintf(why, sizeof why, "a particle smaller than any of its material (radius %g m < %g "
+                 "m) could shorten the stability limit the run's dt = %g s was checked at: add it "
+                 "between runs, or run with force = true", p->radius, rmin, r->dt);
+    lua_pushstring(L, why);
+    bind_refuse_running(L, 1, call, lua_tostring(L, -1));
+}
+
 static int add_particle(lua_State *L, const char *call, int want_dim)
 {
     static const char *const fields[] = {"pos", "radius", "material", "vel", "omega", "fixed",
@@ -232,6 +271,7 @@ static int add_particle(lua_State *L, const char *call, int want_dim)
     if ((p.flags & DEM_FIXED) && (p.flags & DEM_PRESCRIBED))
         return luaL_error(L, "%s: a particle is either fixed or prescribed, not both", call);
     p.material = material_index(L, 1, 2, call, "material", 0);
+    refuse_smaller_during_run(L, s, call, &p);
     core_error err;
     long i = dem_add_particle(s, &p, &err);
     if (i < 0)
@@ -250,6 +290,31 @@ static size_t particle_arg(lua_State *L, dem_scene *s, int arg, const char *call
         luaL_error(L, "bad argument #%d to '%s' (particle id in [1, %d] expected, got %d)",
                    arg - 1, call, (int)dem_count(s), (int)i);
     return (size_t)(i - 1);
+}
+
+/* s:damping_time(i, j) or s:damping_time(i, { wall = w }): the pair's Brilliantov T as the force
+ * loop uses it (per pair when solved from a restitution). */
+static int l_damping_time(lua_State *L)
+{
+    dem_scene *s = check_scene(L, 1);
+    size_t i = particle_arg(L, s, 2, "damping_time"), j = 0;
+    int wall = -1;
+    if (lua_istable(L, 3)) {
+        static const char *const fields[] = {"wall", NULL};
+        bind_check_fields(L, 3, "damping_time", fields);
+        wall =
+            (int)bind_field_number(L, 3, "damping_time", "wall", 0, BIND_POSITIVE | BIND_REQUIRED) -
+            1;
+    } else
+        j = particle_arg(L, s, 3, "damping_time");
+    if (dem_contact(s)->damping != DEM_DAMPING_BRILLIANTOV)
+        return luaL_error(L, "damping_time: the contact law has no brilliantov damping");
+    core_error err;
+    double T;
+    if (dem_pair_damping(s, i, j, wall, &T, &err) != CORE_OK)
+        return bind_raise(L, "damping_time", &err);
+    lua_pushnumber(L, T);
+    return 1;
 }
 
 static int l_set_velocity(lua_State *L)
@@ -416,13 +481,14 @@ typedef struct dem_advance_ctx {
     dem_run_def *run;
 } dem_advance_ctx;
 
-static core_status dem_advance(void *ctx, long n, long *done, core_error *err)
+static core_status dem_advance(void *ctx, long n, progress *p, long *done, core_error *err)
 {
     dem_advance_ctx *c = ctx;
     c->run->steps = n;
-    c->run->progress = NULL;
-    *done = n;
-    return dem_run(c->s, c->run, err);
+    c->run->progress = p; /* counts the steps taken, also those before an interruption */
+    core_status st = dem_run(c->s, c->run, err);
+    *done = st == CORE_OK ? n : (long)(p->done - p->base);
+    return st;
 }
 
 static int l_run(lua_State *L)
@@ -431,6 +497,7 @@ static int l_run(lua_State *L)
                                          "integrator", "m", "n", "q", "every", "on_step",
                                          "progress", NULL};
     dem_scene *s = check_scene(L, 1);
+    bind_refuse_running(L, 1, "run", "return false from on_step to stop it");
     bind_check_table(L, 2, "run");
     bind_check_fields(L, 2, "run", fields);
     dem_run_def run = dem_default_run_def();
@@ -477,7 +544,9 @@ static int l_run(lua_State *L)
     double t0 = dem_time(s);
     long s0 = dem_steps_done(s), f0 = dem_force_evaluations(s);
     dem_advance_ctx ctx = {s, &run};
-    bind_run r = {"dem run", steps, steps, dem_advance, &ctx};
+    /* dt for two timescales: the large step n dt is the one checked against the limit */
+    bind_run r = {"dem run", steps, steps, dem_advance, &ctx, 1,
+                  run.integrator == DEM_TWO_TIMESCALES ? run.tt_n * run.dt : run.dt, force};
     int stopped = bind_run_chunks(L, 1, 2, "run", &r);
     lua_createtable(L, 0, 5);
     lua_pushinteger(L, dem_steps_done(s) - s0);
@@ -611,21 +680,51 @@ static int l_measure(lua_State *L)
             static const char *const fields[] = {"affine", "center", NULL};
             bind_check_table(L, 3, "measure");
             bind_check_fields(L, 3, "measure", fields);
-            if (lua_getfield(L, 3, "affine") == LUA_TTABLE) {
-                affine = 1;
-                for (int a = 0; a < D; a++) {
-                    lua_rawgeti(L, -1, a + 1);
-                    for (int b = 0; b < D; b++) {
+            /* affine: D rows of D finite numbers, the shape checked before any row is
+             * indexed (a number as a row used to crash lua_rawgeti). */
+            if (lua_getfield(L, 3, "affine") != LUA_TNIL) {
+                lua_Debug ar;
+                int uarg = lua_getstack(L, 0, &ar) && lua_getinfo(L, "n", &ar) && ar.namewhat &&
+                                   strcmp(ar.namewhat, "method") == 0
+                               ? 2
+                               : 3;
+                char got[128] = "", v[64];
+                int ok = lua_type(L, -1) == LUA_TTABLE && lua_rawlen(L, -1) == (size_t)D;
+                if (!ok && lua_type(L, -1) == LUA_TTABLE)
+                    snprintf(got, sizeof got, "%d rows", (int)lua_rawlen(L, -1));
+                else if (!ok)
+                    bind_describe(L, -1, got, sizeof got);
+                for (int a = 0; a < D && ok; a++) {
+                    int rt = lua_rawgeti(L, -1, a + 1);
+                    if (rt != LUA_TTABLE || lua_rawlen(L, -1) != (size_t)D) {
+                        if (rt == LUA_TTABLE)
+                            snprintf(got, sizeof got, "%d entries in row %d",
+                                     (int)lua_rawlen(L, -1), a + 1);
+                        else {
+                            bind_describe(L, -1, v, sizeof v);
+                            snprintf(got, sizeof got, "%s as row %d", v, a + 1);
+                        }
+                        ok = 0;
+                    }
+                    for (int b = 0; b < D && ok; b++) {
                         lua_rawgeti(L, -1, b + 1);
-                        int isnum;
-                        grad[a][b] = lua_tonumberx(L, -1, &isnum);
+                        grad[a][b] = lua_tonumber(L, -1);
+                        if (lua_type(L, -1) != LUA_TNUMBER || !isfinite(grad[a][b])) {
+                            bind_describe(L, -1, v, sizeof v);
+                            snprintf(got, sizeof got, "%s at row %d, column %d", v, a + 1, b + 1);
+                            ok = 0;
+                        }
                         lua_pop(L, 1);
-                        if (!isnum)
-                            return luaL_error(L, "measure: affine must be a %dx%d matrix of "
-                                                 "numbers (displacement gradient)", D, D);
                     }
                     lua_pop(L, 1);
                 }
+                if (!ok)
+                    return luaL_error(L,
+                                      "bad field 'affine' in argument #%d to 'measure' (%dx%d "
+                                      "matrix of finite numbers (displacement gradient) "
+                                      "expected, got %s)",
+                                      uarg, D, D, got);
+                affine = 1;
             }
             lua_pop(L, 1);
             bind_field_vector(L, 3, "measure", "center", D, center, 0);
@@ -703,6 +802,10 @@ static int l_set_reference(lua_State *L)
 static int l_scale_mass(lua_State *L)
 {
     dem_scene *s = check_scene(L, 1);
+    const bind_run *r = bind_running(L, 1);
+    if (r && !r->forced && luaL_checknumber(L, 2) < 1) /* lighter: shorter contact times */
+        bind_refuse_running(L, 1, "scale_mass", "a factor below 1 shortens the stability limit "
+                                                "the run's dt was checked at: scale between runs");
     core_error err;
     if (dem_scale_mass(s, luaL_checknumber(L, 2), &err))
         return bind_raise(L, "scale_mass", &err);
@@ -712,6 +815,11 @@ static int l_scale_mass(lua_State *L)
 static int l_scale_stiffness(lua_State *L)
 {
     dem_scene *s = check_scene(L, 1);
+    const bind_run *r = bind_running(L, 1);
+    if (r && !r->forced && luaL_checknumber(L, 2) > 1) /* stiffer: shorter contact times */
+        bind_refuse_running(L, 1, "scale_stiffness", "a factor above 1 shortens the stability "
+                                                     "limit the run's dt was checked at: scale "
+                                                     "between runs");
     core_error err;
     if (dem_scale_stiffness(s, luaL_checknumber(L, 2), &err))
         return bind_raise(L, "scale_stiffness", &err);
@@ -834,6 +942,7 @@ static int l_info(lua_State *L)
 static int l_gc(lua_State *L)
 {
     lscene *u = luaL_checkudata(L, 1, SCENE);
+    bind_refuse_running(L, 1, "close", "it can be closed once its run has returned");
     dem_destroy(u->s);
     u->s = NULL;
     return 0;
@@ -861,11 +970,17 @@ void bind_open_dem(lua_State *L)
          "Sets the contact law of the scene. Normal: linear f = k d (Herrmann Eq. 1a, beta = 1), "
          "power f = k d^beta (beta 1, 1.5 or 2), hertz f = 4/3 E* sqrt(R) d^1.5 (Padbidri Eq. "
          "1.1). Damping: viscous gamma_n d' (Eq. 1b; gamma_n per pair from the materials' "
-         "restitution unless given), brilliantov T K d^0.5 d' (Eq. 2.16; T = damping_time, or "
-         "solved from restitution at impact_velocity for the scene's mean pair). Tangential: "
+         "restitution unless given), brilliantov T K d^0.5 d' (Eq. 2.16) with T = damping_time for "
+         "every pair, or, from restitution = e at impact_velocity (default 1 m/s), a T per pair "
+         "(walls too): T = lambda(e) (m*/K)^(2/5) v^(-1/5) with K = 4/3 E* sqrt(R*), so a "
+         "head-on impact at that speed rebounds with e for every pair whatever its radii, masses "
+         "and materials (at other speeds e follows Brilliantov's law: higher when slower); "
+         "s:damping_time(i, j) gives a pair's T. Tangential: "
          "viscous -gamma_t s (Eq. 2a), spring (Cundall-Strack, Eq. 2b; kt defaults to 2/7 of "
          "the normal tangent stiffness), coulomb_regularized mu f_n min(1, (s/v_r)^(1/exponent)) "
-         "(Eq. 2.18). clip = true forbids attractive normal forces. Returns the damping time."},
+         "(Eq. 2.18). clip = true forbids attractive normal forces. Returns damping_time when one "
+         "is "
+         "given, else nothing."},
         {"add_disk", l_add_disk,
          "s:add_disk{ pos = {x, y}, radius = r, material = m, vel = {vx, vy}, omega = w, "
          "fixed = false, prescribed = false }",
@@ -875,18 +990,28 @@ void bind_open_dem(lua_State *L)
          "s:add_sphere{ pos = {x, y, z}, radius = r, material = m, vel = {...}, omega = {...} }",
          "Adds a sphere to a 3D scene; returns its id."},
         {"add_wall", l_add_wall,
-         "s:add_wall{ point = {...}, normal = {...}, velocity = {...}, friction = mu, material = m }",
+         "s:add_wall{ point = {...}, normal = {...}, velocity = {...}, friction = mu, material = m "
+         "}",
          "Adds a planar wall (normal into the domain), optionally moving and with its own "
          "friction; returns the wall id."},
         {"remove_wall", l_remove_wall, "s:remove_wall(id)", "Removes a wall during a run."},
-        {"wall_velocity", l_wall_velocity, "s:wall_velocity(id, {vx, vy})", "Sets a wall's velocity."},
+        {"wall_velocity", l_wall_velocity, "s:wall_velocity(id, {vx, vy})",
+         "Sets a wall's velocity."},
         {"wall_point", l_wall_point, "s:wall_point(id)", "The wall's reference point now."},
         {"wall_force", l_wall_force, "s:wall_force(id)",
          "Normal force (N) the wall exerted on the particles at the last force evaluation."},
-        {"wall_servo", l_wall_servo, "s:wall_servo(id, { force =, mass =, rate = 0 }) or s:wall_servo(id)",
-         "Force control: the wall moves along its normal as a body of this mass pushed with `force` "
+        {"wall_servo", l_wall_servo,
+         "s:wall_servo(id, { force =, mass =, rate = 0 }) or s:wall_servo(id)",
+         "Force control: the wall moves along its normal as a body of this mass pushed with "
+         "`force` "
          "against the contacts, velocity damped at `rate` (1/s); no table switches it off."},
-        {"set_velocity", l_set_velocity, "s:set_velocity(id, {vx, vy})", "Sets a particle's velocity."},
+        {"set_velocity", l_set_velocity, "s:set_velocity(id, {vx, vy})",
+         "Sets a particle's velocity."},
+        {"damping_time", l_damping_time, "s:damping_time(i, j) or s:damping_time(i, { wall = w })",
+         "The Brilliantov damping time T (s) of particles i and j, or of particle i against wall "
+         "w, "
+         "as the force loop uses it (one T for all, or each pair's own when s:contact solved it "
+         "from a restitution)."},
         {"timestep", l_timestep, "s:timestep{ impact_velocity = v }",
          "The contact time of the stiffest, lightest pair at the impact velocity (default: the "
          "fastest particle or sqrt(2 g H), at least 0.1 m/s), the stability limit (1/10 of it, "
@@ -900,8 +1025,12 @@ void bind_open_dem(lua_State *L)
          "the paper's macro step m(n + q) dt; the cycle simply repeats); steps count small-step "
          "equivalents. on_step runs every `every` steps; returning false stops "
          "the run. Ctrl-C stops between steps with the scene intact. Returns {steps, time, dt, "
-         "force_evaluations, stopped}."},
-        {"measure", l_measure, "s:measure('energy'|'stress'|'coordination'|'slip'|'contacts'|'displacement', opts)",
+         "force_evaluations, stopped}. Progress on stderr: "
+         "nil shows it once the run has taken 2 s, true at once, false never (--quiet: never). "
+         "From on_step, calls that would invalidate the run (a nested run, close, ...) are "
+         "refused."},
+        {"measure", l_measure,
+         "s:measure('energy'|'stress'|'coordination'|'slip'|'contacts'|'displacement', opts)",
          "energy: kinetic, rotational, elastic, potential, total (J). stress: assembly stress "
          "sum(branch x force)/V (opts.volume; compression positive) with pressure. "
          "coordination: z, z_no_rattlers. slip: mean |slip velocity| at contacts. contacts: "

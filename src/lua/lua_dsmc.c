@@ -398,8 +398,9 @@ typedef struct advance_ctx {
     dsmc_run_def *run;
 } advance_ctx;
 
-static core_status advance(void *ctx, long n, long *done, core_error *err)
+static core_status advance(void *ctx, long n, struct progress *p, long *done, core_error *err)
 {
+    (void)p;
     advance_ctx *c = ctx;
     c->run->steps = n;
     return dsmc_run(c->s, c->run, done, err);
@@ -410,6 +411,7 @@ static int l_run(lua_State *L)
     static const char *const fields[] = {"steps", "time", "dt", "every", "on_step", "progress",
                                          "warn", NULL};
     dsmc_scene *s = check_scene(L, 1);
+    bind_refuse_running(L, 1, "run", "return false from on_step to stop it");
     bind_check_table(L, 2, "run");
     bind_check_fields(L, 2, "run", fields);
     if (dsmc_count(s) < 2)
@@ -449,7 +451,7 @@ static int l_run(lua_State *L)
     }
     long s0 = dsmc_steps_done(s);
     advance_ctx ctx = {s, &run};
-    bind_run r = {"dsmc run", steps, expect, advance, &ctx};
+    bind_run r = {"dsmc run", steps, expect, advance, &ctx, 0, run.dt, 0};
     int stopped = bind_run_chunks(L, 1, 2, "run", &r);
     lua_createtable(L, 0, 4);
     lua_pushinteger(L, dsmc_steps_done(s) - s0);
@@ -743,6 +745,7 @@ static int l_info(lua_State *L)
 static int l_gc(lua_State *L)
 {
     lscene *u = luaL_checkudata(L, 1, SCENE);
+    bind_refuse_running(L, 1, "close", "it can be closed once its run has returned");
     dsmc_destroy(u->s);
     u->s = NULL;
     return 0;
@@ -804,7 +807,10 @@ void bind_open_dsmc(lua_State *L)
          "(i) collisional regime, (ii) mean free path larger than the cell, (iii) mean collision "
          "time larger than dt are checked and each violation is warned with its numbers on "
          "stderr (warn = false: silent; s:measure('validity') returns them). on_step runs every "
-         "`every` steps; returning false stops. Returns {steps, time, dt, stopped}."},
+         "`every` steps; returning false stops. Returns {steps, time, dt, stopped}. Progress on stderr: "
+         "nil shows it once the run has taken 2 s, true at once, false never (--quiet: never). "
+         "From on_step, calls that would invalidate the run (a nested run, close, ...) are "
+         "refused."},
         {"measure", l_measure,
          "s:measure('temperature'|'a2'|'fields'|'histogram'|'stats'|'profile'|'validity', opts)",
          "temperature: temperature (J, m <|v - u|^2>/d), t_over_m, kinetic_energy, momentum, "

@@ -338,6 +338,11 @@ static int add_grain(lua_State *L, const char *call, mpm_shape shape)
     static const char *const poly_fields[] = {"vertices", "material", "points_per_cell", "velocity",
                                               "omega",    "clip",     "hydrostatic",     NULL};
     mpm_scene *s = check_scene(L, 1);
+    const bind_run *r = bind_running(L, 1);
+    if (r && r->dt > 0 && !r->forced) /* with dt = 'auto' the CFL condition holds every step */
+        bind_refuse_running(L, 1, call, "a new grain can raise the wave speed the run's fixed dt "
+                                        "was checked against: add grains between runs, or run "
+                                        "with dt = 'auto'");
     bind_check_table(L, 2, call);
     bind_check_fields(L, 2, call,
                       shape == MPM_DISK   ? disk_fields
@@ -559,8 +564,10 @@ typedef struct mpm_advance_ctx {
     mpm_run_def *run;
 } mpm_advance_ctx;
 
-static core_status mpm_advance(void *ctx, long n, long *done, core_error *err)
+static core_status mpm_advance(void *ctx, long n, struct progress *p, long *done,
+                               core_error *err)
 {
+    (void)p;
     mpm_advance_ctx *c = ctx;
     c->run->steps = n;
     return mpm_run(c->s, c->run, done, err);
@@ -571,6 +578,7 @@ static int l_run(lua_State *L)
     static const char *const fields[] = {"steps", "time",    "dt",       "cfl", "force",
                                          "every", "on_step", "progress", NULL};
     mpm_scene *s = check_scene(L, 1);
+    bind_refuse_running(L, 1, "run", "return false from on_step to stop it");
     bind_check_table(L, 2, "run");
     bind_check_fields(L, 2, "run", fields);
     mpm_run_def run = mpm_default_run_def();
@@ -616,7 +624,7 @@ static int l_run(lua_State *L)
     }
     long s0 = mpm_steps_done(s);
     mpm_advance_ctx ctx = {s, &run};
-    bind_run r = {"mpm run", steps, expect, mpm_advance, &ctx};
+    bind_run r = {"mpm run", steps, expect, mpm_advance, &ctx, 0, run.dt, force};
     int stopped = bind_run_chunks(L, 1, 2, "run", &r);
     lua_createtable(L, 0, 4);
     lua_pushinteger(L, mpm_steps_done(s) - s0);
@@ -823,6 +831,7 @@ static int l_info(lua_State *L)
 static int l_gc(lua_State *L)
 {
     lscene *u = luaL_checkudata(L, 1, SCENE);
+    bind_refuse_running(L, 1, "close", "it can be closed once its run has returned");
     mpm_destroy(u->s);
     u->s = NULL;
     return 0;
@@ -916,7 +925,10 @@ void bind_open_mpm(lua_State *L)
          "true. time = T lands exactly on T. on_step runs every `every` steps; returning false "
          "stops the run. Ctrl-C stops between steps with the scene intact; NaN, an inverted "
          "point or a point leaving the grid stop the run with an error naming the step, point "
-         "and grain. Returns {steps, time, dt, stopped}."},
+         "and grain. Returns {steps, time, dt, stopped}. Progress on stderr: "
+         "nil shows it once the run has taken 2 s, true at once, false never (--quiet: never). "
+         "From on_step, calls that would invalidate the run (a nested run, close, ...) are "
+         "refused."},
         {"measure", l_measure, "m:measure('energy'|'momentum'|'columns'|'shear')",
          "energy: kinetic, elastic (Hencky stored energy), plastic (plastic work), potential "
          "(gravity), total; per unit depth (J/m). momentum: linear = {px, py}, angular (about "

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "dem/dem.h"
+#include "core/progress.h"
 #include "lua/bind.h"
 #include "render/render.h"
 
@@ -994,6 +995,12 @@ static int l_field(lua_State *L)
     core_error err;
     if (render_field(rc, &d, img, NULL, &err) != CORE_OK)
         return bind_raise(L, call, &err);
+    size_t shown = 0, ncell = (size_t)d.nx * (size_t)d.ny;
+    for (size_t k = 0; d.values && k < ncell; k++)
+        shown += (!d.mask || d.mask[k]) && isfinite(d.values[k]);
+    if (d.values && !shown && progress_default_style() != PROGRESS_QUIET)
+        fprintf(stderr, "grainlab: warning: field: all %zu values are NaN%s; the image says so "
+                        "instead of showing colours\n", ncell, d.mask ? " or masked" : "");
     return finish_image(L, img, idx, file, frame, call);
 }
 

@@ -231,19 +231,24 @@ core_status render_field(render_context *rc, const render_field_def *def, render
     f.hi[1] = e[1][1];
     f.range[0] = 0;
     f.range[1] = 1;
+    size_t shown = 0;
     if (def->values) {
         double mn = INFINITY, mx = -INFINITY;
         for (size_t k = 0; k < ncell; k++)
             if (cell_shown(def, k)) {
+                shown++;
                 mn = def->values[k] < mn ? def->values[k] : mn;
                 mx = def->values[k] > mx ? def->values[k] : mx;
             }
         data_range(def->range, mn, mx, f.range);
     }
+    /* A field without a single value would be a blank frame with a colour bar of nothing: it gets
+     * no bar and a note saying why it is empty instead. */
+    const int empty = def->values && shown == 0;
     int has_top = (def->title && *def->title) || (def->stamp && *def->stamp) || def->arrows[0];
     const char *bar_label = def->colorbar_label ? def->colorbar_label : "value";
     if ((st = frame_layout(rc, &f, def->width, def->height, has_top,
-                           def->values && def->colorbar, bar_label, err)) != CORE_OK)
+                           def->values && def->colorbar && !empty, bar_label, err)) != CORE_OK)
         return st;
     frame_view(&f, view);
 
@@ -285,6 +290,17 @@ core_status render_field(render_context *rc, const render_field_def *def, render
     if (pixels)
         canvas_pixels(rc, (int)f.ox, (int)f.oy, nc, nr, pixels);
     free(pixels);
+    if (empty) {
+        char note[96];
+        snprintf(note, sizeof note, "no values: all %zu cells are NaN%s", ncell,
+                 def->mask ? " or masked" : "");
+        double px = f.fs;
+        double w = canvas_text_width(rc, note, px);
+        if (w > 0.9 * f.bw) /* fits the scene's width */
+            px *= 0.9 * f.bw / w;
+        canvas_text(rc, note, px, f.ox + 0.5 * f.bw, f.oy + 0.5 * f.bh, 0.5, 0.5, 0,
+                    rgba(180, 30, 30, 255));
+    }
 
     /* ---- arrows from the cell centres, every k-th cell, with a reference arrow ---- */
     if (def->arrows[0]) {

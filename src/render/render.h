@@ -158,7 +158,9 @@ typedef struct render_field_def {
 render_field_def render_default_field_def(void); /* nearest, viridis, colour bar, box */
 
 /* view: as for render_dem (lo, hi = the extent). Fails (CORE_ERR_ARG) on a bad size, grid,
- * extent, range or scale, or with neither values nor arrows. */
+ * extent, range or scale, or with neither values nor arrows. Values of which not one cell is
+ * shown (all NaN or masked) draw no colour bar but a note "no values: all N cells are NaN" across
+ * the extent: never a silently blank frame. */
 core_status render_field(render_context *rc, const render_field_def *def, render_image *out,
                          render_view *view, core_error *err);
 

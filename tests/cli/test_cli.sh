@@ -113,5 +113,62 @@ kill -INT "$pid"
 wait "$pid"; rc=$?; out=$(cat "$tmp/out"); err=$(cat "$tmp/err")
 expect_rc 1 sigint; has "$err" "interrupted by Ctrl-C" sigint
 
+# --- progress of every engine's run, standard error redirected to a file ---
+# GRAINLAB_PROGRESS_DELAY=0 shows unasked progress from the start (by default after 2 s), so the
+# lines below depend only on the run's length, never on timing.
+for e in dem mpm dsmc; do
+  run env GRAINLAB_PROGRESS_DELAY=0 "$G" run_progress.lua engine=$e steps=2000 </dev/null
+  expect_rc 0 "progress-$e"; has "$out" "ran" "progress-$e"
+  for pct in 10 50 90; do has "$err" "$e run:  $pct% ($((pct * 20))/2000 steps)" "progress-$e"; done
+  has "$err" "ETA" "progress-$e"; has "$err" "$e run: done, 2000 steps in" "progress-$e"
+  lines "$err" 10 "progress-$e"
+done
+run env GRAINLAB_PROGRESS_DELAY=1000 "$G" run_progress.lua </dev/null
+expect_rc 0 progress-unasked-short; [ -z "$err" ] && ok || bad "progress-unasked-short: a run shorter than the delay printed"
+run env GRAINLAB_PROGRESS_DELAY=1000 "$G" run_progress.lua engine=mpm progress=true </dev/null
+has "$err" "mpm run:  50% (1000/2000 steps)" progress-asked; lines "$err" 10 progress-asked
+run env GRAINLAB_PROGRESS_DELAY=0 "$G" run_progress.lua progress=false </dev/null
+[ -z "$err" ] && ok || bad "progress-false: printed"
+run env GRAINLAB_PROGRESS_DELAY=0 "$G" --quiet run_progress.lua engine=dsmc progress=true </dev/null
+[ -z "$err" ] && ok || bad "progress-quiet-run: printed"
+run env GRAINLAB_PROGRESS_DELAY=0 "$G" run_progress.lua engine=dem stop_at=500 </dev/null
+has "$err" "dem run: stopped (on_step returned false) at step 500 of 2000 after" progress-stopped
+lines "$err" 3 progress-stopped
+
+# --- Ctrl-C during a run: the last progress line and the error say where it stopped ---
+# start_long ARGS...: runs long_run.lua in the background until it says "running"
+start_long() {
+  "$@" >"$tmp/out" 2>"$tmp/err" &
+  pid=$!
+  for _ in $(seq 200); do grep -q running "$tmp/err" 2>/dev/null && break; sleep 0.05; done
+}
+finish_long() { wait "$pid"; rc=$?; out=$(cat "$tmp/out"); err=$(cat "$tmp/err"); }
+start_long env GRAINLAB_PROGRESS_DELAY=0 "$G" long_run.lua </dev/null
+kill -INT "$pid"; finish_long
+expect_rc 1 run-sigint
+if grep -Eq '^dem run: interrupted at step [0-9]+ of 1000000000 after' <<<"$err"; then ok; else bad "run-sigint: progress line"; fi
+# the kernel stops between steps, or on_step's Lua code is interrupted: both say where
+if grep -Eq 'run: interrupted at step [0-9]+ of 1000000000 of this run \(t = [0-9.e-]+ s\); the scene is intact|interrupted by Ctrl-C \(in on_step: the run stopped at step [0-9]+ of 1000000000 of this run; the scene is intact\)' <<<"$err"
+then ok; else bad "run-sigint: error message"; fi
+[ "$(grep -c 'done,' <<<"$err")" -eq 0 ] && ok || bad "run-sigint: says done"
+
+# --- SIGTERM: stops between steps, removes temporaries, says where, exits 128 + 15 ---
+mkdir -p "$tmp/w"
+start_long "$G" long_run.lua write=true out="$tmp/w/big.dat" </dev/null
+kill -TERM "$pid"; finish_long
+expect_rc 143 sigterm-run
+if grep -Eq "^grainlab: terminated \(SIGTERM\) at step [0-9]+ of 1000000000 of 'dem run'; partial outputs removed \((none was open|1 file)\)$" <<<"$err"
+then ok; else bad "sigterm-run: message"; fi
+[ "$(grep -c traceback <<<"$err")" -eq 0 ] && ok || bad "sigterm-run: a traceback instead of one message"
+[ -z "$(ls "$tmp/w" | grep '\.tmp\.')" ] && ok || bad "sigterm-run: temporary file left: $(ls "$tmp/w")"
+[ ! -e "$tmp/w/big.dat" ] || [ "$(stat -c %s "$tmp/w/big.dat")" -eq 4000000 ] && ok || bad "sigterm-run: partial file"
+# in plain Lua, and where the script swallows errors with pcall
+"$G" -e 'io.stderr:write("running\n") io.stderr:flush() while true do pcall(function() while true do end end) end' \
+  </dev/null >"$tmp/out" 2>"$tmp/err" &
+pid=$!
+for _ in $(seq 200); do grep -q running "$tmp/err" 2>/dev/null && break; sleep 0.05; done
+kill -TERM "$pid"; finish_long
+expect_rc 143 sigterm-lua; has "$err" "grainlab: terminated (SIGTERM); partial outputs removed (none was open)" sigterm-lua
+
 echo "cli: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -48,6 +48,7 @@ static void start(session *s)
         setenv("GRAINLAB_HISTORY", history, 1);
         setenv("HOME", tmpdir, 1);
         setenv("TERM", "xterm", 1);
+        setenv("GRAINLAB_PROGRESS_DELAY", "0", 1); /* unasked progress from the first step */
         unsetenv("INPUTRC");
         execl(GRAINLAB_EXE, "grainlab", (char *)NULL);
         _exit(127);
@@ -209,6 +210,98 @@ static void test_ctrl_c(void **state)
     assert_int_equal(finish(&s), 0);
 }
 
+/* Waits for the process to end by itself; returns its exit status (-1: it did not). */
+static int wait_exit(session *s)
+{
+    int status = -1;
+    double deadline = now() + 20;
+    while (now() < deadline) {
+        pump(s, 20);
+        if (waitpid(s->pid, &status, WNOHANG) == s->pid) {
+            pump(s, 50);
+            close(s->fd);
+            return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+        }
+    }
+    fprintf(stderr, "grainlab did not exit; screen:\n%s\n", s->out);
+    kill(s->pid, SIGKILL);
+    waitpid(s->pid, &status, 0);
+    close(s->fd);
+    return -1;
+}
+
+static const char *DEM_SCENE =
+    "s = dem.scene{ box = {{0, 0}, {0.01, 0.01}}, gravity = {0, -9.81} }; "
+    "s:add_wall{ point = {0, 0}, normal = {0, 1} }; "
+    "for i = 1, 4 do s:add_disk{ pos = {0.002 * i, 0.002}, radius = 4e-4 } end";
+
+/* On a terminal every engine's run draws a bar with rate and ETA and closes with a done line. */
+static void test_progress_bar(void **state)
+{
+    (void)state;
+    session s;
+    start(&s);
+    enter(&s, DEM_SCENE);
+    enter(&s, "r = s:run{ steps = 3000 }");
+    assert_true(expect(&s, "dem run ["));
+    assert_true(expect(&s, "steps/s ETA"));
+    assert_true(expect(&s, "dem run: done, 3000 steps in"));
+    enter(&s, "m = mpm.scene{ cells = {8, 8}, size = {1, 1} }; m:add_disk{ center = {0.5, 0.5}, "
+              "radius = 0.2, material = mpm.material{ density = 1000, shear = 1e5, bulk = 2e5 } }");
+    enter(&s, "r = m:run{ steps = 400 }");
+    assert_true(expect(&s, "mpm run ["));
+    assert_true(expect(&s, "mpm run: done, 400 steps in"));
+    enter(&s, "g = dsmc.scene{ dim = 2, size = {0.1, 0.1}, cells = {4, 4}, radius = 1e-3 }; "
+              "g:fill{ n = 50, speed = 1 }");
+    enter(&s, "r = g:run{ steps = 400, dt = 1e-4, warn = false }");
+    assert_true(expect(&s, "dsmc run ["));
+    assert_true(expect(&s, "dsmc run: done, 400 steps in"));
+    assert_int_equal(finish(&s), 0);
+}
+
+/* Ctrl-C stops the run between steps: the last line says where, the prompt comes back, the scene
+ * is intact. */
+static void test_ctrl_c_in_run(void **state)
+{
+    (void)state;
+    session s;
+    start(&s);
+    enter(&s, DEM_SCENE);
+    enter(&s, "s:run{ steps = 1000000000 }");
+    assert_true(expect(&s, "dem run ["));
+    usleep(200 * 1000);
+    type(&s, "\003");
+    assert_true(expect(&s, "dem run: interrupted at step "));
+    assert_true(expect(&s, " of 1000000000 after"));
+    assert_true(expect(&s, "run: interrupted at step "));
+    assert_true(expect(&s, "the scene is intact"));
+    enter(&s, "print(s:info().steps > 0 and 'intact' or 'no')");
+    assert_true(expect(&s, "intact"));
+    assert_int_equal(finish(&s), 0);
+}
+
+/* SIGTERM ends the session (unlike Ctrl-C), during a run and at the prompt, with 128 + 15. */
+static void test_sigterm(void **state)
+{
+    (void)state;
+    session s;
+    start(&s);
+    enter(&s, DEM_SCENE);
+    enter(&s, "s:run{ steps = 1000000000 }");
+    assert_true(expect(&s, "dem run ["));
+    kill(s.pid, SIGTERM);
+    assert_true(expect(&s, "dem run: interrupted at step "));
+    assert_true(expect(&s, "grainlab: terminated (SIGTERM) at step "));
+    assert_true(expect(&s, " of 1000000000 of 'dem run'; partial outputs removed"));
+    assert_int_equal(wait_exit(&s), 143);
+
+    start(&s);
+    assert_true(wait_prompt(&s));
+    kill(s.pid, SIGTERM);
+    assert_true(expect(&s, "grainlab: terminated (SIGTERM); partial outputs removed"));
+    assert_int_equal(wait_exit(&s), 143);
+}
+
 static void test_completion_and_help(void **state)
 {
     (void)state;
@@ -307,7 +400,9 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_expressions_and_multiline), cmocka_unit_test(test_error_recovery),
         cmocka_unit_test(test_ctrl_c), cmocka_unit_test(test_completion_and_help),
-        cmocka_unit_test(test_table_results), cmocka_unit_test(test_history_persists),
+        cmocka_unit_test(test_table_results),    cmocka_unit_test(test_history_persists),
+        cmocka_unit_test(test_progress_bar),     cmocka_unit_test(test_ctrl_c_in_run),
+        cmocka_unit_test(test_sigterm),
     };
     int failed = cmocka_run_group_tests(tests, NULL, NULL);
     char cmd[128];

@@ -123,12 +123,39 @@ static void test_clocks(void **state)
     assert_true(w1 - w0 < 60);
 }
 
+/* Writes in progress are tracked so that a process ending on SIGTERM can remove their temporary
+ * files; committed and aborted ones are forgotten. */
+static void test_live_temporaries(void **state)
+{
+    (void)state;
+    char a[300], b[300];
+    snprintf(a, sizeof a, "%s/a.dat", dir);
+    snprintf(b, sizeof b, "%s/b.dat", dir);
+    core_error err;
+    atomic_file fa, fb;
+    assert_int_equal(fileio_live_temporaries(), 0);
+    assert_int_equal(atomic_open(&fa, a, &err), CORE_OK);
+    assert_int_equal(atomic_open(&fb, b, &err), CORE_OK);
+    fputs("half", fa.fp);
+    assert_int_equal(fileio_live_temporaries(), 2);
+    assert_int_equal(entries(), 2);
+    assert_int_equal(atomic_commit(&fb, &err), CORE_OK); /* b is done: no longer tracked */
+    assert_int_equal(fileio_live_temporaries(), 1);
+    assert_int_equal(fileio_remove_temporaries(), 1); /* what the CLI does after SIGTERM */
+    assert_int_equal(fileio_live_temporaries(), 0);
+    assert_int_equal(entries(), 1); /* b.dat only */
+    assert_int_equal(fileio_remove_temporaries(), 0);
+    atomic_abort(&fa); /* the writer's own cleanup afterwards is harmless */
+    assert_int_equal(entries(), 1);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_setup_teardown(test_write_and_replace, setup, teardown),
         cmocka_unit_test_setup_teardown(test_unwritable_directory, setup, teardown),
         cmocka_unit_test_setup_teardown(test_abort_leaves_old_file, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_live_temporaries, setup, teardown),
         cmocka_unit_test(test_errors),
         cmocka_unit_test(test_clocks),
     };

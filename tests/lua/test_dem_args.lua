@@ -201,6 +201,13 @@ check.errors(function() r:run(10) end, "bad argument #1 to 'run' (table expected
 check.errors(function() r:set_velocity(1, { nan, 0 }) end, "set_velocity: velocity must be finite", "NaN set_velocity")
 check.eq(r:info().steps, 0, "no bad run took a step")
 check.errors(function() scene3():run{ steps = 1 } end, "run: the scene has no particles", "run on an empty scene")
+-- Measurements of an empty scene are zeros, not undefined behaviour (UBSan: memcpy of NULL in
+-- the neighbour build).
+for _, e in ipairs{ scene2(), scene3() } do
+  check.eq(e:measure("energy").total, 0, "energy of an empty scene")
+  check.eq(e:measure("contacts").count, 0, "contacts of an empty scene")
+  check.eq(e:measure("coordination").z, 0, "coordination of an empty scene")
+end
 
 
 

@@ -351,4 +351,73 @@ do -- the Cundall-Strack spring with the default (overlap-dependent) stiffness c
   end
   check.le(worst, 1e-6, "spring law: energy never rises (it rose 34x the kinetic energy before the fix)")
 end
+-- ---- energy watch: a run going unstable without a word ------------------------------------
+-- 60 undamped, frictionless disks at ~1 m/s in a closed box, no gravity, no driver: the energy
+-- must stay (Hertz is conservative). At the stable limit velocity Verlet makes it fluctuate by
+-- ~0.3%; forced to 3x the limit it grows without bound (it ran 20,000 steps to 1.33x unnoticed
+-- before the watch). The run stops when the energy rises more than 10% of the mechanical energy
+-- above its lowest value, giving both energies with their steps and times, the growth, the
+-- limit, the cause and the remedy.
+local function gas(seed)
+  local L = 0.02
+  local s = dem.scene{ dim = 2, box = { { 0, 0 }, { L, L } } }
+  local q = grainlab.material{ density = 2650, young = 30e9, poisson = 0.3 }
+  s:add_wall{ point = { 0, 0 }, normal = { 0, 1 } }
+  s:add_wall{ point = { 0, 0 }, normal = { 1, 0 } }
+  s:add_wall{ point = { L, 0 }, normal = { -1, 0 } }
+  s:add_wall{ point = { 0, L }, normal = { 0, -1 } }
+  s:contact{ normal = "hertz" }
+  local rng = grainlab.rng{ seed = seed }
+  for i = 0, 59 do
+    s:add_disk{ pos = { (i % 8 + 0.5) * L / 8, (i // 8 + 0.5) * L / 8 }, radius = 1e-3, material = q,
+                vel = { rng:normal(0, 1), rng:normal(0, 1) } }
+  end
+  return s, s:timestep().limit
+end
+do
+  local s, limit = gas(1)
+  local e0 = s:measure("energy").total
+  local msg = check.errors(function() s:run{ steps = 20000, dt = 3 * limit, force = true, progress = false } end,
+                           "run: energy grew in a scene without drivers: ", "3x the limit: the energy watch stops the run")
+  check.contains(msg, "limit 0.1); likely cause: the time step ", "3x: says the threshold and the cause")
+  check.contains(msg, "too large for the contact stiffness", "3x: the cause")
+  check.contains(msg, 'use dt = "auto" or a smaller dt', "3x: the remedy")
+  local steps = s:info().steps
+  check.lt(steps, 20000, "3x: stopped early")
+  local a, sa, b, sb = msg:match("energy grew in a scene without drivers: (%S+) J at step (%d+) %(t = %S+ s%), (%S+) J at step (%d+)")
+  check.is_true(a and b, "3x: both energies and steps in the message")
+  check.eq(tonumber(sb), steps, "3x: the step named is the one it stopped at")
+  check.lt(tonumber(sa), tonumber(sb), "3x: the low point came first")
+  check.near(tonumber(b), s:measure("energy").total, 1e-5, "3x: the energy named is the scene's")
+  check.gt((tonumber(b) - tonumber(a)) / tonumber(b), 0.1, "3x: it grew by more than 10%")
+  check.gt(tonumber(b), e0, "3x: above the initial energy")
+end
+do -- the same gas at the stable limit, 10,000 steps, never trips
+  local s, limit = gas(1)
+  local e0 = s:measure("energy").total
+  local r = s:run{ steps = 10000, dt = limit, progress = false }
+  check.eq(r.steps, 10000, "at the limit: ran to the end")
+  check.near(s:measure("energy").total, e0, 0.01, "at the limit: energy within 1%")
+  -- and in chunks with a callback (the watch keeps its reference across chunks)
+  local s2 = gas(2)
+  local n = 0
+  s2:run{ steps = 6000, dt = limit, every = 500, progress = false, on_step = function() n = n + 1 end }
+  check.eq(n, 12, "at the limit, in chunks: ran to the end")
+end
+do -- in chunks at 3x: the watch keeps its reference across chunks and still stops it
+  local s, limit = gas(1)
+  check.errors(function() s:run{ steps = 20000, dt = 3 * limit, force = true, every = 100, progress = false,
+                                 on_step = function(sc) sc:measure("energy") end } end,
+               "energy grew in a scene without drivers", "3x in chunks of 100 steps")
+end
+do -- drivers are not watched: gravity along a periodic axis (a chute) gains energy legitimately
+  local s = dem.scene{ dim = 2, box = { { 0, 0 }, { 0.01, 0.01 } }, periodic = { true, false }, gravity = { 9.81, 0 } }
+  s:add_disk{ pos = { 0.005, 0.005 }, radius = 0.5e-3 }
+  check.eq(s:run{ steps = 5000, dt = 1e-4, force = true, progress = false }.steps, 5000, "periodic chute: not stopped")
+  check.gt(s:particles().vx[1], 4.8, "periodic chute: it fell through ~120 periods")
+  -- nor a moving wall pushing the gas
+  local g, limit = gas(3)
+  g:add_wall{ point = { 0.0198, 0 }, normal = { -1, 0 }, velocity = { -0.5, 0 } }
+  check.eq(g:run{ steps = 4000, dt = limit, progress = false }.steps, 4000, "moving wall: not stopped")
+end
 check.done()

@@ -26,6 +26,17 @@ check.errors(rep{ scenario = "s", checks = { { name = "a", pass = true }, { name
 check.errors(rep{ scenario = "s", checks = { { name = "a", pass = "yes" } } }, "bad field 'checks[1].pass' in argument #1 to 'report' (boolean expected", "pass type")
 check.errors(rep{ scenario = "s", checks = { { name = "a", vale = 1, limit = 1 } } }, "bad field 'checks[1]' in argument #1 to 'report' (unknown field 'vale'", "check typo")
 check.contains(check.errors(rep(5), "table expected"), "test_report.lua:", "position of the caller")
+-- Figures JSON cannot hold are refused at the call, before anything is printed or written (they
+-- used to print, then become null, or fail in the encoder after the table was out).
+check.errors(rep{ scenario = "s", metrics = { e = 0/0 } }, "bad field 'metrics.e' in argument #1 to 'report' (finite number (a NaN or infinite figure belongs in a check, where it fails) expected, got nan)", "NaN metric")
+check.errors(rep{ scenario = "s", metrics = { e = -1/0 } }, "bad field 'metrics.e'", "infinite metric")
+check.errors(rep{ scenario = "s", params = { k = 1/0 } }, "bad field 'params.k'", "infinite param")
+check.errors(rep{ scenario = "s", metrics = { series = { 1, 2, 0/0 } } }, "bad field 'metrics.series.3'", "NaN in a series")
+check.errors(rep{ scenario = "s", metrics = { t = { [true] = 1 } } }, "bad field 'metrics.t' in argument #1 to 'report' (array 1..n or table with string keys (found key true) expected, got table)", "boolean key")
+check.errors(rep{ scenario = "s", metrics = { t = { 1, x = 2 } } }, "(not both)", "mixed table")
+local loop = {}
+loop.again = loop
+check.errors(rep{ scenario = "s", metrics = { t = loop } }, "bad field 'metrics.t.again' in argument #1 to 'report' (table that does not contain itself", "cycle")
 
 -- One passing report.
 local passed, r = grainlab.report{
