@@ -77,12 +77,6 @@ local plan = {
 }
 local names = { pressure = "direct pressure", membrane = "membrane", mbc = "minimal BC" }
 
-local function write_csv(path, header, rows)
-  local lines = { header }
-  for _, r in ipairs(rows) do lines[#lines + 1] = table.concat(r, ",") end
-  assert(grainlab.write_file(path, table.concat(lines, "\n") .. "\n"))
-end
-
 local function read_csv(path)
   local fh = io.open(path, "r")
   if not fh then return nil end
@@ -165,7 +159,10 @@ local function run_bc(bc, st)
   local s, lab = biax.setup(st, bc, c)
   local sb, stp = biax.start(lab)
   local p = plan[bc]
-  local rows, ev, eyy, exx = {}, 0, 0, 0
+  local ev, eyy, exx = 0, 0, 0
+  -- rewritten during the run (grainlab.recorder's flush), so a run stopped early keeps its curve
+  local rows = grainlab.recorder{ file = string.format("%s_%s.csv", csv, bc), columns = { "axial", "eps_v",
+                                  "eps_yy_coarse", "eps_xx_coarse", "stress_ratio", "rate_ratio", "pressure" } }
   local mesh = analysis.delaunay(s, { ids = lab.ids })
   local t_prev = s:info().time
   local per = math.max(1, math.floor(sample / (rate * c.dt) + 0.5)) -- steps per sample
@@ -263,15 +260,14 @@ local function run_bc(bc, st)
     end
     stress = stress or mesh:stress(s)
     local sr = stress.mean.yy / stress.mean.xx
-    rows[#rows + 1] = { string.format("%.6e", ea), string.format("%.6e", ev), string.format("%.6e", -eyy),
-                        string.format("%.6e", exx), string.format("%.6e", sr), string.format("%.6e", ratio),
-                        string.format("%.6e", stress.mean_pressure) }
+    rows:add{ axial = ea, eps_v = ev, eps_yy_coarse = -eyy, eps_xx_coarse = exx, stress_ratio = sr,
+              rate_ratio = ratio, pressure = stress.mean_pressure }
     if ev > peak then peak, peak_at = ev, ea end
     if ea > 0.01 * f then mbc_ratios[#mbc_ratios + 1] = ratio end
     mesh, t_prev = analysis.delaunay(s, { ids = lab.ids }), now
   end
   progress:finish()
-  write_csv(string.format("%s_%s.csv", csv, bc), "axial,eps_v,eps_yy_coarse,eps_xx_coarse,stress_ratio,rate_ratio,pressure", rows)
+  rows:write()
   local bi = s:boundary_info()
   local mean, dev = 0, 0
   for _, r in ipairs(mbc_ratios) do mean = mean + r end
@@ -320,7 +316,7 @@ if which == "plot" or which == "all" then
   local ev, sr, rr = {}, {}, {}
   for _, bc in ipairs { "pressure", "membrane", "mbc" } do
     local rows = read_csv(string.format("%s_%s.csv", csv, bc))
-    if rows then
+    if rows and #rows > 0 then -- (a run still going has written its header and the rows so far)
       local x, y, z, w = {}, {}, {}, {}
       local peak, at = -math.huge, 0
       for _, r in ipairs(rows) do

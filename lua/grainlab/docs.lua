@@ -92,3 +92,27 @@ document(grainlab.biax, "grainlab.biax.", {
     "Plates: brings each plate onto the sample under force control (s:wall_servo) until it carries p W t within tol, then moves the plates at the imposed strain rate. No-op for 'mbc'. Returns the plate stress / p (bottom, top) before the compression starts." },
   axial = { "axial(lab)", "The imposed axial strain now (compression positive): from the plate gap, or rate x time for 'mbc'." },
 })
+
+local recorder = require("grainlab.recorder")
+grainlab.doc(grainlab.recorder, { name = "grainlab.recorder",
+  usage = "grainlab.recorder{ file = 'out/x.csv', columns = { { 't', fn }, ... } | { name = fn, ... }, order = { names }, units = { name = 'unit' }, flush = 10 }",
+  doc = wrap("A time series: each sample is one row, one number per column. A column is { name, fn } " ..
+    "(fn(s) returns a number; the row comes from rec:sample(s), or rec(s) as on_step) or a bare name " ..
+    "(the rows come from rec:add{...}); columns given as a map name -> fn need `order`. The CSV (header " ..
+    "'name (unit)', integers as %d, floats as %.17g, NaN as nan) is written whole (temporary file + " ..
+    "rename): its header at once, then every `flush` seconds while samples arrive (false: only at " ..
+    "write/close), at rec:write(), and when the recorder is closed or collected (also after a script's " ..
+    "error). Methods: sample, add, column, names, write, plot; #rec is the number of samples.", 92) })
+grainlab.doc(recorder.type, { name = "grainlab.recorder", doc = wrap("A time series made by " ..
+  "grainlab.recorder{...}. Methods: rec:sample(s) (or rec(s), e.g. as a run's on_step), " ..
+  "rec:add{ name = value, ... }, rec:column(name), rec:names(), rec:write([path]), rec:plot{...}; " ..
+  "#rec is the number of samples. help(grainlab.recorder) tells more.", 92) })
+document(recorder.methods, "rec:", {
+  sample = { "sample(s)", "Appends a row: each column's fn(s). A non-number is refused naming the column. rec(s) is the same, so the recorder can be a run's on_step." },
+  add = { "add{ name = value, ... }", "Appends a row given by value; every column must be named, and nothing else." },
+  names = { "names()", "The column names, in CSV order." },
+  column = { "column(name)", "A copy of the column's values, in sampling order." },
+  write = { "write([path])", "Writes the whole CSV to path (default: the recorder's file), temporary file + rename. Returns the path." },
+  plot = { "plot{ file =, x = first column, y = other columns | name | { names }, labels =, title =, xlabel =, ylabel =, xlog =, ylog =, width =, height =, style = 'line' }",
+    "Draws y against x with render.plot. Axis labels default to the column names with their units; on a log axis values <= 0 are gaps. Returns the file." },
+})

@@ -155,8 +155,12 @@ int bind_run_chunks(lua_State *L, int scene, int arg, const char *call, const bi
     scene = lua_absindex(L, scene);
     long every = (long)bind_field_integer(L, arg, call, "every", 0, 1, LUA_MAXINTEGER, 0);
     int has_cb = lua_getfield(L, arg, "on_step") != LUA_TNIL;
-    if (has_cb && lua_type(L, -1) != LUA_TFUNCTION)
-        return bind_field_error(L, arg, call, "on_step", "function");
+    /* a callable object (grainlab.recorder) is as good as a function */
+    if (has_cb && lua_type(L, -1) != LUA_TFUNCTION) {
+        if (luaL_getmetafield(L, -1, "__call") == LUA_TNIL)
+            return bind_field_error(L, arg, call, "on_step", "function");
+        lua_pop(L, 1);
+    }
     int cb = lua_gettop(L);
     if (has_cb && every == 0)
         every = r->expect > 100 ? r->expect / 100 : 1;
