@@ -21,14 +21,61 @@ biax.defaults = {
   every = 250, alpha = 1.5, kappa = 20,
 }
 
-local function cfg_of(opts)
+-- Every configuration key, checked at the entry of each public function (grainlab.args): a typo
+-- or a negative modulus names the call and the field instead of failing deep inside a run.
+local args = require("grainlab.args")
+local STEPS = { "integer", min = 0, max = 1e12 }
+local CONFIG = {
+  young = { "positive" }, poisson = { "range", lo = 0, hi = 0.5, open_hi = true },
+  pressure = { "positive" }, density = { "positive" }, mass_scale = { "positive" },
+  friction = { "nonneg" }, rate = { "positive" }, dt = { "positive" }, rmin = { "positive" },
+  rmax = { "positive" }, thickness = { "nonneg" }, damping_time = { "nonneg" },
+  exponent = { "positive" }, membrane_k = { "positive" }, membrane_radius = { "positive" },
+  every = { "integer", min = 1, max = 1e9 }, alpha = { "positive" }, kappa = { "nonneg" },
+  v_r = { "positive" },
+  -- biax.prepare / biax.prepared
+  n = { "integer", min = 3, max = 1000000 }, seed = { "integer", min = 0 },
+  method = { "option", values = { "deposit", "random" } },
+  shape = { "option", values = { "square", "circle" } }, width = { "positive" },
+  ramp_steps = STEPS, hold_steps = STEPS, friction_steps = STEPS, rest_steps = STEPS,
+  ramp_stages = { "integer", min = 1, max = 1e6 }, prep_drag = { "nonneg" },
+  settle_tol = { "positive" }, settle_rounds = { "integer", min = 1, max = 1e6 },
+  cache = { check = function(v) return v == false or type(v) == "string", "false or a file name" end },
+}
+biax.fields = args.fields(CONFIG)
+
+local function cfg_of(opts, call, argn)
+  args.check(call or "grainlab.biax.config", argn or 1, opts, CONFIG, true)
+  if opts and opts.rmin and opts.rmax and not (opts.rmax >= opts.rmin) then
+    args.fail(call or "grainlab.biax.config", argn or 1, "rmax", "radius >= rmin", opts.rmax)
+  end
   local c = {}
   for k, v in pairs(biax.defaults) do c[k] = v end
   for k, v in pairs(opts or {}) do c[k] = v end
   c.v_r = (opts and opts.v_r) or (c.rmin + c.rmax) * c.rate -- Eq. 3.A2: v_R = d eps_rate
   return c
 end
-biax.config = cfg_of
+function biax.config(opts) return cfg_of(opts, "grainlab.biax.config", 1) end
+
+-- A state {x = {...}, y = {...}, r = {...}} (from biax.prepare or biax.save) at argument argn.
+local function check_state(call, argn, st)
+  local ok = type(st) == "table" and type(st.x) == "table" and type(st.y) == "table"
+    and type(st.r) == "table" and #st.x > 0 and #st.y == #st.x and #st.r == #st.x
+  for i = 1, ok and #st.x or 0 do
+    ok = ok and type(st.x[i]) == "number" and type(st.y[i]) == "number" and type(st.r[i]) == "number"
+  end
+  if not ok then
+    args.arg_fail(call, argn, "state {x = {...}, y = {...}, r = {...}} of equal lengths", st)
+  end
+end
+
+-- A lab table from biax.setup at argument #1.
+local function check_lab(call, lab)
+  local mt = type(lab) == "table" and getmetatable(lab.scene)
+  if not (type(mt) == "table" and mt.__name == "dem.scene" and type(lab.cfg) == "table") then
+    args.arg_fail(call, 1, "lab table from grainlab.biax.setup", lab)
+  end
+end
 
 local function materials(c)
   local grain = grainlab.material{ density = c.density, young = c.young, poisson = c.poisson,
@@ -40,7 +87,8 @@ end
 
 -- A gravity-free, mass-scaled scene holding the state's disks (and nothing else).
 function biax.scene(state, c)
-  c = cfg_of(c)
+  check_state("grainlab.biax.scene", 1, state)
+  c = cfg_of(c, "grainlab.biax.scene", 2)
   local xlo, xhi, ylo, yhi = math.huge, -math.huge, math.huge, -math.huge
   for i = 1, #state.x do
     xlo, xhi = math.min(xlo, state.x[i]), math.max(xhi, state.x[i])
@@ -61,7 +109,11 @@ end
 
 -- Contact laws: App. A (Hertz, Brilliantov damping, regularised Coulomb with v_R = d rate).
 function biax.contact(s, c, frictionless)
-  c = cfg_of(c)
+  args.object("grainlab.biax.contact", 1, s, "dem.scene")
+  c = cfg_of(c, "grainlab.biax.contact", 2)
+  if frictionless ~= nil and type(frictionless) ~= "boolean" then
+    args.arg_fail("grainlab.biax.contact", 3, "boolean", frictionless)
+  end
   if frictionless then
     s:contact{ normal = "hertz", damping = "brilliantov", damping_time = c.damping_time }
   else
@@ -76,7 +128,10 @@ local function save(s)
   for i = 1, P.count do st.x[i], st.y[i], st.r[i] = P.x[i], P.y[i], P.radius[i] end
   return st
 end
-biax.save = save
+function biax.save(s)
+  args.object("grainlab.biax.save", 1, s, "dem.scene")
+  return save(s)
+end
 
 -- Runs `steps` steps at dt in chunks (the boundary is rebuilt inside the engine every c.every).
 local function run(s, steps, c)
@@ -88,7 +143,7 @@ end
 --   hold_steps, friction_steps, rest_steps, settle_tol (0.02), settle_rounds (6), and any of
 --   biax.defaults. Returns the state {x, y, r} and a report table.
 function biax.prepare(opts)
-  local c = cfg_of(opts)
+  local c = cfg_of(opts, "grainlab.biax.prepare", 1)
   local n, seed = c.n or 400, c.seed or 1
   local t0 = grainlab.clock()
   local rm = 0.5 * (c.rmin + c.rmax)
@@ -180,7 +235,7 @@ end
 -- biax.prepare, cached in a file: the same n, seed and preparation give the same sample, so
 -- scripts share it (out/biax_<n>_<seed>.lua by default; cache = false to always prepare).
 function biax.prepared(opts)
-  local c = cfg_of(opts)
+  local c = cfg_of(opts, "grainlab.biax.prepared", 1)
   local path = c.cache
   if path == nil then
     path = string.format("out/biax_%s%d_%d.lua", c.shape == "circle" and "circle_" or "", c.n or 400, c.seed or 1)
@@ -255,7 +310,14 @@ end
 -- A scene from the prepared state with boundary condition bc. Returns the scene and a table
 -- with: ids (sample particles), plates (wall ids or nil), membrane ids, H0 (plate gap), info.
 function biax.setup(st, bc, opts)
-  local c = cfg_of(opts)
+  check_state("grainlab.biax.setup", 1, st)
+  if bc ~= "pressure" and bc ~= "membrane" and bc ~= "mbc" then
+    args.arg_fail("grainlab.biax.setup", 2, "one of 'pressure', 'membrane', 'mbc'", bc)
+  end
+  local c = cfg_of(opts, "grainlab.biax.setup", 3)
+  if not (c.thickness > 0) then -- the boundary pressure acts on edges of this depth
+    args.fail("grainlab.biax.setup", 3, "thickness", "positive number (the pressure needs a depth)", c.thickness)
+  end
   local n0 = #st.x
   local ids = {}
   for i = 1, n0 do ids[i] = i end
@@ -322,6 +384,10 @@ end
 -- Plate forces (bottom, top): the normal force each plate exerts on the sample, contacts and the
 -- tied membrane ends (s:wall_force).
 function biax.plate_forces(lab)
+  check_lab("grainlab.biax.plate_forces", lab)
+  if not lab.plates then
+    args.arg_fail("grainlab.biax.plate_forces", 1, "lab with plates (bc 'pressure' or 'membrane')", lab)
+  end
   return lab.scene:wall_force(lab.plates[1]), lab.scene:wall_force(lab.plates[2])
 end
 
@@ -353,6 +419,13 @@ end
 -- steps, three times in a row. No-op for MBC (its penalty drives the strain). Returns the plate
 -- stress / p (bottom, top) averaged over the last 250 steps before the compression starts.
 function biax.start(lab, max_steps, tol)
+  check_lab("grainlab.biax.start", lab)
+  if max_steps ~= nil and not (math.type(max_steps) == "integer" and max_steps >= 1 and max_steps <= 1e12) then
+    args.arg_fail("grainlab.biax.start", 2, "positive integer (at most 1e12)", max_steps)
+  end
+  if tol ~= nil and not (type(tol) == "number" and tol > 0 and tol <= 1e100) then
+    args.arg_fail("grainlab.biax.start", 3, "positive number", tol)
+  end
   local s, c = lab.scene, lab.cfg
   local ratio_b, ratio_t = 1, 1
   if lab.plates then
@@ -419,12 +492,29 @@ end
 
 -- Imposed axial strain now (plate gap, or rate x time for MBC), compression positive.
 function biax.axial(lab)
+  check_lab("grainlab.biax.axial", lab)
   local s = lab.scene
   if lab.plates then
     local H = s:wall_point(lab.plates[2])[2] - s:wall_point(lab.plates[1])[2]
     return 1 - H / lab.H0
   end
   return lab.cfg.rate * (s:info().time - lab.t0)
+end
+
+-- Each function answers help() itself; those taking a configuration list its fields.
+for name, usage in pairs{
+  config = "grainlab.biax.config{ ... }", prepare = "grainlab.biax.prepare{ n = 400, seed = 1, ... }",
+  prepared = "grainlab.biax.prepared{ n = 400, seed = 1, cache = path|false, ... }",
+  scene = "grainlab.biax.scene(state, cfg)", contact = "grainlab.biax.contact(s, cfg, frictionless)",
+  setup = "grainlab.biax.setup(state, 'pressure'|'membrane'|'mbc', cfg)",
+} do
+  grainlab.doc(biax[name], { name = "grainlab.biax." .. name, usage = usage,
+    doc = "See help(grainlab.biax). Configuration fields: " .. table.concat(biax.fields, ", ") .. ".",
+    fields = biax.fields })
+end
+for name, usage in pairs{ save = "grainlab.biax.save(s)", plate_forces = "grainlab.biax.plate_forces(lab)",
+                          start = "grainlab.biax.start(lab, max_steps, tol)", axial = "grainlab.biax.axial(lab)" } do
+  grainlab.doc(biax[name], { name = "grainlab.biax." .. name, usage = usage, doc = "See help(grainlab.biax)." })
 end
 
 return biax

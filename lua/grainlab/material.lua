@@ -20,9 +20,18 @@ local function bad(field, expected, got)
                       field, expected, describe(got)), 3)
 end
 
+-- A material is shared by every grain and wall made of it (and registered once per scene), so it
+-- cannot change afterwards: the fields live in a private table behind __index, and every
+-- assignment -- to a field that exists or not -- is refused, naming the field.
+local values_of = setmetatable({}, { __mode = "k" })
 local meta = {
   __name = "grainlab.material",
-  __newindex = function() error("a grainlab.material is read-only: make a new one", 2) end,
+  __index = function(m, k) return values_of[m][k] end,
+  __newindex = function(_, k)
+    error(string.format("a grainlab.material is read-only: field %s cannot be set (make a new one with grainlab.material{...})",
+                        describe(k)), 2)
+  end,
+  __pairs = function(m) return next, values_of[m], nil end,
   __tostring = function(m)
     return string.format("grainlab.material %s(density %g, young %g, poisson %g, friction %g, restitution %g)",
       m.name and (m.name .. " ") or "", m.density, m.young, m.poisson, m.friction, m.restitution)
@@ -48,7 +57,7 @@ local function material(t)
     elseif f.kind == "string" then
       if type(v) ~= "string" then bad(name, "string", v) end
     else
-      local ok = type(v) == "number" and v == v and v > -math.huge and v < math.huge
+      local ok = type(v) == "number" and v == v and v >= -1e100 and v <= 1e100 -- as the C bindings
       if f.kind == "positive" then ok = ok and v > 0
       elseif f.kind == "nonneg" then ok = ok and v >= 0
       else
@@ -63,10 +72,15 @@ local function material(t)
     end
     m[name] = v
   end
-  return setmetatable(m, meta)
+  local proxy = setmetatable({}, meta)
+  values_of[proxy] = m
+  return proxy
 end
 
-grainlab.doc(material, { name = "grainlab.material",
+local field_names = {}
+for name in pairs(FIELDS) do field_names[#field_names + 1] = name end
+table.sort(field_names)
+grainlab.doc(material, { name = "grainlab.material", fields = field_names,
   usage = "grainlab.material{ density = 2650, young = 30e9, poisson = 0.3, friction = 0.45, restitution = 0.5, name = 'quartz' }",
   doc = [[A read-only grain material. density (kg/m^3) and young (Pa) are required; poisson defaults
 to 0.3, friction (Coulomb mu) to 0, restitution to 1 (elastic). A DEM pair uses the smaller

@@ -9,27 +9,50 @@
 --   pack.settle(s, {…})   damps a packing into a quiescent state (critical background drag);
 --   pack.slab{…}          a dense polydisperse disk packing of a square periodic in y, for MPM
 --                         grains (the shear test of Bardenhagen et al., Fig. 5); returns tables.
+local args = require("grainlab.args")
 local pack = {}
 
-local function fail(call, field, expected, got)
-  local g = type(got) == "number" and tostring(got) or type(got) == "string" and ("'" .. got .. "'") or type(got)
-  error(string.format("bad field '%s' in argument #2 to '%s' (%s expected, got %s)", field, call, expected, g), 3)
-end
+-- Every public function checks its arguments at entry against these specs (grainlab.args), so
+-- an error names grainlab.pack.* and the field, never add_disk, rng or uniform; the same specs
+-- give the field lists that help() and the generated binding test read.
+local function fail(call, field, expected, got) args.fail(call, call:find("slab") and 1 or 2, field, expected, got) end
 
-local function check_opts(call, opts, allowed)
-  if type(opts) ~= "table" then
-    error(string.format("bad argument #2 to '%s' (table expected, got %s)", call, type(opts)), 3)
-  end
-  for k in pairs(opts) do
-    if not allowed[k] then
-      local names = {}
-      for name in pairs(allowed) do names[#names + 1] = name end
-      table.sort(names)
-      error(string.format("bad argument #2 to '%s' (unknown field '%s'; valid fields: %s)", call,
-                          tostring(k), table.concat(names, ", ")), 3)
-    end
-  end
-end
+-- Counts are capped: a Lua-side packer placing more than ten million grains would run for hours
+-- (and an integer like 2^62 would never end).
+local MAX_COUNT = 10000000
+local RADIUS = { check = function(v)
+  local expected = "positive number or {min, max} with 0 < min <= max (at most 1e+100)"
+  if type(v) == "number" then return v > 0 and v <= 1e100, expected end
+  return type(v) == "table" and #v == 2 and type(v[1]) == "number" and type(v[2]) == "number"
+    and v[1] > 0 and v[2] >= v[1] and v[2] <= 1e100, expected
+end }
+local DRAG = { check = function(v)
+  return v == "auto" or (type(v) == "number" and v >= 0 and v <= 1e100),
+    "non-negative number or 'auto'"
+end }
+local SPECS = {
+  random = { n = { "integer", min = 1, max = MAX_COUNT, required = true }, radius = RADIUS,
+             region = { "table" }, seed = { "integer", min = 0 }, material = { check = args.material },
+             max_tries = { "integer", min = 1, max = 1e12 }, speed = { "nonneg" } },
+  deposit = { n = { "integer", min = 1, max = MAX_COUNT, required = true }, radius = RADIUS,
+              region = { "table" }, seed = { "integer", min = 0 }, material = { check = args.material },
+              relax_steps = { "integer", min = 0, max = 1e12 }, drag = DRAG },
+  settle = { soften = { "range", lo = 0, hi = 1, open_lo = true }, drag = DRAG, quiet = { "positive" },
+             min_steps = { "integer", min = 0, max = 1e12 }, max_steps = { "integer", min = 1, max = 1e12 },
+             ramp_stages = { "integer", min = 1, max = 1e6 }, ramp_steps = { "integer", min = 1, max = 1e12 },
+             final_steps = { "integer", min = 0, max = 1e12 }, dt_final = { "positive" },
+             verbose = { "boolean" }, dt = { "positive" }, v_floor = { "positive" },
+             check_steps = { "integer", min = 1, max = 1e12 }, collapse = { "nonneg" },
+             collapse_drag = { "nonneg" }, collapse_quiet = { "positive" } },
+  slab = { size = { "positive", required = true }, n = { "integer", min = 1, max = 100000 },
+           diameter = { check = function(v)
+             return type(v) == "table" and #v == 3 and type(v[1]) == "number" and type(v[2]) == "number"
+               and type(v[3]) == "number" and v[1] > 0 and v[1] < v[2] and v[2] < v[3] and v[3] <= 1e100,
+               "{d_min, d_mean, d_max} with 0 < d_min < d_mean < d_max"
+           end },
+           seed = { "integer", min = 0 }, width = { "range", lo = 1, hi = 1e6, open_lo = true },
+           margin = { "nonneg" } },
+}
 
 local function positive_int(call, opts, field, default)
   local v = opts[field]
@@ -56,11 +79,11 @@ end
 local function region_of(call, s, region, dim)
   local info = s:info()
   if region == nil then return info.box[1], info.box[2] end
-  local ok = type(region) == "table" and type(region[1]) == "table" and type(region[2]) == "table"
-  for d = 1, dim do
-    ok = ok and type(region[1][d]) == "number" and type(region[2][d]) == "number" and region[2][d] > region[1][d]
+  local ok, expected = args.box(dim)(region)
+  for d = 1, dim do -- inside the box: a region outside it would fail inside add_disk
+    ok = ok and region[1][d] >= info.box[1][d] and region[2][d] <= info.box[2][d]
   end
-  if not ok then fail(call, "region", "{{lower corner}, {upper corner}}", region) end
+  if not ok then fail(call, "region", expected .. ", inside the scene's box", region) end
   return region[1], region[2]
 end
 
@@ -111,21 +134,26 @@ local function existing(s, dim)
 end
 
 -- The options both packers share: n, the seeded stream, the radius sampler, the region.
-local function common(call, s, opts, fields)
-  check_opts(call, opts, fields)
+local function common(call, s, opts, spec)
+  args.object(call, 1, s, "dem.scene")
+  args.check(call, 2, opts, spec)
   local info = s:info()
-  local n = positive_int(call, opts, "n", nil)
-  if not n then fail(call, "n", "positive integer", nil) end
+  local n = opts.n
   local rng = grainlab.rng{ seed = opts.seed or 0 }
   local sample, rmax_new = radius_sampler(call, opts.radius, rng)
   local lo, hi = region_of(call, s, opts.region, info.dim)
+  for d = 1, info.dim do
+    if 2 * rmax_new > hi[d] - lo[d] then
+      fail(call, "radius", string.format("radius at most half the region's smallest extent (%g)",
+                                         0.5 * (hi[d] - lo[d])), opts.radius)
+    end
+  end
   return info, n, rng, sample, rmax_new, lo, hi
 end
 
 function pack.random(s, opts)
-  local call = "pack.random"
-  local info, n, rng, sample, rmax_new, lo, hi = common(call, s, opts,
-    { n = true, radius = true, region = true, seed = true, material = true, max_tries = true, speed = true })
+  local call = "grainlab.pack.random"
+  local info, n, rng, sample, rmax_new, lo, hi = common(call, s, opts, SPECS.random)
   local dim = info.dim
   local max_tries = positive_int(call, opts, "max_tries", 1000 * n)
   local speed = opts.speed or 0
@@ -251,9 +279,8 @@ local function drop_and_roll(grid, r, x0, xl, xr, yf, rmax, ytop)
 end
 
 function pack.deposit(s, opts)
-  local call = "pack.deposit"
-  local info, n, rng, sample, rmax_new, lo, hi = common(call, s, opts,
-    { n = true, radius = true, region = true, seed = true, material = true, relax_steps = true, drag = true })
+  local call = "grainlab.pack.deposit"
+  local info, n, rng, sample, rmax_new, lo, hi = common(call, s, opts, SPECS.deposit)
   local dim = info.dim
   local g = info.gravity
   if dim == 3 then
@@ -384,13 +411,9 @@ end
 -- period of the fundamental with critical drag. Near rest the contacts are soft too (small
 -- overlaps): dt ~1e-6 s is stable here (4e-6 s is not), 10x the dt of an impact at 1 m/s.
 function pack.settle(s, opts)
-  local call = "pack.settle"
-  opts = opts or {}
-  check_opts(call, opts, { soften = true, drag = true, quiet = true, min_steps = true,
-                           max_steps = true, ramp_stages = true, ramp_steps = true,
-                           final_steps = true, dt_final = true, verbose = true, dt = true,
-                           v_floor = true, check_steps = true, collapse = true,
-                           collapse_drag = true, collapse_quiet = true })
+  local call = "grainlab.pack.settle"
+  args.object(call, 1, s, "dem.scene")
+  opts = args.check(call, 2, opts, SPECS.settle, true)
   local soften = opts.soften or 1
   if type(soften) ~= "number" or not (soften > 0 and soften <= 1) then fail(call, "soften", "number in (0, 1]", soften) end
   local quiet = opts.quiet or 1e-5
@@ -592,19 +615,19 @@ grainlab.doc(pack, { name = "grainlab.pack", doc = [[Packing generators (reprodu
 -- it, as in the paper's Fig. 5). Returns {x, y, r,
 -- area_fraction (of the L x L square), shrink, mean_radius}.
 function pack.slab(opts)
-  check_opts("slab", opts, { size = true, n = true, diameter = true, seed = true, width = true, margin = true })
+  args.check("grainlab.pack.slab", 1, opts, SPECS.slab)
   local L = opts.size
-  if type(L) ~= "number" or not (L > 0) then fail("slab", "size", "positive number", L) end
+  if type(L) ~= "number" or not (L > 0) then fail("grainlab.pack.slab", "size", "positive number", L) end
   local n = positive_int("slab", opts, "n", 369)
   local dd = opts.diameter or { 31e-6, 57e-6, 250e-6 }
   if type(dd) ~= "table" or #dd ~= 3 or not (dd[1] > 0 and dd[1] < dd[2] and dd[2] < dd[3]) then
-    fail("slab", "diameter", "{d_min, d_mean, d_max} with 0 < d_min < d_mean < d_max", dd)
+    fail("grainlab.pack.slab", "diameter", "{d_min, d_mean, d_max} with 0 < d_min < d_mean < d_max", dd)
   end
   local d_min, d_mean, d_max = dd[1], dd[2], math.min(dd[3], 0.25 * L)
   local W0 = opts.width or 1.8
-  if type(W0) ~= "number" or not (W0 > 1) then fail("slab", "width", "number > 1", W0) end
+  if type(W0) ~= "number" or not (W0 > 1) then fail("grainlab.pack.slab", "width", "number > 1", W0) end
   local margin = opts.margin or 0
-  if type(margin) ~= "number" or not (margin >= 0) then fail("slab", "margin", "non-negative number", margin) end
+  if type(margin) ~= "number" or not (margin >= 0) then fail("grainlab.pack.slab", "margin", "non-negative number", margin) end
   local Lp = L + 2 * margin -- packed width; the disks are shifted by -margin at the end
   W0 = W0 * Lp
   local rng = grainlab.rng{ seed = opts.seed or 5 }
@@ -633,7 +656,7 @@ function pack.slab(opts)
         if ex * ex + ey * ey < (r[i] + r[j]) ^ 2 then ok = false; break end
       end
     until ok or tries > 100000
-    if not ok then error("slab: no room for the disks in the initial slab; use fewer or smaller disks", 2) end
+    if not ok then error("grainlab.pack.slab: no room for the disks in the initial slab; use fewer or smaller disks", 2) end
   end
   local soft = grainlab.material{ density = 1900, young = 2e8, poisson = 0.3, friction = 0, restitution = 0.3 }
   local ds = dem.scene{ box = { { -0.1 * Lp, 0 }, { W0 + 0.1 * Lp, L } }, gravity = { 0, 0 }, periodic = { false, true } }
@@ -681,6 +704,17 @@ function pack.slab(opts)
     end
   end
   return { x = ox, y = oy, r = or_, area_fraction = area / (L * L), shrink = worst + 1e-3, mean_radius = rsum / #ox }
+end
+
+-- Each function answers help() itself, with the fields its entry check accepts.
+for name, usage in pairs{
+  random = "grainlab.pack.random(s, { n =, radius = r | {min, max}, region = {{lo},{hi}}, seed =, material =, max_tries =, speed = })",
+  deposit = "grainlab.pack.deposit(s, { n =, radius = {0.5e-3, 1e-3}, region =, seed =, material =, relax_steps = 20000, drag = 'auto' })",
+  settle = "grainlab.pack.settle(s, { drag = 'auto', quiet = 1e-5, max_steps = 200000, ... })",
+  slab = "grainlab.pack.slab{ size = L, n = 369, diameter = {d_min, d_mean, d_max}, seed = 5, width = 1.8, margin = 0 }",
+} do
+  grainlab.doc(pack[name], { name = "grainlab.pack." .. name, usage = usage,
+    doc = "See help(grainlab.pack) for what it does and returns.", fields = args.fields(SPECS[name]) })
 end
 
 return pack

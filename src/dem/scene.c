@@ -324,9 +324,31 @@ long dem_add_particle(dem_scene *s, const dem_particle_def *p, core_error *err)
             return core_fail(err, CORE_ERR_ARG, "position and velocity must be finite"), -1;
         if (p->x[d] < s->lo[d] || p->x[d] > s->hi[d])
             return core_fail(err, CORE_ERR_ARG,
-                             "position %g on axis %d is outside the box [%g, %g]", p->x[d], d + 1,
-                             s->lo[d], s->hi[d]), -1;
+                             "position %g on axis %d is outside the box [%g, %g] (field 'pos')",
+                             p->x[d], d + 1, s->lo[d], s->hi[d]),
+                   -1;
     }
+    /* Sizes against the box: a grain wider than the box is no grain of this scene, and a grain
+     * so small that its contact overlaps (~1e-4 r) drown in the rounding of its coordinates
+     * (2.2e-16 |x|) gives forces from noise. At r >= 1e-9 max|x| such an overlap still spans
+     * about 450 ulps of the coordinate. */
+    double extent = INFINITY, reach = 0;
+    for (int d = 0; d < D; d++) {
+        extent = fmin(extent, s->hi[d] - s->lo[d]);
+        reach = fmax(reach, fmax(fabs(s->lo[d]), fabs(s->hi[d])));
+    }
+    if (p->radius > 0.5 * extent)
+        return core_fail(err, CORE_ERR_ARG,
+                         "radius %g is larger than half the box's smallest extent %g (field "
+                         "'radius')",
+                         p->radius, 0.5 * extent),
+               -1;
+    if (p->radius < 1e-9 * reach)
+        return core_fail(err, CORE_ERR_ARG,
+                         "radius %g is below 1e-9 of the largest box coordinate %g: its contacts "
+                         "would be lost in the rounding of its position (field 'radius')",
+                         p->radius, reach),
+               -1;
     for (int d = 0; d < 3; d++)
         if (!isfinite(p->omega[d]))
             return core_fail(err, CORE_ERR_ARG, "angular velocity must be finite"), -1;

@@ -78,8 +78,19 @@ core_status dsmc_create(const dsmc_scene_def *def, dsmc_scene **out, core_error 
                              (int)fmin(floor((def->hi[k] - def->lo[k]) / (2 * def->radius)), 1e9));
         ncells *= def->cells[k];
     }
-    if (ncells > 4e9)
-        return core_fail(err, CORE_ERR_ARG, "%.0f cells is more than 4e9", ncells);
+    {
+        /* Per-cell arrays (collision remainders, cell starts, next-in-cell) are allocated here;
+         * a calloc far beyond the machine may "succeed" on an overcommitting system and kill the
+         * process later, so the grid has a fixed budget of 8 GiB, stated with the numbers. */
+        const dsmc_scene *z = NULL;
+        const double budget = 8.0 * 1024 * 1024 * 1024;
+        double bytes = ncells * (double)(sizeof *z->remainder + sizeof *z->start + sizeof *z->next);
+        if (bytes > budget)
+            return core_fail(err, CORE_ERR_ARG,
+                             "%.4g cells need %.3g bytes, above the limit of %.3g bytes (8 GiB); "
+                             "use fewer cells (field 'cells')",
+                             ncells, bytes, budget);
+    }
 
     dsmc_scene *s = calloc(1, sizeof *s);
     if (!s)
@@ -210,6 +221,14 @@ static core_status reserve(dsmc_scene *s, size_t n, core_error *err)
 
 static core_status check_room(const dsmc_scene *s, size_t n, const char *what, core_error *err)
 {
+    /* Positions, velocities (3 + 3 doubles) and a cell index per particle, within the same
+     * fixed 8 GiB budget as the cell grid, for the same reason (overcommitted allocations). */
+    const double budget = 8.0 * 1024 * 1024 * 1024, per = 6 * sizeof(double) + sizeof(uint32_t);
+    if (((double)s->n + (double)n) * per > budget)
+        return core_fail(err, CORE_ERR_ARG,
+                         "%s %zu particles: %zu particles need %.3g bytes, above the limit of "
+                         "%.3g bytes (8 GiB) (field 'n')",
+                         what, n, s->n + n, ((double)s->n + (double)n) * per, budget);
     size_t cap = dsmc_capacity(s);
     if (n > cap || s->n + n > cap)
         return core_fail(err, CORE_ERR_ARG,

@@ -5,6 +5,29 @@
 
 #include "lua/bind.h"
 
+static const char *number_kind(unsigned flags);
+
+/* The largest magnitude any number crossing the bindings may have, unless the flags allow inf.
+ * No SI quantity of a granular scene comes near it, and products of three such numbers (a
+ * stiffness times an overlap squared, m v^2) stay finite in double precision (1e300 < 1.8e308),
+ * so no kernel turns an accepted input into inf or NaN. */
+#define BIND_MAX_MAGNITUDE 1e100
+
+static int too_large(double v, unsigned flags)
+{
+    return !(flags & BIND_ALLOW_INF) && isfinite(v) && fabs(v) > BIND_MAX_MAGNITUDE;
+}
+
+/* "positive number" or, for a finite value above the cap, "positive number of magnitude at most
+ * 1e+100": the limit is in the message only when it is what the value broke. */
+static const char *expected_kind(unsigned flags, double v, char *buf, size_t size)
+{
+    if (!too_large(v, flags))
+        return number_kind(flags);
+    snprintf(buf, size, "%s of magnitude at most %g", number_kind(flags), BIND_MAX_MAGNITUDE);
+    return buf;
+}
+
 /* The argument number the user sees: a method's self is not counted, as in luaL_argerror. */
 static int user_arg(lua_State *L, int arg)
 {
@@ -43,6 +66,80 @@ int bind_field_error(lua_State *L, int arg, const char *call, const char *field,
     bind_describe(L, -1, got, sizeof got);
     return luaL_error(L, "bad field '%s' in argument #%d to '%s' (%s expected, got %s)", field,
                       user_arg(L, arg), call, expected, got);
+}
+
+int bind_arg_error(lua_State *L, int arg, const char *call, const char *expected)
+{
+    char got[64];
+    bind_describe(L, arg, got, sizeof got);
+    return luaL_error(L, "bad argument #%d to '%s' (%s expected, got %s)", user_arg(L, arg), call,
+                      expected, got);
+}
+
+double bind_arg_number(lua_State *L, int arg, const char *call, unsigned flags)
+{
+    double v = lua_tonumber(L, arg);
+    char buf[96];
+    if (lua_type(L, arg) != LUA_TNUMBER || isnan(v) || (!(flags & BIND_ALLOW_INF) && isinf(v)) ||
+        ((flags & BIND_POSITIVE) && !(v > 0)) || ((flags & BIND_NONNEG) && !(v >= 0)) ||
+        too_large(v, flags))
+        bind_arg_error(L, arg, call, expected_kind(flags, v, buf, sizeof buf));
+    return v;
+}
+
+lua_Integer bind_arg_integer(lua_State *L, int arg, const char *call, lua_Integer min,
+                             lua_Integer max)
+{
+    int isint;
+    lua_Integer v = lua_tointegerx(L, arg, &isint);
+    if (!isint || lua_type(L, arg) != LUA_TNUMBER || v < min || v > max) {
+        char expected[96];
+        if (min == LUA_MININTEGER && max == LUA_MAXINTEGER)
+            snprintf(expected, sizeof expected, "integer");
+        else if (max == LUA_MAXINTEGER)
+            snprintf(expected, sizeof expected, "integer >= %lld", (long long)min);
+        else
+            snprintf(expected, sizeof expected, "integer in [%lld, %lld]", (long long)min,
+                     (long long)max);
+        bind_arg_error(L, arg, call, expected);
+    }
+    return v;
+}
+
+void bind_arg_vector(lua_State *L, int arg, const char *call, int n, double *out)
+{
+    char expected[64];
+    snprintf(expected, sizeof expected, "array of %d finite numbers", n);
+    if (lua_type(L, arg) != LUA_TTABLE || lua_rawlen(L, arg) != (size_t)n)
+        bind_arg_error(L, arg, call, expected);
+    for (int k = 0; k < n; k++) {
+        lua_rawgeti(L, arg, k + 1);
+        int isnum;
+        double v = lua_tonumberx(L, -1, &isnum);
+        if (!isnum || lua_type(L, -1) != LUA_TNUMBER || !isfinite(v) || too_large(v, 0)) {
+            char got[64];
+            bind_describe(L, -1, got, sizeof got);
+            luaL_error(L, "bad argument #%d to '%s' (%s%s expected, got %s at entry %d)",
+                       user_arg(L, arg), call, expected,
+                       too_large(v, 0) ? " of magnitude at most 1e+100" : "", got, k + 1);
+        }
+        lua_pop(L, 1);
+        out[k] = v;
+    }
+}
+
+void *bind_check_self(lua_State *L, int arg, const char *tname, const char *call)
+{
+    void *u = luaL_testudata(L, arg, tname);
+    if (!u) {
+        char got[64];
+        bind_describe(L, arg, got, sizeof got);
+        luaL_error(L,
+                   "bad argument #%d to '%s' (%s expected, got %s; a method is called with "
+                   "':', as s:%s(...))",
+                   user_arg(L, arg) > 0 ? user_arg(L, arg) : arg, call, tname, got, call);
+    }
+    return u;
 }
 
 void bind_check_table(lua_State *L, int arg, const char *call)
@@ -108,10 +205,11 @@ double bind_field_number(lua_State *L, int arg, const char *call, const char *fi
         return def;
     int isnum;
     double v = lua_tonumberx(L, -1, &isnum);
+    char buf[96];
     if (!isnum || lua_type(L, -1) != LUA_TNUMBER || isnan(v) ||
         (!(flags & BIND_ALLOW_INF) && isinf(v)) || ((flags & BIND_POSITIVE) && !(v > 0)) ||
-        ((flags & BIND_NONNEG) && !(v >= 0)))
-        bind_field_error(L, arg, call, field, expected);
+        ((flags & BIND_NONNEG) && !(v >= 0)) || too_large(v, flags))
+        bind_field_error(L, arg, call, field, expected_kind(flags, v, buf, sizeof buf));
     lua_pop(L, 1);
     return v;
 }
@@ -183,14 +281,18 @@ int bind_field_vector(lua_State *L, int arg, const char *call, const char *field
         lua_rawgeti(L, -1, k + 1);
         int isnum;
         double v = lua_tonumberx(L, -1, &isnum);
+        isnum = isnum && lua_type(L, -1) == LUA_TNUMBER; /* no "1.5" strings */
         lua_pop(L, 1);
-        if (!isnum || !isfinite(v)) {
+        if (!isnum || !isfinite(v) || too_large(v, 0)) {
             char got[64];
             lua_rawgeti(L, -1, k + 1);
             bind_describe(L, -1, got, sizeof got);
-            return luaL_error(L, "bad field '%s' in argument #%d to '%s' (array of %d finite "
-                              "numbers expected, got %s at entry %d)",
-                              field, user_arg(L, arg), call, n, got, k + 1);
+            return luaL_error(L,
+                              "bad field '%s' in argument #%d to '%s' (array of %d finite "
+                              "numbers%s expected, got %s at entry %d)",
+                              field, user_arg(L, arg), call, n,
+                              isnum && too_large(v, 0) ? " of magnitude at most 1e+100" : "", got,
+                              k + 1);
         }
         out[k] = v;
     }
@@ -233,10 +335,14 @@ void bind_field_box(lua_State *L, int arg, const char *call, const char *field, 
             lua_rawgeti(L, -1, d + 1);
             int isnum;
             double v = lua_tonumberx(L, -1, &isnum);
+            isnum = isnum && lua_type(L, -1) == LUA_TNUMBER;
             lua_pop(L, 1);
-            if (!isnum || !isfinite(v)) {
+            if (!isnum || !isfinite(v) || too_large(v, 0)) {
                 lua_pop(L, 1);
-                bind_field_error(L, arg, call, field, expected);
+                bind_field_error(L, arg, call, field,
+                                 isnum && too_large(v, 0)
+                                     ? "box corners of magnitude at most 1e+100"
+                                     : expected);
             }
             (c == 0 ? lo : hi)[d] = v;
         }
@@ -248,6 +354,33 @@ void bind_field_box(lua_State *L, int arg, const char *call, const char *field, 
             lua_getfield(L, arg, field);
             bind_field_error(L, arg, call, field, "upper corner above the lower one on every axis");
         }
+}
+
+int bind_steps_or_time(lua_State *L, int arg, const char *call, long *steps, double *time)
+{
+    *steps = (long)bind_field_integer(L, arg, call, "steps", -1, 0, LUA_MAXINTEGER, 0);
+    *time = bind_field_number(L, arg, call, "time", -1, BIND_NONNEG);
+    if (*steps >= 0 && *time >= 0) {
+        lua_getfield(L, arg, "time");
+        bind_field_error(L, arg, call, "time", "nothing when 'steps' is given (give one)");
+    }
+    if (*steps < 0 && *time < 0) {
+        lua_pushnil(L);
+        bind_field_error(L, arg, call, "steps", "step count (or field 'time')");
+    }
+    return *steps >= 0;
+}
+
+long bind_time_steps(lua_State *L, int arg, const char *call, double time, double dt)
+{
+    double n = ceil(time / dt - 1e-9);
+    if (!(n <= 1e15)) {
+        char expected[128];
+        snprintf(expected, sizeof expected, "time of at most 1e15 steps of dt = %g s", dt);
+        lua_getfield(L, arg, "time");
+        bind_field_error(L, arg, call, "time", expected);
+    }
+    return n > 0 ? (long)n : 0;
 }
 
 /* Optimal string alignment distance (edits and adjacent swaps), capped: names are short. */

@@ -52,8 +52,9 @@ const char *bind_field_string(lua_State *L, int arg, const char *call, const cha
 int bind_field_option(lua_State *L, int arg, const char *call, const char *field,
                       const char *const names[], int def, unsigned flags);
 
-/* Reads an array of n finite numbers (a position, a velocity) into out; absent: out unchanged
- * (or an error when BIND_REQUIRED). Returns 1 when present. */
+/* Reads an array of exactly n finite numbers (a position, a velocity) into out: a table of
+ * another length is refused, never truncated. Absent: out unchanged (or an error when
+ * BIND_REQUIRED). Returns 1 when present. */
 int bind_field_vector(lua_State *L, int arg, const char *call, const char *field, int n,
                       double *out, unsigned flags);
 int bind_field_boolean(lua_State *L, int arg, const char *call, const char *field, int def);
@@ -66,6 +67,18 @@ void bind_field_box(lua_State *L, int arg, const char *call, const char *field, 
  * on top of the stack. */
 int bind_field_error(lua_State *L, int arg, const char *call, const char *field,
                      const char *expected);
+
+/* Positional arguments, in the same grammar: "bad argument #N to 'call' (EXPECTED expected, got
+ * VALUE)". A number is finite unless BIND_ALLOW_INF; flags as for fields. */
+int bind_arg_error(lua_State *L, int arg, const char *call, const char *expected);
+double bind_arg_number(lua_State *L, int arg, const char *call, unsigned flags);
+lua_Integer bind_arg_integer(lua_State *L, int arg, const char *call, lua_Integer min,
+                             lua_Integer max);
+/* An array of exactly n finite numbers (a velocity) into out. */
+void bind_arg_vector(lua_State *L, int arg, const char *call, int n, double *out);
+/* The userdata of type tname at arg, or an error naming the call that says how to call a method
+ * (s:run{...}, not s.run{...}) when arg is a method's self. */
+void *bind_check_self(lua_State *L, int arg, const char *tname, const char *call);
 
 /* Writes a short description of the value at idx: "-0.1", "'xyz'", "nil", "table". */
 void bind_describe(lua_State *L, int idx, char *buf, size_t size);
@@ -94,6 +107,14 @@ typedef struct bind_run {
  * Returns 1 when on_step returned false. */
 int bind_run_chunks(lua_State *L, int scene, int arg, const char *call, const bind_run *r);
 
+/* Reads `steps` (a non-negative integer) or `time` (s, non-negative) from the run options at
+ * arg, exactly one of them, with errors naming the fields. Returns 1 with *steps set, or 0 with
+ * *time set. */
+int bind_steps_or_time(lua_State *L, int arg, const char *call, long *steps, double *time);
+/* The number of steps of dt that cover `time`, or an error naming field 'time' beyond 1e15 steps
+ * (a year at a million steps a second: beyond it a count loses its meaning, and it would soon
+ * overflow). */
+long bind_time_steps(lua_State *L, int arg, const char *call, double time, double dt);
 /* The run in progress of the scene at idx (its on_step is calling), or NULL. */
 const bind_run *bind_running(lua_State *L, int idx);
 
@@ -113,6 +134,23 @@ typedef struct bind_fn {
     const char *usage; /* "grainlab.rng{ seed = 0, stream = 0 }" */
     const char *doc;   /* what it does, arguments, what it returns */
 } bind_fn;
+
+/* The keys a function's options table accepts: the same NULL-terminated array the function
+ * passes to bind_check_fields, so that help() and the generated binding tests
+ * (tests/lua/test_fuzz_*.lua) enumerate exactly what the function checks. `mode` is NULL, or the
+ * first argument the list goes with (s:measure('stress', { volume = })). */
+typedef struct bind_fields {
+    const char *name;          /* the registered function or method */
+    const char *mode;          /* NULL or the mode argument */
+    const char *const *fields; /* NULL-terminated */
+} bind_fields;
+
+/* Adds `fields` (or `modes[mode]`) to the doc records of the functions of the table at idx;
+ * a name that is not a documented function there is a programming error (luaL_error). The list
+ * ends with a NULL name. */
+void bind_register_fields(lua_State *L, int idx, const bind_fields *list);
+/* The same for the methods of the userdata type `tname` (after bind_new_type). */
+void bind_type_fields(lua_State *L, const char *tname, const bind_fields *list);
 
 /* Sets each function as a field of the table at idx and records its doc. */
 void bind_register(lua_State *L, int idx, const bind_fn *fns);

@@ -94,7 +94,7 @@ static double *read_array_at(lua_State *L, int tab, const char *key, int arg, co
         lua_rawgeti(L, arr, (lua_Integer)i + 1);
         int isnum = lua_type(L, -1) == LUA_TNUMBER;
         v[i] = lua_tonumber(L, -1);
-        if (!isnum || !isfinite(v[i]))
+        if (!isnum || !isfinite(v[i]) || fabs(v[i]) > 1e100) /* the bindings' magnitude cap */
             entry_error(L, arg, call, name, what, i + 1);
         lua_pop(L, 1);
     }
@@ -193,17 +193,18 @@ static void set_tensor_arrays(lua_State *L, const double *t, size_t n, const cha
 }
 
 /* ---- analysis.delaunay ------------------------------------------------------------------------ */
+static const char *const DELAUNAY_FIELDS[] = {"alpha", "ids", NULL};
+
 static int l_delaunay(lua_State *L)
 {
     const char *call = "delaunay";
-    static const char *const ofields[] = {"alpha", "ids", NULL};
     double alpha = 1.5;
     long *ids = NULL;
     size_t nids = 0;
     int has_opts = !lua_isnoneornil(L, 2);
     if (has_opts) {
         bind_check_table(L, 2, call);
-        bind_check_fields(L, 2, call, ofields);
+        bind_check_fields(L, 2, call, DELAUNAY_FIELDS);
         alpha = bind_field_number(L, 2, call, "alpha", 1.5, BIND_NONNEG);
     }
     const double *x, *y, *r = NULL;
@@ -235,6 +236,10 @@ static int l_delaunay(lua_State *L)
     /* ids: entries of the table (or scene particles), distinct, so that the mesh's vertices
      * map back to one particle each. */
     if (has_opts && (ids = read_ids(L, 2, call, "ids", n, 1, 0, &nids))) {
+        if (nids < 3) { /* the triangulation's own minimum, named after the field */
+            lua_getfield(L, 2, "ids");
+            return bind_field_error(L, 2, call, "ids", "array of at least 3 distinct particle ids");
+        }
         double *sx = scratch(L, nids), *sy = scratch(L, nids), *sr = r ? scratch(L, nids) : NULL;
         for (size_t k = 0; k < nids; k++) {
             sx[k] = x[ids[k]];
@@ -1164,13 +1169,14 @@ static int l_boundary_edges(lua_State *L)
     return 1;
 }
 
+static const char *const SPRINGS_FIELDS[] = {"i", "j", "k", "rest", NULL};
+
 static int l_springs(lua_State *L)
 {
     const char *call = "springs";
-    static const char *const fields[] = {"i", "j", "k", "rest", NULL};
     dem_scene *s = bind_check_dem_scene(L, 1, call);
     bind_check_table(L, 2, call);
-    bind_check_fields(L, 2, call, fields);
+    bind_check_fields(L, 2, call, SPRINGS_FIELDS);
     double k = bind_field_number(L, 2, call, "k", 0, BIND_REQUIRED | BIND_POSITIVE);
     /* Ids checked as integers in range before they become C indices. */
     size_t n = 0, nj = 0;
@@ -1179,7 +1185,7 @@ static int l_springs(lua_State *L)
     if (nj != n) {
         char got[64], want[64];
         snprintf(got, sizeof got, "%zu values", nj);
-        snprintf(want, sizeof want, "as many ids as i (%zu)", n);
+        snprintf(want, sizeof want, "as many ids as 'i' (%zu)", n);
         return field_fail(L, 2, call, "j", want, got);
     }
     double *rest = read_array(L, 2, call, "rest", &n, 0);
@@ -1189,17 +1195,22 @@ static int l_springs(lua_State *L)
     return 0;
 }
 
+static const char *const TIE_FIELDS[] = {"ids", "wall", "axis", NULL};
+
 static int l_tie(lua_State *L)
 {
     const char *call = "tie";
-    static const char *const fields[] = {"ids", "wall", "axis", NULL};
     dem_scene *s = bind_check_dem_scene(L, 1, call);
     bind_check_table(L, 2, call);
-    bind_check_fields(L, 2, call, fields);
+    bind_check_fields(L, 2, call, TIE_FIELDS);
     int wall = (int)bind_field_integer(L, 2, call, "wall", 0, 1, 1 << 30, BIND_REQUIRED) - 1;
     int axis = (int)bind_field_integer(L, 2, call, "axis", 2, 1, 2, 0) - 1;
     size_t n = 0;
     const long *ids = read_ids(L, 2, call, "ids", dem_count(s), 0, 1, &n);
+    if (n == 0) { /* tying nothing is a mistake, not a no-op */
+        lua_getfield(L, 2, "ids");
+        return bind_field_error(L, 2, call, "ids", "non-empty array of particle ids");
+    }
     for (size_t q = 0; q < n; q++) {
         core_error err;
         if (dem_tie_to_wall(s, (size_t)ids[q], wall, axis, &err))
@@ -1208,13 +1219,14 @@ static int l_tie(lua_State *L)
     return 0;
 }
 
+static const char *const SPIN_FIELDS[] = {"id", "omega", NULL};
+
 static int l_spin(lua_State *L)
 {
     const char *call = "spin";
-    static const char *const fields[] = {"id", "omega", NULL};
     dem_scene *s = bind_check_dem_scene(L, 1, call);
     bind_check_table(L, 2, call);
-    bind_check_fields(L, 2, call, fields);
+    bind_check_fields(L, 2, call, SPIN_FIELDS);
     lua_Integer id = bind_field_integer(L, 2, call, "id", 0, 1, (lua_Integer)dem_count(s),
                                         BIND_REQUIRED);
     double w = bind_field_number(L, 2, call, "omega", 0, BIND_REQUIRED);
@@ -1273,8 +1285,11 @@ void bind_open_analysis(lua_State *L)
          "scene). Refuses fewer than 3 particles, collinear centres, duplicate positions and "
          "non-positive radii. Returns an analysis.mesh."},
         {NULL, NULL, NULL, NULL}};
+    static const bind_fields fn_fields[] = {{"delaunay", NULL, DELAUNAY_FIELDS},
+                                            {NULL, NULL, NULL}};
     lua_newtable(L);
     bind_register(L, -1, fns);
+    bind_register_fields(L, -1, fn_fields);
     bind_doc(L, -1, "analysis", "analysis",
              "The Delaunay-cell continuum of a 2D assembly (Padbidri Sec. 2.5, 3.2): cells, "
              "boundary loop, Bagi-Satake strains and strain rates, L_II, Christoffersen stress.");
@@ -1328,4 +1343,9 @@ void bind_open_analysis(lua_State *L)
     lua_getfield(L, -1, "__index");
     bind_register(L, lua_gettop(L), scene_methods);
     lua_pop(L, 2);
+    static const bind_fields method_fields[] = {{"springs", NULL, SPRINGS_FIELDS},
+                                                {"spin", NULL, SPIN_FIELDS},
+                                                {"tie", NULL, TIE_FIELDS},
+                                                {NULL, NULL, NULL}};
+    bind_type_fields(L, "dem.scene", method_fields);
 }

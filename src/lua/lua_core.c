@@ -52,16 +52,17 @@ static int l_threads(lua_State *L)
 /* ---- random streams ---------------------------------------------------------------------- */
 static const char *RNG = "grainlab.rng";
 
+static const char *const RNG_FIELDS[] = {"seed", "stream", NULL};
+
 static int l_rng_new(lua_State *L)
 {
-    static const char *const fields[] = {"seed", "stream", NULL};
     lua_settop(L, 1);
     if (lua_isnil(L, 1)) { /* grainlab.rng() and grainlab.rng(nil): all defaults */
         lua_newtable(L);
         lua_replace(L, 1);
     }
     bind_check_table(L, 1, "rng");
-    bind_check_fields(L, 1, "rng", fields);
+    bind_check_fields(L, 1, "rng", RNG_FIELDS);
     lua_Integer seed = bind_field_integer(L, 1, "rng", "seed", 0, 0, LUA_MAXINTEGER, 0);
     lua_Integer stream = bind_field_integer(L, 1, "rng", "stream", 0, 0, 1 << 20, 0);
     rng *r = lua_newuserdatauv(L, sizeof *r, 0);
@@ -73,7 +74,8 @@ static int l_rng_new(lua_State *L)
 static int l_rng_uniform(lua_State *L)
 {
     rng *r = luaL_checkudata(L, 1, RNG);
-    double a = luaL_optnumber(L, 2, 0.0), b = luaL_optnumber(L, 3, 1.0);
+    double a = lua_isnoneornil(L, 2) ? 0.0 : bind_arg_number(L, 2, "uniform", 0);
+    double b = lua_isnoneornil(L, 3) ? 1.0 : bind_arg_number(L, 3, "uniform", 0);
     luaL_argcheck(L, b >= a, 3, "upper bound below lower bound");
     lua_pushnumber(L, a + (b - a) * rng_uniform(r));
     return 1;
@@ -82,8 +84,8 @@ static int l_rng_uniform(lua_State *L)
 static int l_rng_normal(lua_State *L)
 {
     rng *r = luaL_checkudata(L, 1, RNG);
-    double mean = luaL_optnumber(L, 2, 0.0), sd = luaL_optnumber(L, 3, 1.0);
-    luaL_argcheck(L, sd >= 0, 3, "standard deviation must be >= 0");
+    double mean = lua_isnoneornil(L, 2) ? 0.0 : bind_arg_number(L, 2, "normal", 0);
+    double sd = lua_isnoneornil(L, 3) ? 1.0 : bind_arg_number(L, 3, "normal", BIND_NONNEG);
     lua_pushnumber(L, mean + sd * rng_normal(r));
     return 1;
 }
@@ -91,8 +93,8 @@ static int l_rng_normal(lua_State *L)
 static int l_rng_integer(lua_State *L)
 {
     rng *r = luaL_checkudata(L, 1, RNG);
-    lua_Integer lo = luaL_checkinteger(L, 2), hi = luaL_checkinteger(L, 3);
-    luaL_argcheck(L, hi >= lo, 3, "upper bound below lower bound");
+    lua_Integer lo = bind_arg_integer(L, 2, "integer", LUA_MININTEGER, LUA_MAXINTEGER);
+    lua_Integer hi = bind_arg_integer(L, 3, "integer", lo, LUA_MAXINTEGER);
     uint64_t span = (uint64_t)hi - (uint64_t)lo + 1; /* 0 means the full 2^64 range */
     uint64_t u = span ? rng_below(r, span) : rng_next(r);
     lua_pushinteger(L, (lua_Integer)((uint64_t)lo + u));
@@ -116,11 +118,12 @@ static int l_rng_tostring(lua_State *L)
 /* ---- progress reporters ------------------------------------------------------------------ */
 static const char *PROGRESS = "grainlab.progress";
 
+static const char *const PROGRESS_FIELDS[] = {"label", "total", "unit", NULL};
+
 static int l_progress_new(lua_State *L)
 {
-    static const char *const fields[] = {"label", "total", "unit", NULL};
     bind_check_table(L, 1, "progress");
-    bind_check_fields(L, 1, "progress", fields);
+    bind_check_fields(L, 1, "progress", PROGRESS_FIELDS);
     const char *label = bind_field_string(L, 1, "progress", "label", "run", 0);
     double total = bind_field_number(L, 1, "progress", "total", 0, BIND_NONNEG);
     const char *unit = bind_field_string(L, 1, "progress", "unit", "steps", 0);
@@ -136,11 +139,11 @@ static int l_progress_new(lua_State *L)
 static double check_done(lua_State *L, int arg, const char *call)
 {
     double done = luaL_checknumber(L, arg);
-    if (!(done >= 0) || !isfinite(done)) {
+    if (!(done >= 0) || !(done <= 1e100)) { /* NaN, inf and the bindings' magnitude cap */
         char got[64];
         bind_describe(L, arg, got, sizeof got);
-        luaL_error(L, "bad argument #1 to '%s' (finite non-negative number expected, got %s)",
-                   call, got);
+        luaL_error(L, "bad argument #1 to '%s' (finite non-negative number expected, got %s)", call,
+                   got);
     }
     return done;
 }
@@ -173,9 +176,14 @@ static int l_progress_finish(lua_State *L)
 /* ---- files ------------------------------------------------------------------------------- */
 static int l_write_file(lua_State *L)
 {
-    const char *path = luaL_checkstring(L, 1);
+    /* strings only: a number would silently become a file name or the file's text */
+    if (lua_type(L, 1) != LUA_TSTRING)
+        bind_arg_error(L, 1, "write_file", "string");
+    if (lua_type(L, 2) != LUA_TSTRING)
+        bind_arg_error(L, 2, "write_file", "string");
+    const char *path = lua_tostring(L, 1);
     size_t len;
-    const char *data = luaL_checklstring(L, 2, &len);
+    const char *data = lua_tolstring(L, 2, &len);
     core_error err;
     if (atomic_write(path, data, len, &err) != CORE_OK) {
         luaL_pushfail(L);
@@ -230,6 +238,9 @@ void bind_open_core(lua_State *L, int idx)
     bind_new_type(L, PROGRESS, progress_methods, progress_meta,
                   "A progress reporter from grainlab.progress{...}.");
     bind_register(L, idx, fns);
+    static const bind_fields fields[] = {
+        {"rng", NULL, RNG_FIELDS}, {"progress", NULL, PROGRESS_FIELDS}, {NULL, NULL, NULL}};
+    bind_register_fields(L, idx, fields);
     lua_pushliteral(L, GRAINLAB_VERSION);
     lua_setfield(L, idx, "version");
     lua_pushliteral(L, GRAINLAB_DEPS);

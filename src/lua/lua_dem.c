@@ -1,5 +1,6 @@
 /* The Lua module `dem`: scenes of disks (2D) or spheres (3D) over src/dem. Translates and checks
  * arguments, calls the kernels, raises their errors named after the call. */
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -37,12 +38,13 @@ struct dem_scene *bind_check_dem_scene(lua_State *L, int idx, const char *call)
 }
 
 /* ---- dem.scene{...} ------------------------------------------------------------------------ */
+static const char *const SCENE_FIELDS[] = {"dim",       "box",  "gravity", "periodic",
+                                           "thickness", "skin", NULL};
+
 static int l_scene(lua_State *L)
 {
-    static const char *const fields[] = {"dim", "box", "gravity", "periodic", "thickness", "skin",
-                                         NULL};
     bind_check_table(L, 1, "scene");
-    bind_check_fields(L, 1, "scene", fields);
+    bind_check_fields(L, 1, "scene", SCENE_FIELDS);
     dem_scene_def def = dem_default_scene_def();
     def.dim = (int)bind_field_integer(L, 1, "scene", "dim", 2, 2, 3, 0);
     bind_field_box(L, 1, "scene", "box", def.dim, def.lo, def.hi);
@@ -138,26 +140,57 @@ static const char *const DAMPING_NAMES[] = {"none", "viscous", "brilliantov", NU
 static const char *const TANGENT_NAMES[] = {"none", "viscous", "spring", "coulomb_regularized",
                                             NULL};
 
+static const char *const CONTACT_FIELDS[] = {
+    "normal",          "stiffness",  "beta",    "damping", "gamma_n", "damping_time", "restitution",
+    "impact_velocity", "tangential", "gamma_t", "kt",      "v_r",     "exponent",     "clip",
+    "rolling",         NULL};
+
+/* A field given although the chosen law ignores it is refused: a typo'd law must not leave the
+ * user believing a value took effect. `why` names the field and value that give it meaning. */
+static void only_with(lua_State *L, const char *field, int meaningful, const char *why)
+{
+    if (!meaningful && lua_getfield(L, 2, field) != LUA_TNIL) {
+        char expected[160];
+        snprintf(expected, sizeof expected, "nothing unless %s", why);
+        bind_field_error(L, 2, "contact", field, expected);
+    }
+    lua_settop(L, 2);
+}
+
 static int l_contact(lua_State *L)
 {
-    static const char *const fields[] = {
-        "normal", "stiffness", "beta", "damping", "gamma_n", "damping_time", "restitution",
-        "impact_velocity", "tangential", "gamma_t", "kt", "v_r", "exponent", "clip", "rolling",
-        NULL};
     dem_scene *s = check_scene(L, 1);
-    bind_refuse_running(L, 1, "contact", "the contact law cannot change under the time step its "
-                                         "run was checked at: change it between runs");
+    bind_refuse_running(L, 1, "contact",
+                        "the contact law cannot change under the time step its "
+                        "run was checked at: change it between runs");
     bind_check_table(L, 2, "contact");
-    bind_check_fields(L, 2, "contact", fields);
+    bind_check_fields(L, 2, "contact", CONTACT_FIELDS);
     dem_contact_def c = dem_default_contact_def();
     c.normal = (dem_normal_law)bind_field_option(L, 2, "contact", "normal", NORMAL_NAMES,
                                                  DEM_NORMAL_HERTZ, 0);
+    c.damping = (dem_damping_law)bind_field_option(L, 2, "contact", "damping", DAMPING_NAMES,
+                                                   DEM_DAMPING_NONE, 0);
+    c.tangential = (dem_tangential_law)bind_field_option(L, 2, "contact", "tangential",
+                                                         TANGENT_NAMES, DEM_TANGENT_NONE, 0);
+    lua_settop(L, 2);
+    only_with(L, "stiffness", c.normal != DEM_NORMAL_HERTZ,
+              "'normal' is 'linear' or 'power' (hertz takes the materials' moduli)");
+    only_with(L, "beta", c.normal == DEM_NORMAL_POWER, "'normal' is 'power'");
+    only_with(L, "gamma_n", c.damping == DEM_DAMPING_VISCOUS, "'damping' is 'viscous'");
+    only_with(L, "damping_time", c.damping == DEM_DAMPING_BRILLIANTOV,
+              "'damping' is 'brilliantov'");
+    only_with(L, "gamma_t", c.tangential == DEM_TANGENT_VISCOUS, "'tangential' is 'viscous'");
+    only_with(L, "kt", c.tangential == DEM_TANGENT_SPRING, "'tangential' is 'spring'");
+    only_with(L, "v_r", c.tangential == DEM_TANGENT_REGULARIZED,
+              "'tangential' is 'coulomb_regularized'");
+    only_with(L, "exponent", c.tangential == DEM_TANGENT_REGULARIZED,
+              "'tangential' is 'coulomb_regularized'");
+    only_with(L, "impact_velocity", c.damping == DEM_DAMPING_BRILLIANTOV,
+              "'damping' is 'brilliantov' (with 'restitution')");
     unsigned need_k = c.normal == DEM_NORMAL_HERTZ ? 0 : BIND_REQUIRED;
     c.stiffness = bind_field_number(L, 2, "contact", "stiffness", 0, BIND_POSITIVE | need_k);
     c.beta = bind_field_number(L, 2, "contact", "beta", c.normal == DEM_NORMAL_LINEAR ? 1 : 1.5,
                                BIND_POSITIVE);
-    c.damping = (dem_damping_law)bind_field_option(L, 2, "contact", "damping", DAMPING_NAMES,
-                                                   DEM_DAMPING_NONE, 0);
     /* Absent optional values are -1 ("not given"); given ones must be in range. */
     c.gamma_n = bind_field_number(L, 2, "contact", "gamma_n", -1, 0);
     if (c.gamma_n < 0 && lua_getfield(L, 2, "gamma_n") != LUA_TNIL)
@@ -166,12 +199,17 @@ static int l_contact(lua_State *L)
     if (c.damping_time < 0 && lua_getfield(L, 2, "damping_time") != LUA_TNIL)
         return bind_field_error(L, 2, "contact", "damping_time", "non-negative number");
     double e = bind_field_number(L, 2, "contact", "restitution", -1, 0);
+    if (c.damping_time >= 0 && lua_getfield(L, 2, "restitution") != LUA_TNIL)
+        return bind_field_error(L, 2, "contact", "restitution",
+                                "nothing when 'damping_time' is given: give damping_time (one T "
+                                "for every pair) or restitution (a T per pair), not both");
+    lua_settop(L, 2);
     if (e >= 0 || lua_getfield(L, 2, "restitution") != LUA_TNIL) {
         lua_getfield(L, 2, "restitution");
         if (c.damping != DEM_DAMPING_BRILLIANTOV)
             return bind_field_error(L, 2, "contact", "restitution",
-                                    "nothing unless damping = 'brilliantov' (viscous damping takes "
-                                    "the materials' restitution)");
+                                    "nothing unless 'damping' is 'brilliantov' (viscous damping "
+                                    "takes the materials' restitution)");
         if (!(e > 0 && e <= 1))
             return bind_field_error(L, 2, "contact", "restitution", "number in (0, 1]");
         lua_pop(L, 1);
@@ -180,9 +218,8 @@ static int l_contact(lua_State *L)
     if (e < 0 && lua_getfield(L, 2, "impact_velocity") != LUA_TNIL)
         return bind_field_error(
             L, 2, "contact", "impact_velocity",
-            "nothing unless restitution is given (the speed at which it holds)");
-    c.tangential = (dem_tangential_law)bind_field_option(L, 2, "contact", "tangential",
-                                                         TANGENT_NAMES, DEM_TANGENT_NONE, 0);
+            "nothing unless restitution is given (the speed at which 'restitution' holds)");
+    lua_settop(L, 2);
     c.gamma_t = bind_field_number(L, 2, "contact", "gamma_t", 0, BIND_NONNEG);
     c.kt = bind_field_number(L, 2, "contact", "kt", -1, 0);
     if (c.kt <= 0 && lua_getfield(L, 2, "kt") != LUA_TNIL)
@@ -193,13 +230,12 @@ static int l_contact(lua_State *L)
     c.rolling = bind_field_boolean(L, 2, "contact", "rolling", 0);
     if (c.damping == DEM_DAMPING_BRILLIANTOV) {
         if (c.damping_time < 0 && e < 0)
-            return luaL_error(L, "contact: brilliantov damping needs damping_time (s) or "
-                                 "restitution (with impact_velocity, default 1 m/s)");
-        if (c.damping_time >= 0 && e >= 0)
-            return luaL_error(L, "contact: give damping_time (one T for every pair) or "
-                                 "restitution (a T per pair), not both");
+            return luaL_error(L, "bad argument #1 to 'contact' (damping = 'brilliantov' needs "
+                                 "field 'damping_time' (s) or 'restitution' (with "
+                                 "'impact_velocity', default 1 m/s))");
         /* From a restitution each pair gets its own T when the pair list is built: nothing
-         * depends on the particles present now. */
+         * depends on the particles present now. (damping_time and restitution together are
+         * refused above, naming the fields.) */
         c.restitution = e;
         c.impact_velocity = v_imp;
     }
@@ -214,6 +250,8 @@ static int l_contact(lua_State *L)
 }
 
 /* ---- particles ------------------------------------------------------------------------------ */
+static const char *const PARTICLE_FIELDS[] = {"pos",   "radius", "material",   "vel",
+                                              "omega", "fixed",  "prescribed", NULL};
 /* From the on_step of a run (not forced), a particle may join only if the stability limit that
  * run's dt was checked against still holds: the limit comes from the smallest particle of each
  * material (contact times grow with size), so the new one must be no smaller than those. */
@@ -233,28 +271,30 @@ static void refuse_smaller_during_run(lua_State *L, dem_scene *s, const char *ca
         return;
     char why[320];
     if (isinf(rmin))
-        snprintf(why, sizeof why, "a particle of a material new to the scene could shorten the "
+        snprintf(why, sizeof why,
+                 "a particle of a material new to the scene could shorten the "
                  "stability limit the run's dt = %g s was checked at: add it between runs, or run "
-                 "with force = true", r->dt);
+                 "with force = true",
+                 r->dt);
     else
-        snprintf(why, sizeof why, "a particle smaller than any of its material (radius %g m < %g "
+        snprintf(why, sizeof why,
+                 "a particle smaller than any of its material (radius %g m < %g "
                  "m) could shorten the stability limit the run's dt = %g s was checked at: add it "
-                 "between runs, or run with force = true", p->radius, rmin, r->dt);
+                 "between runs, or run with force = true",
+                 p->radius, rmin, r->dt);
     lua_pushstring(L, why);
     bind_refuse_running(L, 1, call, lua_tostring(L, -1));
 }
 
 static int add_particle(lua_State *L, const char *call, int want_dim)
 {
-    static const char *const fields[] = {"pos", "radius", "material", "vel", "omega", "fixed",
-                                         "prescribed", NULL};
     dem_scene *s = check_scene(L, 1);
     const int D = dem_dim(s);
     if (D != want_dim)
         return luaL_error(L, "%s: this is a %dD scene (use %s)", call, D,
                           D == 2 ? "add_disk" : "add_sphere");
     bind_check_table(L, 2, call);
-    bind_check_fields(L, 2, call, fields);
+    bind_check_fields(L, 2, call, PARTICLE_FIELDS);
     dem_particle_def p;
     memset(&p, 0, sizeof p);
     bind_field_vector(L, 2, call, "pos", D, p.x, BIND_REQUIRED);
@@ -285,26 +325,29 @@ static int l_add_sphere(lua_State *L) { return add_particle(L, "add_sphere", 3);
 
 static size_t particle_arg(lua_State *L, dem_scene *s, int arg, const char *call)
 {
-    lua_Integer i = luaL_checkinteger(L, arg);
-    if (i < 1 || (size_t)i > dem_count(s))
-        luaL_error(L, "bad argument #%d to '%s' (particle id in [1, %d] expected, got %d)",
-                   arg - 1, call, (int)dem_count(s), (int)i);
+    int isint;
+    lua_Integer i = lua_tointegerx(L, arg, &isint);
+    if (!isint || lua_type(L, arg) != LUA_TNUMBER || i < 1 || (size_t)i > dem_count(s)) {
+        char expected[64];
+        snprintf(expected, sizeof expected, "particle id in [1, %zu]", dem_count(s));
+        bind_arg_error(L, arg, call, expected);
+    }
     return (size_t)(i - 1);
 }
 
 /* s:damping_time(i, j) or s:damping_time(i, { wall = w }): the pair's Brilliantov T as the force
  * loop uses it (per pair when solved from a restitution). */
+static const char *const DAMPING_TIME_FIELDS[] = {"wall", NULL};
+
 static int l_damping_time(lua_State *L)
 {
     dem_scene *s = check_scene(L, 1);
     size_t i = particle_arg(L, s, 2, "damping_time"), j = 0;
     int wall = -1;
     if (lua_istable(L, 3)) {
-        static const char *const fields[] = {"wall", NULL};
-        bind_check_fields(L, 3, "damping_time", fields);
-        wall =
-            (int)bind_field_number(L, 3, "damping_time", "wall", 0, BIND_POSITIVE | BIND_REQUIRED) -
-            1;
+        bind_check_fields(L, 3, "damping_time", DAMPING_TIME_FIELDS);
+        wall = (int)bind_field_integer(L, 3, "damping_time", "wall", 0, 1, INT_MAX, BIND_REQUIRED) -
+               1; /* 1.5 is no wall id */
     } else
         j = particle_arg(L, s, 3, "damping_time");
     if (dem_contact(s)->damping != DEM_DAMPING_BRILLIANTOV)
@@ -322,12 +365,7 @@ static int l_set_velocity(lua_State *L)
     dem_scene *s = check_scene(L, 1);
     size_t i = particle_arg(L, s, 2, "set_velocity");
     double v[3] = {0, 0, 0};
-    luaL_checktype(L, 3, LUA_TTABLE);
-    for (int d = 0; d < dem_dim(s); d++) {
-        lua_rawgeti(L, 3, d + 1);
-        v[d] = luaL_checknumber(L, -1);
-        lua_pop(L, 1);
-    }
+    bind_arg_vector(L, 3, "set_velocity", dem_dim(s), v);
     core_error err;
     if (dem_set_velocity(s, i, v, &err))
         return bind_raise(L, "set_velocity", &err);
@@ -335,14 +373,15 @@ static int l_set_velocity(lua_State *L)
 }
 
 /* ---- walls ---------------------------------------------------------------------------------- */
+static const char *const WALL_FIELDS[] = {"point",    "normal",   "velocity",
+                                          "friction", "material", NULL};
+
 static int l_add_wall(lua_State *L)
 {
-    static const char *const fields[] = {"point", "normal", "velocity", "friction", "material",
-                                         NULL};
     dem_scene *s = check_scene(L, 1);
     const int D = dem_dim(s);
     bind_check_table(L, 2, "add_wall");
-    bind_check_fields(L, 2, "add_wall", fields);
+    bind_check_fields(L, 2, "add_wall", WALL_FIELDS);
     dem_wall_def w;
     memset(&w, 0, sizeof w);
     bind_field_vector(L, 2, "add_wall", "point", D, w.point, BIND_REQUIRED);
@@ -360,17 +399,17 @@ static int l_add_wall(lua_State *L)
     return 1;
 }
 
-static int wall_arg(lua_State *L, int arg)
+/* A wall id: a positive integer (the kernel says whether that wall exists). */
+static int wall_arg(lua_State *L, int arg, const char *call)
 {
-    lua_Integer id = luaL_checkinteger(L, arg);
-    return (int)(id - 1);
+    return (int)(bind_arg_integer(L, arg, call, 1, INT_MAX) - 1);
 }
 
 static int l_remove_wall(lua_State *L)
 {
     dem_scene *s = check_scene(L, 1);
     core_error err;
-    if (dem_remove_wall(s, wall_arg(L, 2), &err))
+    if (dem_remove_wall(s, wall_arg(L, 2, "remove_wall"), &err))
         return bind_raise(L, "remove_wall", &err);
     return 0;
 }
@@ -379,14 +418,10 @@ static int l_wall_velocity(lua_State *L)
 {
     dem_scene *s = check_scene(L, 1);
     double v[3] = {0, 0, 0};
-    luaL_checktype(L, 3, LUA_TTABLE);
-    for (int d = 0; d < dem_dim(s); d++) {
-        lua_rawgeti(L, 3, d + 1);
-        v[d] = luaL_checknumber(L, -1);
-        lua_pop(L, 1);
-    }
+    const int id = wall_arg(L, 2, "wall_velocity");
+    bind_arg_vector(L, 3, "wall_velocity", dem_dim(s), v);
     core_error err;
-    if (dem_set_wall_velocity(s, wall_arg(L, 2), v, &err))
+    if (dem_set_wall_velocity(s, id, v, &err))
         return bind_raise(L, "wall_velocity", &err);
     return 0;
 }
@@ -396,21 +431,22 @@ static int l_wall_force(lua_State *L)
     dem_scene *s = check_scene(L, 1);
     double fn;
     core_error err;
-    if (dem_wall_force(s, wall_arg(L, 2), &fn, &err))
+    if (dem_wall_force(s, wall_arg(L, 2, "wall_force"), &fn, &err))
         return bind_raise(L, "wall_force", &err);
     lua_pushnumber(L, fn);
     return 1;
 }
 
+static const char *const SERVO_FIELDS[] = {"force", "mass", "rate", NULL};
+
 static int l_wall_servo(lua_State *L)
 {
     dem_scene *s = check_scene(L, 1);
-    const int id = wall_arg(L, 2);
+    const int id = wall_arg(L, 2, "wall_servo");
     double force = 0, mass = 0, rate = 0;
     if (!lua_isnoneornil(L, 3)) {
-        static const char *const fields[] = {"force", "mass", "rate", NULL};
         bind_check_table(L, 3, "wall_servo");
-        bind_check_fields(L, 3, "wall_servo", fields);
+        bind_check_fields(L, 3, "wall_servo", SERVO_FIELDS);
         force = bind_field_number(L, 3, "wall_servo", "force", 0, BIND_REQUIRED | BIND_NONNEG);
         mass = bind_field_number(L, 3, "wall_servo", "mass", 0, BIND_REQUIRED | BIND_POSITIVE);
         rate = bind_field_number(L, 3, "wall_servo", "rate", 0, BIND_NONNEG);
@@ -435,7 +471,7 @@ static int l_wall_point(lua_State *L)
     dem_scene *s = check_scene(L, 1);
     double p[3];
     core_error err;
-    if (dem_wall_point(s, wall_arg(L, 2), p, &err))
+    if (dem_wall_point(s, wall_arg(L, 2, "wall_point"), p, &err))
         return bind_raise(L, "wall_point", &err);
     push_vector(L, p, dem_dim(s));
     return 1;
@@ -455,14 +491,15 @@ static void push_timestep(lua_State *L, const dem_timestep *t)
     lua_setfield(L, -2, "impact_velocity");
 }
 
+static const char *const TIMESTEP_FIELDS[] = {"impact_velocity", NULL};
+
 static int l_timestep(lua_State *L)
 {
     dem_scene *s = check_scene(L, 1);
     double v = 0;
     if (!lua_isnoneornil(L, 2)) {
-        static const char *const fields[] = {"impact_velocity", NULL};
         bind_check_table(L, 2, "timestep");
-        bind_check_fields(L, 2, "timestep", fields);
+        bind_check_fields(L, 2, "timestep", TIMESTEP_FIELDS);
         v = bind_field_number(L, 2, "timestep", "impact_velocity", 0, BIND_POSITIVE);
     }
     dem_timestep t;
@@ -491,15 +528,16 @@ static core_status dem_advance(void *ctx, long n, progress *p, long *done, core_
     return st;
 }
 
+static const char *const RUN_FIELDS[] = {"steps",      "time",     "dt", "force", "impact_velocity",
+                                         "integrator", "m",        "n",  "q",     "every",
+                                         "on_step",    "progress", NULL};
+
 static int l_run(lua_State *L)
 {
-    static const char *const fields[] = {"steps", "time", "dt", "force", "impact_velocity",
-                                         "integrator", "m", "n", "q", "every", "on_step",
-                                         "progress", NULL};
     dem_scene *s = check_scene(L, 1);
     bind_refuse_running(L, 1, "run", "return false from on_step to stop it");
     bind_check_table(L, 2, "run");
-    bind_check_fields(L, 2, "run", fields);
+    bind_check_fields(L, 2, "run", RUN_FIELDS);
     dem_run_def run = dem_default_run_def();
     run.integrator = (dem_integrator)bind_field_option(L, 2, "run", "integrator",
                                                        INTEGRATOR_NAMES, DEM_VELOCITY_VERLET, 0);
@@ -535,12 +573,10 @@ static int l_run(lua_State *L)
         }
     }
     lua_pop(L, 1);
-    long steps = (long)bind_field_integer(L, 2, "run", "steps", -1, 0, LUA_MAXINTEGER, 0);
-    double time = bind_field_number(L, 2, "run", "time", -1, BIND_NONNEG);
-    if ((steps >= 0) == (time >= 0))
-        return luaL_error(L, "run: give exactly one of steps and time");
-    if (time >= 0)
-        steps = (long)ceil(time / run.dt - 1e-9);
+    long steps;
+    double time;
+    if (!bind_steps_or_time(L, 2, "run", &steps, &time))
+        steps = bind_time_steps(L, 2, "run", time, run.dt);
     double t0 = dem_time(s);
     long s0 = dem_steps_done(s), f0 = dem_force_evaluations(s);
     dem_advance_ctx ctx = {s, &run};
@@ -590,6 +626,10 @@ static void add_contact(const dem_contact_info *c, void *ctx)
     }
 }
 
+static const char *const STRESS_FIELDS[] = {"volume", NULL};
+
+static const char *const DISPLACEMENT_FIELDS[] = {"affine", "center", NULL};
+
 static int l_measure(lua_State *L)
 {
     static const char *const what_names[] = {"energy", "stress", "coordination", "slip",
@@ -613,9 +653,8 @@ static int l_measure(lua_State *L)
     case 1: {
         double volume = 0;
         if (!lua_isnoneornil(L, 3)) {
-            static const char *const fields[] = {"volume", NULL};
             bind_check_table(L, 3, "measure");
-            bind_check_fields(L, 3, "measure", fields);
+            bind_check_fields(L, 3, "measure", STRESS_FIELDS);
             volume = bind_field_number(L, 3, "measure", "volume", 0, BIND_POSITIVE);
         }
         double sig[3][3];
@@ -677,9 +716,8 @@ static int l_measure(lua_State *L)
         double grad[3][3] = {{0}}, center[3] = {0, 0, 0};
         int affine = 0;
         if (!lua_isnoneornil(L, 3)) {
-            static const char *const fields[] = {"affine", "center", NULL};
             bind_check_table(L, 3, "measure");
-            bind_check_fields(L, 3, "measure", fields);
+            bind_check_fields(L, 3, "measure", DISPLACEMENT_FIELDS);
             /* affine: D rows of D finite numbers, the shape checked before any row is
              * indexed (a number as a row used to crash lua_rawgeti). */
             if (lua_getfield(L, 3, "affine") != LUA_TNIL) {
@@ -709,7 +747,8 @@ static int l_measure(lua_State *L)
                     for (int b = 0; b < D && ok; b++) {
                         lua_rawgeti(L, -1, b + 1);
                         grad[a][b] = lua_tonumber(L, -1);
-                        if (lua_type(L, -1) != LUA_TNUMBER || !isfinite(grad[a][b])) {
+                        if (lua_type(L, -1) != LUA_TNUMBER || !isfinite(grad[a][b]) ||
+                            fabs(grad[a][b]) > 1e100) { /* the bindings' magnitude cap */
                             bind_describe(L, -1, v, sizeof v);
                             snprintf(got, sizeof got, "%s at row %d, column %d", v, a + 1, b + 1);
                             ok = 0;
@@ -807,7 +846,7 @@ static int l_scale_mass(lua_State *L)
         bind_refuse_running(L, 1, "scale_mass", "a factor below 1 shortens the stability limit "
                                                 "the run's dt was checked at: scale between runs");
     core_error err;
-    if (dem_scale_mass(s, luaL_checknumber(L, 2), &err))
+    if (dem_scale_mass(s, bind_arg_number(L, 2, "scale_mass", BIND_POSITIVE), &err))
         return bind_raise(L, "scale_mass", &err);
     return 0;
 }
@@ -821,7 +860,7 @@ static int l_scale_stiffness(lua_State *L)
                                                      "limit the run's dt was checked at: scale "
                                                      "between runs");
     core_error err;
-    if (dem_scale_stiffness(s, luaL_checknumber(L, 2), &err))
+    if (dem_scale_stiffness(s, bind_arg_number(L, 2, "scale_stiffness", BIND_POSITIVE), &err))
         return bind_raise(L, "scale_stiffness", &err);
     return 0;
 }
@@ -831,7 +870,7 @@ static int l_drag(lua_State *L)
     dem_scene *s = check_scene(L, 1);
     if (!lua_isnoneornil(L, 2)) {
         core_error err;
-        if (dem_set_drag(s, luaL_checknumber(L, 2), &err))
+        if (dem_set_drag(s, bind_arg_number(L, 2, "drag", BIND_NONNEG), &err))
             return bind_raise(L, "drag", &err);
     }
     lua_pushnumber(L, dem_drag(s));
@@ -839,36 +878,49 @@ static int l_drag(lua_State *L)
 }
 
 /* s:set_forces{ ids = {...}, fx = {...}, fy = {...}[, fz = {...}] } */
+static const char *const FORCES_FIELDS[] = {"ids", "fx", "fy", "fz", NULL};
+
 static int l_set_forces(lua_State *L)
 {
-    static const char *const fields[] = {"ids", "fx", "fy", "fz", NULL};
     static const char *const comp[3] = {"fx", "fy", "fz"};
     dem_scene *s = check_scene(L, 1);
     const int D = dem_dim(s);
     bind_check_table(L, 2, "set_forces");
-    bind_check_fields(L, 2, "set_forces", fields);
+    bind_check_fields(L, 2, "set_forces", FORCES_FIELDS);
+    if (D == 2 && lua_getfield(L, 2, "fz") != LUA_TNIL)
+        return bind_field_error(L, 2, "set_forces", "fz", "nothing in a 2D scene");
+    lua_settop(L, 2);
     if (lua_getfield(L, 2, "ids") != LUA_TTABLE)
         return bind_field_error(L, 2, "set_forces", "ids", "array of particle ids");
-    lua_Integer n = luaL_len(L, -1);
+    lua_Integer n = (lua_Integer)lua_rawlen(L, -1);
     for (int d = 0; d < D; d++)
-        if (lua_getfield(L, 2, comp[d]) != LUA_TTABLE || luaL_len(L, -1) != n)
-            return bind_field_error(L, 2, "set_forces", comp[d], "array as long as ids");
+        if (lua_getfield(L, 2, comp[d]) != LUA_TTABLE || (lua_Integer)lua_rawlen(L, -1) != n)
+            return bind_field_error(L, 2, "set_forces", comp[d], "array as long as 'ids'");
     int base = lua_gettop(L) - D; /* ids at base, components after */
     for (lua_Integer k = 1; k <= n; k++) {
         lua_rawgeti(L, base, k);
-        lua_Integer id = lua_tointeger(L, -1);
+        int isint;
+        lua_Integer id = lua_tointegerx(L, -1, &isint);
+        if (!isint || lua_type(L, -1) != LUA_TNUMBER || id < 1 || (size_t)id > dem_count(s)) {
+            char expected[64];
+            snprintf(expected, sizeof expected, "particle ids in [1, %zu]", dem_count(s));
+            return bind_field_error(L, 2, "set_forces", "ids", expected);
+        }
         lua_pop(L, 1);
         double f[3] = {0, 0, 0};
         for (int d = 0; d < D; d++) {
             lua_rawgeti(L, base + 1 + d, k);
             f[d] = lua_tonumber(L, -1);
+            if (lua_type(L, -1) != LUA_TNUMBER || !isfinite(f[d]) || fabs(f[d]) > 1e100)
+                return bind_field_error(L, 2, "set_forces", comp[d],
+                                        "arrays of finite forces (N) of magnitude at most 1e+100");
             lua_pop(L, 1);
         }
         core_error err;
-        if (id < 1 || dem_set_external_force(s, (size_t)(id - 1), f, &err))
-            return luaL_error(L, "set_forces: entry %d: %s", (int)k,
-                              id < 1 ? "particle ids start at 1" : err.msg);
+        if (dem_set_external_force(s, (size_t)(id - 1), f, &err))
+            return luaL_error(L, "set_forces: entry %d: %s", (int)k, err.msg);
     }
+    lua_settop(L, 2);
     return 0;
 }
 
@@ -878,12 +930,13 @@ static int l_clear_forces(lua_State *L)
     return 0;
 }
 
+static const char *const QUASISTATIC_FIELDS[] = {"pressure", "strain_rate", NULL};
+
 static int l_quasistatic(lua_State *L)
 {
-    static const char *const fields[] = {"pressure", "strain_rate", NULL};
     dem_scene *s = check_scene(L, 1);
     bind_check_table(L, 2, "quasistatic");
-    bind_check_fields(L, 2, "quasistatic", fields);
+    bind_check_fields(L, 2, "quasistatic", QUASISTATIC_FIELDS);
     double p = bind_field_number(L, 2, "quasistatic", "pressure", 0, BIND_REQUIRED | BIND_POSITIVE);
     double rate = bind_field_number(L, 2, "quasistatic", "strain_rate", 0,
                                     BIND_REQUIRED | BIND_POSITIVE);
@@ -1063,6 +1116,20 @@ void bind_open_dem(lua_State *L)
     static const luaL_Reg meta[] = {
         {"__gc", l_gc}, {"__close", l_gc}, {"__tostring", l_tostring}, {NULL, NULL}};
     bind_new_type(L, SCENE, methods, meta, "A DEM scene from dem.scene{...}.");
+    static const bind_fields method_fields[] = {{"contact", NULL, CONTACT_FIELDS},
+                                                {"add_disk", NULL, PARTICLE_FIELDS},
+                                                {"add_sphere", NULL, PARTICLE_FIELDS},
+                                                {"add_wall", NULL, WALL_FIELDS},
+                                                {"wall_servo", NULL, SERVO_FIELDS},
+                                                {"timestep", NULL, TIMESTEP_FIELDS},
+                                                {"run", NULL, RUN_FIELDS},
+                                                {"measure", "stress", STRESS_FIELDS},
+                                                {"measure", "displacement", DISPLACEMENT_FIELDS},
+                                                {"set_forces", NULL, FORCES_FIELDS},
+                                                {"quasistatic", NULL, QUASISTATIC_FIELDS},
+                                                {"damping_time", NULL, DAMPING_TIME_FIELDS},
+                                                {NULL, NULL, NULL}};
+    bind_type_fields(L, SCENE, method_fields);
     static const bind_fn fns[] = {
         {"scene", l_scene,
          "dem.scene{ dim = 2, box = {{x0, y0}, {x1, y1}}, gravity = {0, -9.81}, periodic = "
@@ -1071,8 +1138,10 @@ void bind_open_dem(lua_State *L)
          "makes them cylinders (m = rho pi r^2 t, I = m r^2/2). skin: Verlet-list skin (0: 0.2 "
          "of the largest radius)."},
         {NULL, NULL, NULL, NULL}};
+    static const bind_fields fn_fields[] = {{"scene", NULL, SCENE_FIELDS}, {NULL, NULL, NULL}};
     lua_newtable(L);
     bind_register(L, -1, fns);
+    bind_register_fields(L, -1, fn_fields);
     bind_doc(L, -1, "dem", "dem",
              "Discrete elements: soft disks and spheres with contact laws, walls, integrators.");
     lua_setglobal(L, "dem");

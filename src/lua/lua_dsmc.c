@@ -56,7 +56,7 @@ static int read_numbers(lua_State *L, int arg, const char *call, const char *fie
         lua_rawgeti(L, -1, k + 1);
         int ok = integer ? lua_isinteger(L, -1) && lua_tointeger(L, -1) >= 1 &&
                                lua_tointeger(L, -1) <= (1 << 24)
-                         : lua_type(L, -1) == LUA_TNUMBER && isfinite(lua_tonumber(L, -1));
+                         : lua_type(L, -1) == LUA_TNUMBER && fabs(lua_tonumber(L, -1)) <= 1e100;
         double v = lua_tonumber(L, -1);
         lua_pop(L, 1);
         if (!ok)
@@ -75,8 +75,8 @@ static void read_box(lua_State *L, int arg, int dim, dsmc_scene_def *def)
     lua_pop(L, 1);
     if (has_box == has_size) {
         lua_getfield(L, arg, "box");
-        bind_field_error(L, arg, "scene", "box", has_box ? "box or size, not both"
-                                                          : "box or size (one of them)");
+        bind_field_error(L, arg, "scene", "box",
+                         has_box ? "'box' or 'size', not both" : "'box' or 'size' (one of them)");
     }
     if (has_size) {
         char e2[64];
@@ -96,13 +96,14 @@ static void read_box(lua_State *L, int arg, int dim, dsmc_scene_def *def)
     bind_field_box(L, arg, "scene", "box", dim, def->lo, def->hi);
 }
 
+static const char *const SCENE_FIELDS[] = {
+    "dim",    "box",  "size",    "cells",           "periodic",      "gravity", "restitution",
+    "radius", "mass", "density", "excluded_volume", "packing_limit", "seed",    NULL};
+
 static int l_scene(lua_State *L)
 {
-    static const char *const fields[] = {"dim", "box", "size", "cells", "periodic", "gravity",
-                                         "restitution", "radius", "mass", "density",
-                                         "excluded_volume", "packing_limit", "seed", NULL};
     bind_check_table(L, 1, "scene");
-    bind_check_fields(L, 1, "scene", fields);
+    bind_check_fields(L, 1, "scene", SCENE_FIELDS);
     dsmc_scene_def def = dsmc_default_scene_def();
     def.dim = (int)bind_field_integer(L, 1, "scene", "dim", 2, 2, 3, 0);
     int D = def.dim;
@@ -146,7 +147,7 @@ static int l_scene(lua_State *L)
     lua_pop(L, 2);
     if (has_mass && has_density) {
         lua_getfield(L, 1, "density");
-        return bind_field_error(L, 1, "scene", "density", "nothing when mass is given");
+        return bind_field_error(L, 1, "scene", "density", "nothing when 'mass' is given");
     }
     def.mass = bind_field_number(L, 1, "scene", "mass", 0, has_mass ? BIND_POSITIVE : 0);
     def.density = bind_field_number(L, 1, "scene", "density", def.density, BIND_POSITIVE);
@@ -168,14 +169,15 @@ static int l_scene(lua_State *L)
 }
 
 /* ---- particles ------------------------------------------------------------------------------ */
+static const char *const FILL_FIELDS[] = {"n",        "temperature", "speed", "region",
+                                          "velocity", "seed",        NULL};
+
 static int l_fill(lua_State *L)
 {
-    static const char *const fields[] = {"n", "temperature", "speed", "region", "velocity", "seed",
-                                         NULL};
     dsmc_scene *s = check_scene(L, 1);
     int D = dsmc_def(s)->dim;
     bind_check_table(L, 2, "fill");
-    bind_check_fields(L, 2, "fill", fields);
+    bind_check_fields(L, 2, "fill", FILL_FIELDS);
     dsmc_fill_def f = dsmc_default_fill_def();
     f.n = (size_t)bind_field_integer(L, 2, "fill", "n", 0, 1, LUA_MAXINTEGER, BIND_REQUIRED);
     f.temperature = bind_field_number(L, 2, "fill", "temperature", 0, BIND_POSITIVE);
@@ -183,8 +185,8 @@ static int l_fill(lua_State *L)
     if ((f.temperature > 0) == (f.speed > 0)) {
         lua_getfield(L, 2, "temperature");
         return bind_field_error(L, 2, "fill", "temperature",
-                                f.speed > 0 ? "nothing when speed is given"
-                                            : "positive number (or give speed)");
+                                f.speed > 0 ? "nothing when 'speed' is given"
+                                            : "positive number (or give 'speed')");
     }
     char expected[64];
     snprintf(expected, sizeof expected, "array of %d numbers", D);
@@ -202,7 +204,7 @@ static int l_fill(lua_State *L)
                 int ok = lua_type(L, -1) == LUA_TTABLE && luaL_len(L, -1) == D;
                 if (ok) {
                     lua_rawgeti(L, -1, k + 1);
-                    ok = lua_type(L, -1) == LUA_TNUMBER && isfinite(lua_tonumber(L, -1));
+                    ok = lua_type(L, -1) == LUA_TNUMBER && fabs(lua_tonumber(L, -1)) <= 1e100;
                     (c == 0 ? f.lo : f.hi)[k] = lua_tonumber(L, -1);
                     lua_pop(L, 1);
                 }
@@ -223,13 +225,14 @@ static int l_fill(lua_State *L)
 }
 
 /* s:add{ x = {...}, y = {...}, vx = {...}, vy = {...} }: arrays of equal length. */
+static const char *const ADD_FIELDS[] = {"x", "y", "z", "vx", "vy", "vz", NULL};
+
 static int l_add(lua_State *L)
 {
-    static const char *const fields[] = {"x", "y", "z", "vx", "vy", "vz", NULL};
     dsmc_scene *s = check_scene(L, 1);
     int D = dsmc_def(s)->dim;
     bind_check_table(L, 2, "add");
-    bind_check_fields(L, 2, "add", fields);
+    bind_check_fields(L, 2, "add", ADD_FIELDS);
     static const char *const names[6] = {"x", "y", "z", "vx", "vy", "vz"};
     double *a[6] = {NULL, NULL, NULL, NULL, NULL, NULL};
     lua_Integer n = -1;
@@ -244,16 +247,18 @@ static int l_add(lua_State *L)
         if (lua_getfield(L, 2, names[q]) != LUA_TTABLE ||
             (n >= 0 && luaL_len(L, -1) != n) || luaL_len(L, -1) < 1)
             bind_field_error(L, 2, "add", names[q],
-                             n >= 0 ? "array as long as x" : "non-empty array of numbers");
+                             n >= 0 ? "array as long as 'x'" : "non-empty array of numbers");
         n = luaL_len(L, -1);
         a[q] = lua_newuserdatauv(L, (size_t)n * sizeof(double), 0); /* freed by the GC */
         for (lua_Integer i = 0; i < n; i++) {
             lua_rawgeti(L, -2, i + 1);
             int isnum;
             a[q][i] = lua_tonumberx(L, -1, &isnum);
-            if (!isnum || !isfinite(a[q][i]))
-                return luaL_error(L, "bad field '%s' in argument #1 to 'add' (array of finite "
-                                  "numbers expected, entry %d is not)", names[q], (int)i + 1);
+            if (!isnum || lua_type(L, -1) != LUA_TNUMBER || !(fabs(a[q][i]) <= 1e100))
+                return luaL_error(L,
+                                  "bad field '%s' in argument #1 to 'add' (array of finite "
+                                  "numbers of magnitude at most 1e+100 expected, entry %d is not)",
+                                  names[q], (int)i + 1);
             lua_pop(L, 1);
         }
         lua_remove(L, -2); /* the userdata stays on the stack while we work */
@@ -306,15 +311,17 @@ static int side_of(lua_State *L, int D, const char *name)
     return -1;
 }
 
+static const char *const WALL_FIELDS[] = {"side",        "kind",      "restitution",
+                                          "temperature", "amplitude", "frequency",
+                                          "phase",       "velocity",  NULL};
+
 static int l_wall(lua_State *L)
 {
-    static const char *const fields[] = {"side", "kind", "restitution", "temperature",
-                                         "amplitude", "frequency", "phase", "velocity", NULL};
     static const char *const kinds[] = {"specular", "diffuse", NULL};
     dsmc_scene *s = check_scene(L, 1);
     int D = dsmc_def(s)->dim;
     bind_check_table(L, 2, "wall");
-    bind_check_fields(L, 2, "wall", fields);
+    bind_check_fields(L, 2, "wall", WALL_FIELDS);
     const char *name = bind_field_string(L, 2, "wall", "side", NULL, BIND_REQUIRED);
     int side = side_of(L, D, name);
     if (side < 0) {
@@ -336,10 +343,16 @@ static int l_wall(lua_State *L)
         w.temperature = bind_field_number(L, 2, "wall", "temperature", 0,
                                           BIND_REQUIRED | BIND_POSITIVE);
     else if (lua_getfield(L, 2, "temperature") != LUA_TNIL)
-        return bind_field_error(L, 2, "wall", "temperature", "nothing for kind 'specular'");
+        return bind_field_error(L, 2, "wall", "temperature", "nothing unless 'kind' is 'diffuse'");
     w.amplitude = bind_field_number(L, 2, "wall", "amplitude", 0, BIND_NONNEG);
     w.frequency = bind_field_number(L, 2, "wall", "frequency", 0, BIND_NONNEG);
     w.phase = bind_field_number(L, 2, "wall", "phase", 0, 0);
+    for (int k = 0; k < 2 && !(w.amplitude > 0); k++) { /* an oscillation needs its amplitude */
+        const char *f = k ? "phase" : "frequency";
+        if (lua_getfield(L, 2, f) != LUA_TNIL)
+            return bind_field_error(L, 2, "wall", f, "nothing unless 'amplitude' is > 0");
+        lua_pop(L, 1);
+    }
     if (w.amplitude > 0 && !(w.frequency > 0)) {
         lua_getfield(L, 2, "frequency");
         return bind_field_error(L, 2, "wall", "frequency", "positive number with an amplitude");
@@ -406,14 +419,15 @@ static core_status advance(void *ctx, long n, struct progress *p, long *done, co
     return dsmc_run(c->s, c->run, done, err);
 }
 
+static const char *const RUN_FIELDS[] = {"steps",   "time",     "dt",   "every",
+                                         "on_step", "progress", "warn", NULL};
+
 static int l_run(lua_State *L)
 {
-    static const char *const fields[] = {"steps", "time", "dt", "every", "on_step", "progress",
-                                         "warn", NULL};
     dsmc_scene *s = check_scene(L, 1);
     bind_refuse_running(L, 1, "run", "return false from on_step to stop it");
     bind_check_table(L, 2, "run");
-    bind_check_fields(L, 2, "run", fields);
+    bind_check_fields(L, 2, "run", RUN_FIELDS);
     if (dsmc_count(s) < 2)
         return luaL_error(L, "run: the scene has %d particles (fill it first)",
                           (int)dsmc_count(s));
@@ -433,10 +447,9 @@ static int l_run(lua_State *L)
         run.dt = bind_field_number(L, 2, "run", "dt", 0, BIND_POSITIVE);
     }
     lua_pop(L, 1);
-    long steps = (long)bind_field_integer(L, 2, "run", "steps", -1, 0, LUA_MAXINTEGER, 0);
-    double time = bind_field_number(L, 2, "run", "time", -1, BIND_NONNEG);
-    if ((steps >= 0) == (time >= 0))
-        return luaL_error(L, "run: give exactly one of steps and time");
+    long steps;
+    double time;
+    int by_steps = bind_steps_or_time(L, 2, "run", &steps, &time);
     int warn = bind_field_boolean(L, 2, "run", "warn", 1);
     v.dt = run.dt;
     v.dt_ok = v.collision_time > run.dt;
@@ -444,9 +457,9 @@ static int l_run(lua_State *L)
         warn_validity(&v);
     double t0 = dsmc_time(s);
     long expect = steps;
-    if (time >= 0) {
+    if (!by_steps) {
         run.time_end = t0 + time;
-        expect = (long)ceil(time / run.dt - 1e-9);
+        expect = bind_time_steps(L, 2, "run", time, run.dt);
         steps = LUA_MAXINTEGER;
     }
     long s0 = dsmc_steps_done(s);
@@ -522,6 +535,12 @@ static void measure_stats(lua_State *L, dsmc_scene *s)
     set_number(L, "total_collisions", dsmc_total_collisions(s));
     (void)steps;
 }
+
+static const char *const HISTOGRAM_FIELDS[] = {"bins", "range", "quantity", NULL};
+
+static const char *const PROFILE_FIELDS[] = {"axis", "bins", NULL};
+
+static const char *const VALIDITY_FIELDS[] = {"dt", NULL};
 
 static int l_measure(lua_State *L)
 {
@@ -599,14 +618,13 @@ static int l_measure(lua_State *L)
         return 1;
     }
     if (what == 3) { /* histogram */
-        static const char *const fields[] = {"bins", "range", "quantity", NULL};
         static const char *const qn[] = {"component", "speed", NULL};
         int bins = 40, q = 0;
         dsmc_moments m;
         dsmc_measure_moments(s, &m);
         double sd = sqrt(m.t_over_m), range[2];
         if (has_opts) {
-            bind_check_fields(L, 3, "measure", fields);
+            bind_check_fields(L, 3, "measure", HISTOGRAM_FIELDS);
             bins = (int)bind_field_integer(L, 3, "measure", "bins", 40, 1, 100000, 0);
             q = bind_field_option(L, 3, "measure", "quantity", qn, 0, 0);
         }
@@ -653,10 +671,9 @@ static int l_measure(lua_State *L)
         return 1;
     }
     if (what == 5) { /* profile */
-        static const char *const fields[] = {"axis", "bins", NULL};
         int axis = D, bins = d->cells[D - 1];
         if (has_opts) {
-            bind_check_fields(L, 3, "measure", fields);
+            bind_check_fields(L, 3, "measure", PROFILE_FIELDS);
             axis = (int)bind_field_integer(L, 3, "measure", "axis", D, 1, D, 0);
             bins = (int)bind_field_integer(L, 3, "measure", "bins", d->cells[axis - 1], 1, 1000000,
                                            0);
@@ -681,8 +698,7 @@ static int l_measure(lua_State *L)
     /* validity */
     double dt = 0;
     if (has_opts) {
-        static const char *const fields[] = {"dt", NULL};
-        bind_check_fields(L, 3, "measure", fields);
+        bind_check_fields(L, 3, "measure", VALIDITY_FIELDS);
         dt = bind_field_number(L, 3, "measure", "dt", 0, BIND_NONNEG);
     }
     dsmc_validity v;
@@ -842,6 +858,15 @@ void bind_open_dsmc(lua_State *L)
     static const luaL_Reg meta[] = {
         {"__gc", l_gc}, {"__close", l_gc}, {"__tostring", l_tostring}, {NULL, NULL}};
     bind_new_type(L, SCENE, methods, meta, "A DSMC granular gas from dsmc.scene{...}.");
+    static const bind_fields method_fields[] = {{"fill", NULL, FILL_FIELDS},
+                                                {"add", NULL, ADD_FIELDS},
+                                                {"wall", NULL, WALL_FIELDS},
+                                                {"run", NULL, RUN_FIELDS},
+                                                {"measure", "histogram", HISTOGRAM_FIELDS},
+                                                {"measure", "profile", PROFILE_FIELDS},
+                                                {"measure", "validity", VALIDITY_FIELDS},
+                                                {NULL, NULL, NULL}};
+    bind_type_fields(L, SCENE, method_fields);
 
     static const bind_fn fns[] = {
         {"scene", l_scene,
@@ -859,6 +884,8 @@ void bind_open_dsmc(lua_State *L)
         {NULL, NULL, NULL, NULL}};
     lua_newtable(L);
     bind_register(L, -1, fns);
+    static const bind_fields fn_fields[] = {{"scene", NULL, SCENE_FIELDS}, {NULL, NULL, NULL}};
+    bind_register_fields(L, -1, fn_fields);
     bind_doc(L, -1, "dsmc", "dsmc",
              "Granular gases by direct simulation Monte Carlo (Herrmann & Mueller Sec. 4, after "
              "Bird): stochastic collisions within cells, 2D and 3D.");

@@ -42,12 +42,13 @@ static void push_pair(lua_State *L, const double v[2])
  */
 static const char *const MODEL_NAMES[] = {"elastic", "vonmises", NULL};
 
+static const char *const MATERIAL_FIELDS[] = {"model", "density",   "shear", "bulk",
+                                              "yield", "hardening", NULL};
+
 static int l_material(lua_State *L)
 {
-    static const char *const fields[] = {"model", "density",   "shear", "bulk",
-                                         "yield", "hardening", NULL};
     bind_check_table(L, 1, "material");
-    bind_check_fields(L, 1, "material", fields);
+    bind_check_fields(L, 1, "material", MATERIAL_FIELDS);
     mpm_material m = mpm_default_material();
     m.model = (mpm_model)bind_field_option(L, 1, "material", "model", MODEL_NAMES, MPM_ELASTIC, 0);
     m.density = bind_field_number(L, 1, "material", "density", 0, BIND_REQUIRED | BIND_POSITIVE);
@@ -60,8 +61,9 @@ static int l_material(lua_State *L)
         const char *plastic[] = {"yield", "hardening"};
         for (int k = 0; k < 2; k++)
             if (lua_getfield(L, 1, plastic[k]) != LUA_TNIL)
-                return bind_field_error(L, 1, "material", plastic[k],
-                                        "nothing for model 'elastic' (use model = 'vonmises')");
+                return bind_field_error(
+                    L, 1, "material", plastic[k],
+                    "nothing for model 'elastic' (use field 'model' = 'vonmises')");
             else
                 lua_pop(L, 1);
     }
@@ -103,6 +105,18 @@ static int material_index(lua_State *L)
     return 1;
 }
 
+/* A material is shared by every grain made of it: changing it afterwards would change them
+ * behind the scene's back, so it is read-only. */
+static int material_newindex(lua_State *L)
+{
+    char key[64];
+    bind_describe(L, 2, key, sizeof key);
+    return luaL_error(L,
+                      "an mpm.material is read-only: field %s cannot be set (make a new one "
+                      "with mpm.material{...})",
+                      key);
+}
+
 static int material_tostring(lua_State *L)
 {
     const mpm_material *m = luaL_checkudata(L, 1, MATERIAL);
@@ -141,7 +155,7 @@ static void read_pair(lua_State *L, int arg, const char *field, const char *expe
         int ok = is_int ? lua_isinteger(L, -1) && lua_tointeger(L, -1) >= 1 &&
                               lua_tointeger(L, -1) <= (1 << 20)
                         : lua_type(L, -1) == LUA_TNUMBER && lua_tonumber(L, -1) > 0 &&
-                              isfinite(lua_tonumber(L, -1));
+                              lua_tonumber(L, -1) <= 1e100;
         double v = lua_tonumber(L, -1);
         lua_pop(L, 1);
         if (!ok)
@@ -239,7 +253,18 @@ static void read_walls(lua_State *L, mpm_scene_def *def)
         bind_field_error(L, 1, "scene", "walls", expected);
     lua_pop(L, 1); /* the nil kind */
     int tab = lua_gettop(L);
-    bind_check_fields(L, tab, "scene", sides);
+    for (lua_pushnil(L); lua_next(L, tab); lua_pop(L, 1)) { /* a typo names the field */
+        int known = 0;
+        for (int k = 0; sides[k] && !known; k++)
+            known = lua_type(L, -2) == LUA_TSTRING && strcmp(lua_tostring(L, -2), sides[k]) == 0;
+        if (!known) {
+            lua_pushvalue(L, tab);
+            bind_field_error(L, 1, "scene", "walls", expected);
+        }
+    }
+    if (lua_rawlen(L, tab) == 0 && (lua_pushnil(L), lua_next(L, tab) == 0))
+        bind_field_error(L, 1, "scene", "walls", expected); /* {}: no wall named */
+    lua_settop(L, tab);
     for (int k = 0; k < 4; k++) {
         if (lua_getfield(L, tab, sides[k]) == LUA_TNIL) {
             lua_pop(L, 1);
@@ -253,16 +278,18 @@ static void read_walls(lua_State *L, mpm_scene_def *def)
     lua_pop(L, 1);
 }
 
+static const char *const SCENE_FIELDS[] = {"cells",   "size",     "origin", "periodic",
+                                           "gravity", "walls",    "update", "pic",
+                                           "shape",   "wall_gap", NULL};
+
 static int l_scene(lua_State *L)
 {
-    static const char *const fields[] = {"cells",  "size", "origin", "periodic", "gravity", "walls",
-                                         "update", "pic",  "shape",  "wall_gap", NULL};
     bind_check_table(L, 1, "scene");
-    bind_check_fields(L, 1, "scene", fields);
+    bind_check_fields(L, 1, "scene", SCENE_FIELDS);
     mpm_scene_def def = mpm_default_scene_def();
     double cells[2];
     read_pair(L, 1, "cells", "array of 2 integers in [1, 1048576]", def.cells, cells, 1);
-    read_pair(L, 1, "size", "array of 2 positive numbers", NULL, def.size, 1);
+    read_pair(L, 1, "size", "array of 2 positive numbers of at most 1e+100", NULL, def.size, 1);
     bind_field_vector(L, 1, "scene", "origin", 2, def.origin, 0);
     bind_field_vector(L, 1, "scene", "gravity", 2, def.gravity, 0);
     if (lua_getfield(L, 1, "periodic") != LUA_TNIL) {
@@ -327,16 +354,16 @@ static int material_of(lua_State *L, int scene, int arg, const char *call)
 }
 
 /* ---- grains ---------------------------------------------------------------------------------- */
+static const char *const DISK_FIELDS[] = {"center",   "radius", "material", "points_per_cell",
+                                          "velocity", "omega",  "clip",     "hydrostatic",
+                                          NULL};
+static const char *const RECT_FIELDS[] = {
+    "lo", "hi", "material", "points_per_cell", "velocity", "omega", "clip", "hydrostatic", NULL};
+static const char *const POLYGON_FIELDS[] = {"vertices", "material", "points_per_cell", "velocity",
+                                             "omega",    "clip",     "hydrostatic",     NULL};
+
 static int add_grain(lua_State *L, const char *call, mpm_shape shape)
 {
-    static const char *const disk_fields[] = {"center",   "radius", "material", "points_per_cell",
-                                              "velocity", "omega",  "clip",     "hydrostatic",
-                                              NULL};
-    static const char *const rect_fields[] = {"lo",       "hi",    "material", "points_per_cell",
-                                              "velocity", "omega", "clip",     "hydrostatic",
-                                              NULL};
-    static const char *const poly_fields[] = {"vertices", "material", "points_per_cell", "velocity",
-                                              "omega",    "clip",     "hydrostatic",     NULL};
     mpm_scene *s = check_scene(L, 1);
     const bind_run *r = bind_running(L, 1);
     if (r && r->dt > 0 && !r->forced) /* with dt = 'auto' the CFL condition holds every step */
@@ -345,9 +372,9 @@ static int add_grain(lua_State *L, const char *call, mpm_shape shape)
                                         "with dt = 'auto'");
     bind_check_table(L, 2, call);
     bind_check_fields(L, 2, call,
-                      shape == MPM_DISK   ? disk_fields
-                      : shape == MPM_RECT ? rect_fields
-                                          : poly_fields);
+                      shape == MPM_DISK   ? DISK_FIELDS
+                      : shape == MPM_RECT ? RECT_FIELDS
+                                          : POLYGON_FIELDS);
     mpm_grain_def g = mpm_default_grain_def();
     g.shape = shape;
     if (shape == MPM_POLYGON) {
@@ -361,7 +388,7 @@ static int add_grain(lua_State *L, const char *call, mpm_shape shape)
             for (int a = 0; ok && a < 2; a++) {
                 lua_rawgeti(L, -1, a + 1);
                 v[2 * i + a] = lua_tonumberx(L, -1, &ok);
-                ok = ok && isfinite(v[2 * i + a]);
+                ok = ok && lua_type(L, -1) == LUA_TNUMBER && fabs(v[2 * i + a]) <= 1e100;
                 lua_pop(L, 1);
             }
             if (!ok)
@@ -410,14 +437,15 @@ static int l_add_rect(lua_State *L) { return add_grain(L, "add_rect", MPM_RECT);
 static int l_add_polygon(lua_State *L) { return add_grain(L, "add_polygon", MPM_POLYGON); }
 
 /* ---- contact --------------------------------------------------------------------------------- */
+static const char *const CONTACT_FIELDS[] = {"model",      "mu",       "normals", "separation",
+                                             "strain_cap", "conserve", NULL};
+
 static int l_contact(lua_State *L)
 {
-    static const char *const fields[] = {"model",      "mu",       "normals", "separation",
-                                         "strain_cap", "conserve", NULL};
     static const char *const names[] = {"noslip", "friction", NULL};
     mpm_scene *s = check_scene(L, 1);
     bind_check_table(L, 2, "contact");
-    bind_check_fields(L, 2, "contact", fields);
+    bind_check_fields(L, 2, "contact", CONTACT_FIELDS);
     int model = bind_field_option(L, 2, "contact", "model", names, 0, BIND_REQUIRED);
     core_error err;
     mpm_contact_options o = mpm_default_contact_options();
@@ -445,46 +473,42 @@ static int l_contact(lua_State *L)
     return 0;
 }
 
+/* A grain id in [1, count] at arg, as a 0-based index. */
+static size_t grain_arg(lua_State *L, mpm_scene *s, int arg, const char *call)
+{
+    int isint;
+    lua_Integer id = lua_tointegerx(L, arg, &isint);
+    if (!isint || lua_type(L, arg) != LUA_TNUMBER || id < 1 || (size_t)id > mpm_grain_count(s)) {
+        char expected[64];
+        snprintf(expected, sizeof expected, "grain id in [1, %zu]", mpm_grain_count(s));
+        bind_arg_error(L, arg, call, expected);
+    }
+    return (size_t)(id - 1);
+}
+
 /* m:prescribe(grain, {vx, vy}) */
 static int l_prescribe(lua_State *L)
 {
     mpm_scene *s = check_scene(L, 1);
-    lua_Integer id = luaL_checkinteger(L, 2);
-    if (id < 1 || (size_t)id > mpm_grain_count(s))
-        return luaL_error(L,
-                          "bad argument #1 to 'prescribe' (grain id in [1, %d] expected, got "
-                          "%d)",
-                          (int)mpm_grain_count(s), (int)id);
+    size_t id = grain_arg(L, s, 2, "prescribe");
     double v[2];
-    if (lua_type(L, 3) != LUA_TTABLE)
-        return luaL_error(L,
-                          "bad argument #2 to 'prescribe' (velocity {vx, vy} expected, got "
-                          "%s)",
-                          luaL_typename(L, 3));
-    for (int k = 0; k < 2; k++) {
-        lua_rawgeti(L, 3, k + 1);
-        int ok;
-        v[k] = lua_tonumberx(L, -1, &ok);
-        if (!ok || !isfinite(v[k]))
-            return luaL_error(L, "bad argument #2 to 'prescribe' (velocity {vx, vy} of finite "
-                                 "numbers expected)");
-        lua_pop(L, 1);
-    }
+    bind_arg_vector(L, 3, "prescribe", 2, v);
     core_error err;
-    if (mpm_prescribe(s, (size_t)(id - 1), v, &err))
+    if (mpm_prescribe(s, id, v, &err))
         return bind_raise(L, "prescribe", &err);
     return 0;
 }
 
 /* m:plane{ point = {x, y}, normal = {nx, ny}, kind = 'friction', mu = 0.5, velocity = {0, 0} } */
+static const char *const PLANE_FIELDS[] = {"point", "normal", "kind", "mu", "velocity", NULL};
+
 static int l_plane(lua_State *L)
 {
-    static const char *const fields[] = {"point", "normal", "kind", "mu", "velocity", NULL};
     static const char *const kinds[] = {"noslip", "slip", "friction", NULL};
     static const mpm_wall kind_of[] = {MPM_WALL_NOSLIP, MPM_WALL_SLIP, MPM_WALL_FRICTION};
     mpm_scene *s = check_scene(L, 1);
     bind_check_table(L, 2, "plane");
-    bind_check_fields(L, 2, "plane", fields);
+    bind_check_fields(L, 2, "plane", PLANE_FIELDS);
     mpm_plane_def d = {{0, 0}, {0, 1}, MPM_WALL_FRICTION, 0, {0, 0}};
     bind_field_vector(L, 2, "plane", "point", 2, d.point, BIND_REQUIRED);
     bind_field_vector(L, 2, "plane", "normal", 2, d.normal, BIND_REQUIRED);
@@ -541,14 +565,15 @@ static void push_timestep(lua_State *L, const mpm_timestep *t)
     lua_setfield(L, -2, "dt_auto");
 }
 
+static const char *const TIMESTEP_FIELDS[] = {"cfl", NULL};
+
 static int l_timestep(lua_State *L)
 {
     mpm_scene *s = check_scene(L, 1);
     double cfl = MPM_DEFAULT_CFL;
     if (!lua_isnoneornil(L, 2)) {
-        static const char *const fields[] = {"cfl", NULL};
         bind_check_table(L, 2, "timestep");
-        bind_check_fields(L, 2, "timestep", fields);
+        bind_check_fields(L, 2, "timestep", TIMESTEP_FIELDS);
         cfl = bind_field_number(L, 2, "timestep", "cfl", cfl, BIND_POSITIVE);
     }
     mpm_timestep t;
@@ -573,14 +598,15 @@ static core_status mpm_advance(void *ctx, long n, struct progress *p, long *done
     return mpm_run(c->s, c->run, done, err);
 }
 
+static const char *const RUN_FIELDS[] = {"steps", "time",    "dt",       "cfl", "force",
+                                         "every", "on_step", "progress", NULL};
+
 static int l_run(lua_State *L)
 {
-    static const char *const fields[] = {"steps", "time",    "dt",       "cfl", "force",
-                                         "every", "on_step", "progress", NULL};
     mpm_scene *s = check_scene(L, 1);
     bind_refuse_running(L, 1, "run", "return false from on_step to stop it");
     bind_check_table(L, 2, "run");
-    bind_check_fields(L, 2, "run", fields);
+    bind_check_fields(L, 2, "run", RUN_FIELDS);
     mpm_run_def run = mpm_default_run_def();
     run.cfl = bind_field_number(L, 2, "run", "cfl", MPM_DEFAULT_CFL, BIND_POSITIVE);
     if (run.cfl > 1) {
@@ -611,15 +637,14 @@ static int l_run(lua_State *L)
         }
     }
     lua_pop(L, 1);
-    long steps = (long)bind_field_integer(L, 2, "run", "steps", -1, 0, LUA_MAXINTEGER, 0);
-    double time = bind_field_number(L, 2, "run", "time", -1, BIND_NONNEG);
-    if ((steps >= 0) == (time >= 0))
-        return luaL_error(L, "run: give exactly one of steps and time");
+    long steps;
+    double time;
+    int by_steps = bind_steps_or_time(L, 2, "run", &steps, &time);
     double t0 = mpm_time(s);
     long expect = steps; /* for progress and the default `every` */
-    if (time >= 0) {
+    if (!by_steps) {
         run.time_end = t0 + time;
-        expect = (long)ceil(time / (run.dt > 0 ? run.dt : ts.dt_auto) - 1e-9);
+        expect = bind_time_steps(L, 2, "run", time, run.dt > 0 ? run.dt : ts.dt_auto);
         steps = LUA_MAXINTEGER;
     }
     long s0 = mpm_steps_done(s);
@@ -687,13 +712,10 @@ static int l_measure(lua_State *L)
 static int l_grain(lua_State *L)
 {
     mpm_scene *s = check_scene(L, 1);
-    lua_Integer id = luaL_checkinteger(L, 2);
-    if (id < 1 || (size_t)id > mpm_grain_count(s))
-        return luaL_error(L, "bad argument #1 to 'grain' (grain id in [1, %d] expected, got %d)",
-                          (int)mpm_grain_count(s), (int)id);
+    size_t id = grain_arg(L, s, 2, "grain");
     mpm_grain_info g;
     core_error err;
-    if (mpm_grain(s, (size_t)(id - 1), &g, &err))
+    if (mpm_grain(s, id, &g, &err))
         return bind_raise(L, "grain", &err);
     lua_createtable(L, 0, 7);
     set_number(L, "mass", g.mass);
@@ -749,12 +771,13 @@ static int l_points(lua_State *L)
 }
 
 /* m:set_velocities{ vx = {...}, vy = {...} }: one entry per point. */
+static const char *const VELOCITIES_FIELDS[] = {"vx", "vy", NULL};
+
 static int l_set_velocities(lua_State *L)
 {
-    static const char *const fields[] = {"vx", "vy", NULL};
     mpm_scene *s = check_scene(L, 1);
     bind_check_table(L, 2, "set_velocities");
-    bind_check_fields(L, 2, "set_velocities", fields);
+    bind_check_fields(L, 2, "set_velocities", VELOCITIES_FIELDS);
     size_t n = mpm_point_count(s);
     char expected[96];
     snprintf(expected, sizeof expected, "array of %zu finite numbers (one per point)", n);
@@ -768,10 +791,10 @@ static int l_set_velocities(lua_State *L)
             lua_rawgeti(L, -2, (lua_Integer)i + 1);
             int isnum;
             v[d][i] = lua_tonumberx(L, -1, &isnum);
-            if (!isnum || !isfinite(v[d][i]))
+            if (!isnum || lua_type(L, -1) != LUA_TNUMBER || !(fabs(v[d][i]) <= 1e100))
                 return luaL_error(L,
                                   "bad field '%s' in argument #1 to 'set_velocities' (%s "
-                                  "expected, entry %d is not)",
+                                  "of magnitude at most 1e+100 expected, entry %d is not)",
                                   comp[d], expected, (int)i + 1);
             lua_pop(L, 1);
         }
@@ -951,6 +974,16 @@ void bind_open_mpm(lua_State *L)
     static const luaL_Reg meta[] = {
         {"__gc", l_gc}, {"__close", l_gc}, {"__tostring", l_tostring}, {NULL, NULL}};
     bind_new_type(L, SCENE, methods, meta, "An MPM scene from mpm.scene{...}.");
+    static const bind_fields method_fields[] = {{"add_disk", NULL, DISK_FIELDS},
+                                                {"add_rect", NULL, RECT_FIELDS},
+                                                {"add_polygon", NULL, POLYGON_FIELDS},
+                                                {"contact", NULL, CONTACT_FIELDS},
+                                                {"plane", NULL, PLANE_FIELDS},
+                                                {"timestep", NULL, TIMESTEP_FIELDS},
+                                                {"run", NULL, RUN_FIELDS},
+                                                {"set_velocities", NULL, VELOCITIES_FIELDS},
+                                                {NULL, NULL, NULL}};
+    bind_type_fields(L, SCENE, method_fields);
 
     luaL_newmetatable(L, MATERIAL);
     bind_doc(L, -1, MATERIAL, MATERIAL,
@@ -960,6 +993,8 @@ void bind_open_mpm(lua_State *L)
     lua_setfield(L, -2, "__index");
     lua_pushcfunction(L, material_tostring);
     lua_setfield(L, -2, "__tostring");
+    lua_pushcfunction(L, material_newindex);
+    lua_setfield(L, -2, "__newindex");
     lua_pop(L, 1);
 
     static const bind_fn fns[] = {
@@ -986,8 +1021,11 @@ void bind_open_mpm(lua_State *L)
          "plasticity with linear isotropic hardening (q = yield + hardening eps_p, radial "
          "return). SI units."},
         {NULL, NULL, NULL, NULL}};
+    static const bind_fields fn_fields[] = {
+        {"scene", NULL, SCENE_FIELDS}, {"material", NULL, MATERIAL_FIELDS}, {NULL, NULL, NULL}};
     lua_newtable(L);
     bind_register(L, -1, fns);
+    bind_register_fields(L, -1, fn_fields);
     bind_doc(L, -1, "mpm", "mpm",
              "Material points: deformable grains on a background grid (Bardenhagen et al. 1998).");
     lua_setglobal(L, "mpm");

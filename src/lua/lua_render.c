@@ -101,7 +101,9 @@ static int l_image_pixel(lua_State *L)
 static int l_image_save(lua_State *L)
 {
     render_image *img = check_image(L, 1);
-    const char *path = luaL_checkstring(L, 2);
+    if (lua_type(L, 2) != LUA_TSTRING) /* a number would be converted into a file name */
+        bind_arg_error(L, 2, "save", "string");
+    const char *path = lua_tostring(L, 2);
     core_error err;
     if (render_write_png(img, path, &err) != CORE_OK)
         return bind_raise(L, "save", &err);
@@ -138,6 +140,17 @@ static void *buffer_below_top(lua_State *L, size_t size)
     return p;
 }
 
+/* The table at idx has no keys but 1..#t: {a = ...} is no list, and must not read as an empty one.
+ */
+static int pure_array(lua_State *L, int idx)
+{
+    idx = lua_absindex(L, idx);
+    size_t n = lua_rawlen(L, idx), count = 0;
+    for (lua_pushnil(L); lua_next(L, idx); lua_pop(L, 1))
+        count++;
+    return count == n;
+}
+
 static void read_show(lua_State *L, int arg, const char *call, scene_opts *o)
 {
     render_grains_def *d = &o->def;
@@ -159,7 +172,7 @@ static void read_show(lua_State *L, int arg, const char *call, scene_opts *o)
     lua_Integer n = 1;
     if (t == LUA_TTABLE)
         n = (lua_Integer)lua_rawlen(L, -1);
-    else if (t != LUA_TSTRING)
+    if ((t != LUA_TTABLE && t != LUA_TSTRING) || (t == LUA_TTABLE && !pure_array(L, -1)))
         bind_field_error(L, arg, call, "show", what);
     for (lua_Integer i = 1; i <= n; i++) {
         if (t == LUA_TTABLE)
@@ -217,7 +230,7 @@ static void read_walls(lua_State *L, int arg, const char *call, dem_scene *s, sc
         o->def.nwalls = k;
         return;
     }
-    if (!lua_istable(L, -1))
+    if (!lua_istable(L, -1) || !pure_array(L, -1))
         bind_field_error(L, arg, call, "walls", what);
     int n = (int)lua_rawlen(L, -1);
     render_wall *walls = buffer_below_top(L, (size_t)n * sizeof *walls);
@@ -403,7 +416,7 @@ static void read_range(lua_State *L, int arg, const char *call, double range[2])
             lua_rawgeti(L, -1, k + 1);
             int isnum;
             range[k] = lua_tonumberx(L, -1, &isnum);
-            ok = isnum && isfinite(range[k]);
+            ok = isnum && lua_type(L, -1) == LUA_TNUMBER && fabs(range[k]) <= 1e100;
             lua_pop(L, 1);
         }
         if (!ok || !(range[0] < range[1]))
@@ -412,14 +425,15 @@ static void read_range(lua_State *L, int arg, const char *call, double range[2])
     lua_pop(L, 1);
 }
 
+static const char *const SCENE_OPTS_FIELDS[] = {
+    "width", "height", "color", "colormap", "range",  "show",         "title",
+    "stamp", "label",  "walls", "frame",    "camera", "displacement", NULL};
+
 /* Reads the options table at arg (absent: all defaults) into o. Strings and arrays it points to
  * are kept alive on the stack until the call returns. */
 static void read_scene_opts(lua_State *L, int scene, int arg, const char *call, dem_scene *s,
                             scene_opts *o)
 {
-    static const char *const fields[] = {"width", "height", "color", "colormap", "range", "show",
-                                         "title", "stamp", "label", "walls", "frame", "camera",
-                                         "displacement", NULL};
     memset(o, 0, sizeof *o);
     o->def = render_default_grains_def();
     o->frame = -1;
@@ -428,7 +442,7 @@ static void read_scene_opts(lua_State *L, int scene, int arg, const char *call, 
         lua_replace(L, arg);
     }
     bind_check_table(L, arg, call);
-    bind_check_fields(L, arg, call, fields);
+    bind_check_fields(L, arg, call, SCENE_OPTS_FIELDS);
     render_grains_def *d = &o->def;
     d->width = (int)bind_field_integer(L, arg, call, "width", 0, RENDER_MIN_SIZE, RENDER_MAX_SIZE, 0);
     d->height = (int)bind_field_integer(L, arg, call, "height", 0, RENDER_MIN_SIZE,
@@ -520,7 +534,9 @@ static int l_png(lua_State *L)
 {
     lua_settop(L, 3);
     check_dem(L, 1, "png");
-    const char *pattern = luaL_checkstring(L, 2);
+    if (lua_type(L, 2) != LUA_TSTRING) /* a number would be converted into a file name */
+        bind_arg_error(L, 2, "png", "string");
+    const char *pattern = lua_tostring(L, 2);
     scene_opts o;
     render_image *img = push_image(L); /* freed by __gc even if an error follows */
     int idx = lua_gettop(L);
@@ -604,14 +620,15 @@ static double *series_array(lua_State *L, int st, int k, const char *name, size_
     return v;
 }
 
+static const char *const PLOT_FIELDS[] = {"file",   "width", "height", "title",  "xlabel",
+                                          "ylabel", "xlog",  "ylog",   "series", NULL};
+
 static int l_plot(lua_State *L)
 {
-    static const char *const fields[] = {"file", "width", "height", "title", "xlabel", "ylabel",
-                                         "xlog", "ylog", "series", NULL};
     static const char *const sfields[] = {"x", "y", "label", "style", NULL};
     lua_settop(L, 1);
     bind_check_table(L, 1, "plot");
-    bind_check_fields(L, 1, "plot", fields);
+    bind_check_fields(L, 1, "plot", PLOT_FIELDS);
     render_plot_def def = render_default_plot_def();
     const char *file = bind_field_string(L, 1, "plot", "file", NULL, 0);
     def.width = (int)bind_field_integer(L, 1, "plot", "width", 0, RENDER_MIN_SIZE, RENDER_MAX_SIZE, 0);
@@ -728,7 +745,7 @@ static void grid_entry(lua_State *L, const char *call, const char *name, int kin
         }
     } else if (lua_type(L, -1) == LUA_TNUMBER) {
         double v = lua_tonumber(L, -1);
-        if (!isinf(v)) {
+        if (isnan(v) || fabs(v) <= 1e100) {
             ((double *)out)[k] = v;
             return;
         }
@@ -736,7 +753,11 @@ static void grid_entry(lua_State *L, const char *call, const char *name, int kin
     char got[64];
     bind_describe(L, -1, got, sizeof got);
     fail_printf(L, "bad field '%s' in argument #1 to '%s' (%s expected, got %s%s)", name, call,
-               kind == GRID_FLAGS ? "booleans" : "numbers (NaN for no value)", got, where);
+                kind == GRID_FLAGS ? "booleans"
+                : lua_type(L, -1) == LUA_TNUMBER && !isinf(lua_tonumber(L, -1))
+                    ? "numbers (NaN for no value) of magnitude at most 1e+100"
+                    : "numbers (NaN for no value)",
+                got, where);
 }
 
 /* Reads field key of the table at tbl (named name in errors: "values", "arrows.u") as nx * ny
@@ -927,16 +948,17 @@ static int finish_image(lua_State *L, render_image *img, int idx, const char *fi
 }
 
 /* render.field{...} */
+static const char *const FIELD_FIELDS[] = {
+    "file",   "frame", "width",      "height",        "values",   "nx",    "ny",
+    "extent", "mask",  "background", "interpolation", "colormap", "range", "colorbar",
+    "box",    "title", "stamp",      "label",         "arrows",   NULL};
+
 static int l_field(lua_State *L)
 {
-    static const char *const fields[] = {"file", "frame", "width", "height", "values", "nx",
-                                         "ny", "extent", "mask", "background", "interpolation", "colormap",
-                                         "range", "colorbar", "box", "title", "stamp", "label",
-                                         "arrows", NULL};
     const char *call = "field";
     lua_settop(L, 1);
     bind_check_table(L, 1, call);
-    bind_check_fields(L, 1, call, fields);
+    bind_check_fields(L, 1, call, FIELD_FIELDS);
     render_field_def d = render_default_field_def();
     const char *file = bind_field_string(L, 1, call, "file", NULL, 0);
     long frame = (long)bind_field_integer(L, 1, call, "frame", -1, 0, LUA_MAXINTEGER, 0);
@@ -1013,7 +1035,7 @@ static double *read_numbers(lua_State *L, const char *call, const char *name, si
     if (*n == (size_t)-1)
         snprintf(what, sizeof what, "array of finite numbers");
     else
-        snprintf(what, sizeof what, "array as long as %s (%zu)", same_as, *n);
+        snprintf(what, sizeof what, "array as long as '%s' (%zu)", same_as, *n);
     if (lua_getfield(L, 1, name) != LUA_TTABLE)
         bind_field_error(L, 1, call, name, what);
     int arr = lua_gettop(L);
@@ -1026,12 +1048,16 @@ static double *read_numbers(lua_State *L, const char *call, const char *name, si
     for (size_t i = 0; i < len; i++) {
         lua_rawgeti(L, arr, (lua_Integer)i + 1);
         v[i] = lua_tonumber(L, -1);
-        if (lua_type(L, -1) != LUA_TNUMBER || isinf(v[i]) || (!nan && isnan(v[i]))) {
+        if (lua_type(L, -1) != LUA_TNUMBER || isinf(v[i]) || (!nan && isnan(v[i])) ||
+            fabs(v[i]) > 1e100) {
             char got[64];
             bind_describe(L, -1, got, sizeof got);
-            fail_printf(L, "bad field '%s' in argument #1 to '%s' (%s expected, got %s at entry "
-                          "%zu)", name, call, nan ? "numbers (NaN: grey)" : "finite numbers",
-                       got, i + 1);
+            fail_printf(L,
+                        "bad field '%s' in argument #1 to '%s' (%s%s expected, got %s at entry "
+                        "%zu)",
+                        name, call, nan ? "numbers (NaN: grey)" : "finite numbers",
+                        fabs(v[i]) > 1e100 && isfinite(v[i]) ? " of magnitude at most 1e+100" : "",
+                        got, i + 1);
         }
         lua_pop(L, 1);
     }
@@ -1041,15 +1067,16 @@ static double *read_numbers(lua_State *L, const char *call, const char *name, si
 }
 
 /* render.points{...} */
+static const char *const POINTS_FIELDS[] = {
+    "file",     "frame", "width",    "height", "x",     "y",     "values", "size", "extent",
+    "colormap", "range", "colorbar", "box",    "title", "stamp", "label",  NULL};
+
 static int l_points(lua_State *L)
 {
-    static const char *const fields[] = {"file", "frame", "width", "height", "x", "y", "values",
-                                         "size", "extent", "colormap", "range", "colorbar", "box",
-                                         "title", "stamp", "label", NULL};
     const char *call = "points";
     lua_settop(L, 1);
     bind_check_table(L, 1, call);
-    bind_check_fields(L, 1, call, fields);
+    bind_check_fields(L, 1, call, POINTS_FIELDS);
     render_points_def d = render_default_points_def();
     const char *file = bind_field_string(L, 1, call, "file", NULL, 0);
     long frame = (long)bind_field_integer(L, 1, call, "frame", -1, 0, LUA_MAXINTEGER, 0);
@@ -1173,8 +1200,13 @@ void bind_open_render(lua_State *L)
          "drawn. Writes file (PNG, whole; frame patterns as in render.png) and returns its name, "
          "or without file returns a render.image."},
         {NULL, NULL, NULL, NULL}};
+    static const bind_fields fn_fields[] = {
+        {"png", NULL, SCENE_OPTS_FIELDS}, {"image", NULL, SCENE_OPTS_FIELDS},
+        {"plot", NULL, PLOT_FIELDS},      {"field", NULL, FIELD_FIELDS},
+        {"points", NULL, POINTS_FIELDS},  {NULL, NULL, NULL}};
     lua_newtable(L);
     bind_register(L, -1, fns);
+    bind_register_fields(L, -1, fn_fields);
     bind_doc(L, -1, "render", "render",
              "Headless images: frames of DEM scenes (OSMesa, anti-aliased), grid fields and point "
              "clouds (MPM, DSMC), colour maps, text, colour bars and line plots, written as PNG.");

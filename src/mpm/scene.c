@@ -111,6 +111,21 @@ core_status mpm_create(const mpm_scene_def *def, mpm_scene **out, core_error *er
         return core_fail(err, CORE_ERR_ARG, "unknown shape functions %d", (int)def->shape);
     if (!(def->pic >= 0 && def->pic <= 1))
         return core_fail(err, CORE_ERR_ARG, "pic must be in [0, 1], got %g", def->pic);
+    {
+        /* The grid at creation holds 9 doubles and 2 bytes per node, and frictional contact adds
+         * per-grain fields later. Calloc of a huge grid may "succeed" on an overcommitting
+         * system and kill the process at the first step, so a grid above a fixed budget is
+         * refused here, with the numbers: 8 GiB for the creation fields (about 1.1e8 nodes,
+         * e.g. 10000 x 10000 cells). */
+        const double budget = 8.0 * 1024 * 1024 * 1024;
+        double nodes = (def->cells[0] + 3.0) * (def->cells[1] + 3.0);
+        double bytes = nodes * (9 * sizeof(double) + 2);
+        if (bytes > budget)
+            return core_fail(err, CORE_ERR_ARG,
+                             "cells %d x %d need %.3g bytes of grid fields, above the limit of "
+                             "%.3g bytes (8 GiB); use fewer cells (field 'cells')",
+                             def->cells[0], def->cells[1], bytes, budget);
+    }
     mpm_scene *s = calloc(1, sizeof *s);
     if (!s)
         return core_fail(err, CORE_ERR_NOMEM, "out of memory for the scene");

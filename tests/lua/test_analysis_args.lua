@@ -46,7 +46,7 @@ check.eq(table.concat(sub:boundary(), " "), "1 2 4", "ids without radii: the loo
 local subr = analysis.delaunay({ x = square.x, y = square.y, radius = { 1, 1, 1, 1, 1 } }, { ids = { 5, 1, 2 } })
 check.eq(subr:info().cells, 1, "ids with radii")
 check.errors(function() analysis.delaunay(square, { ids = {} }) end,
-  "delaunay: a Delaunay triangulation needs at least 3 particles, got 0", "empty ids")
+  "bad field 'ids' in argument #2 to 'delaunay' (array of at least 3 distinct particle ids expected, got table)", "empty ids")
 
 -- ---- analysis.delaunay: the coordinate and radius arrays --------------------------------------
 check.errors(function() analysis.delaunay({ x = { 0, 1, 0 }, y = { 0, 0 } }) end,
@@ -194,7 +194,7 @@ check.errors(function() s:boundary{ mode = "delaunay", mbc = 5 } end,
 check.eq(s:boundary{ mode = "delaunay", ids = { 1, 2, 3, 4 } }.edges, 4, "boundary on listed ids")
 s:boundary{ mode = "none" }
 check.errors(function() s:springs{ i = { 1, 2 }, j = { 3 }, k = 1 } end,
-  "bad field 'j' in argument #1 to 'springs' (as many ids as i (2) expected, got 1 values)", "springs lengths")
+  "bad field 'j' in argument #1 to 'springs' (as many ids as 'i' (2) expected, got 1 values)", "springs lengths")
 check.errors(function() s:springs{ i = { 1, 2 }, j = { 3, 1e300 }, k = 1 } end,
   "bad field 'j' in argument #1 to 'springs' (particle ids in [1, 4] expected, got 1e+300 at entry 2)", "springs id huge (was UB)")
 check.errors(function() s:springs{ i = { 1.5 }, j = { 3 }, k = 1 } end,

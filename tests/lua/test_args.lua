@@ -32,7 +32,7 @@ check.errors(function() return grainlab.threads(0) end,
 
 -- Methods count arguments as the user sees them: self is not #1.
 local r = grainlab.rng{ seed = 1 }
-check.errors(function() return r:integer() end, "bad argument #1 to 'integer' (number expected, got no value)", "method arg")
+check.errors(function() return r:integer() end, "bad argument #1 to 'integer' (integer expected, got no value)", "method arg")
 check.errors(function() return r:uniform(2, 1) end, "bad argument #2 to 'uniform' (upper bound below lower bound)", "bounds")
 check.errors(function() return r.uniform(5) end, "bad argument #1 to 'uniform' (grainlab.rng expected, got number)", "bad self")
 local p = grainlab.progress{ total = 1 }
@@ -45,5 +45,5 @@ check.eq(ok, nil, "write_file result")
 check.eq(err, "cannot write '/nonexistent_dir/x.txt': No such file or directory", "write_file message")
 
 check.errors(function() grainlab.doc(print, { nme = "x" }) end,
-  "bad argument #2 to 'doc' (unknown field 'nme'; valid fields: name, usage, doc)", "doc fields")
+  "bad argument #2 to 'doc' (unknown field 'nme'; valid fields: name, usage, doc, fields)", "doc fields")
 check.done()

@@ -45,7 +45,7 @@ check.errors(function() s:contact{ normal = "linear" } end,
   "bad field 'stiffness' in argument #1 to 'contact' (positive number expected, got nil)", "linear law needs a stiffness")
 check.errors(function() s:contact{ normal = "power", stiffness = 1e4, beta = 3 } end,
   "contact: beta must be 1, 1.5 or 2, got 3", "power exponent")
-check.errors(function() s:scale_mass(0) end, "scale_mass: mass scale factor must be > 0, got 0", "mass scale 0")
+check.errors(function() s:scale_mass(0) end, "bad argument #1 to 'scale_mass' (positive number expected, got 0)", "mass scale 0")
 
 -- ---- NaN anywhere ------------------------------------------------------------------------------
 local nan = 0 / 0
@@ -140,7 +140,7 @@ do
   check.errors(function() b:contact{ damping = "brilliantov", restitution = 1.01 } end,
     "bad field 'restitution' in argument #1 to 'contact' (number in (0, 1] expected, got 1.01)", "brilliantov restitution > 1")
   check.errors(function() b:contact{ damping = "brilliantov" } end,
-    "contact: brilliantov damping needs damping_time (s) or restitution", "brilliantov without a time")
+    "bad argument #1 to 'contact' (damping = 'brilliantov' needs field 'damping_time' (s) or 'restitution'", "brilliantov without a time")
 end
 
 -- ---- unknown fields (typos) --------------------------------------------------------------------
@@ -182,8 +182,8 @@ check.errors(function() dem.scene{ dim = 3, box = { { 0, 0, 0 }, { 1, 1, 1 } }, 
 -- ---- run: steps xor time, and their values -------------------------------------------------------
 local r = scene2()
 r:add_disk{ pos = { 0.5, 0.5 }, radius = 1e-3, material = mat }
-check.errors(function() r:run{ steps = 10, time = 1e-3 } end, "run: give exactly one of steps and time", "steps and time")
-check.errors(function() r:run{} end, "run: give exactly one of steps and time", "neither steps nor time")
+check.errors(function() r:run{ steps = 10, time = 1e-3 } end, "bad field 'time' in argument #1 to 'run' (nothing when 'steps' is given (give one) expected, got 0.001)", "steps and time")
+check.errors(function() r:run{} end, "bad field 'steps' in argument #1 to 'run' (step count (or field 'time') expected, got nil)", "neither steps nor time")
 check.errors(function() r:run{ steps = -5 } end,
   "bad field 'steps' in argument #1 to 'run' (non-negative integer expected, got -5)", "negative steps")
 check.errors(function() r:run{ steps = 1.5 } end,
@@ -198,7 +198,7 @@ check.errors(function() r:run{ steps = 1, dt = -1 } end,
 check.errors(function() r:run{ steps = 1, dt = "fast" } end,
   "bad field 'dt' in argument #1 to 'run' (positive number expected, got 'fast')", "dt not a number")
 check.errors(function() r:run(10) end, "bad argument #1 to 'run' (table expected, got number)", "run without a table")
-check.errors(function() r:set_velocity(1, { nan, 0 }) end, "set_velocity: velocity must be finite", "NaN set_velocity")
+check.errors(function() r:set_velocity(1, { nan, 0 }) end, "bad argument #2 to 'set_velocity' (array of 2 finite numbers expected, got ", "NaN set_velocity")
 check.eq(r:info().steps, 0, "no bad run took a step")
 check.errors(function() scene3():run{ steps = 1 } end, "run: the scene has no particles", "run on an empty scene")
 -- Measurements of an empty scene are zeros, not undefined behaviour (UBSan: memcpy of NULL in
@@ -214,7 +214,7 @@ end
 -- Values given out of range are refused rather than read as "not given".
 local c = dem.scene{ dim = 2, box = { { 0, 0 }, { 1, 1 } } }
 check.errors(function() c:contact{ normal = "linear", stiffness = 1, damping = "viscous", restitution = 7 } end,
-  "bad field 'restitution' in argument #1 to 'contact' (nothing unless damping = 'brilliantov'", "restitution with viscous damping")
+  "bad field 'restitution' in argument #1 to 'contact' (nothing unless 'damping' is 'brilliantov'", "restitution with viscous damping")
 check.errors(function() c:contact{ normal = "hertz", damping = "viscous", gamma_n = -1 } end,
   "bad field 'gamma_n' in argument #1 to 'contact' (non-negative number expected, got -1)", "negative gamma_n")
 check.errors(function() c:contact{ normal = "hertz", damping = "brilliantov", damping_time = -1 } end,

@@ -27,11 +27,11 @@ check.is_true(rsa(5):particles().x[47] ~= s1:particles().x[47], "random: another
 check.errors(function()
   local s = dem.scene{ dim = 2, box = { { 0, 0 }, { 0.005, 0.005 } } }
   grainlab.pack.random(s, { n = 500, radius = 1e-3, max_tries = 2000 })
-end, "pack.random: placed", "random: a region too full says how many it placed")
+end, "grainlab.pack.random: placed", "random: a region too full says how many it placed")
 check.errors(function() grainlab.pack.random(dem.scene{ dim = 2, box = { { 0, 0 }, { 1, 1 } } }, { n = 0 }) end,
-  "bad field 'n' in argument #2 to 'pack.random' (positive integer expected, got 0)", "random: n")
+  "bad field 'n' in argument #2 to 'grainlab.pack.random' (integer in [1, 10000000] expected, got 0)", "random: n")
 check.errors(function() grainlab.pack.random(dem.scene{ dim = 2, box = { { 0, 0 }, { 1, 1 } } }, { n = 5, radus = 1 }) end,
-  "bad argument #2 to 'pack.random' (unknown field 'radus'", "random: typo")
+  "bad argument #2 to 'grainlab.pack.random' (unknown field 'radus'", "random: typo")
 
 -- 2D deposition: geometric, no overlap before relaxation, every disk at or above the floor
 do
@@ -54,7 +54,7 @@ do
   check.ge(r.z, 3, "deposit + settle: a contact network (z >= 3)")
   check.le(r.v_rms, 1e-5, "deposit + settle: at rest after the drag-free steps")
   check.errors(function() grainlab.pack.deposit(s, { n = 5000, seed = 1 }) end,
-    "pack.deposit: the region is full after", "deposit: a full region says so")
+    "grainlab.pack.deposit: the region is full after", "deposit: a full region says so")
 end
 
 -- 3D deposition: random suspension, softened fall, stiffness restored, settled bed in contact

@@ -25,7 +25,7 @@ check.errors(function() dsmc.scene(with{ mass = 0 }) end,
 check.errors(function() dsmc.scene(with{ density = 0 }) end,
   "bad field 'density' in argument #1 to 'scene' (positive number expected, got 0)", "zero density")
 check.errors(function() dsmc.scene(with{ density = 1000, mass = 1 }) end,
-  "bad field 'density' in argument #1 to 'scene' (nothing when mass is given expected, got 1000)", "mass and density")
+  "bad field 'density' in argument #1 to 'scene' (nothing when 'mass' is given expected, got 1000)", "mass and density")
 -- cells smaller than a particle
 check.errors(function() dsmc.scene(with{ cells = { 100, 10 } }) end,
   "scene: cells along x are 0.001 m wide, smaller than a particle (diameter 0.002 m); use at most 50 cells",
@@ -36,7 +36,7 @@ check.errors(function() dsmc.scene(with{ cells = { 0, 10 } }) end,
 check.errors(function() dsmc.scene(with{ dim = 4 }) end,
   "bad field 'dim' in argument #1 to 'scene' (integer in [2, 3] expected, got 4)", "dim 4")
 check.errors(function() dsmc.scene(with{ box = { { 0, 0 }, { 1, 1 } } }) end,
-  "bad field 'box' in argument #1 to 'scene' (box or size, not both expected", "box and size")
+  "bad field 'box' in argument #1 to 'scene' ('box' or 'size', not both expected", "box and size")
 check.errors(function() dsmc.scene(with{ excluded_volume = "hard" }) end,
   "bad field 'excluded_volume' in argument #1 to 'scene' (one of 'none', 'free_volume', 'enskog' expected, got 'hard')",
   "unknown excluded-volume model")
@@ -54,9 +54,9 @@ check.errors(function() s:fill{ n = 3000, temperature = 1e-6 } end,
 check.errors(function() s:fill{ n = 100, temperature = 1e-6, region = { { 0, 0 }, { 0.01, 0.01 } } } end,
   "fill: cannot add 100 particles: the region holds at most 26 at the packing limit", "overfull region")
 check.errors(function() s:fill{ n = 10 } end,
-  "bad field 'temperature' in argument #1 to 'fill' (positive number (or give speed) expected, got nil)", "no temperature")
+  "bad field 'temperature' in argument #1 to 'fill' (positive number (or give 'speed') expected, got nil)", "no temperature")
 check.errors(function() s:fill{ n = 10, temperature = 1, speed = 1 } end,
-  "bad field 'temperature' in argument #1 to 'fill' (nothing when speed is given expected, got 1)", "both")
+  "bad field 'temperature' in argument #1 to 'fill' (nothing when 'speed' is given expected, got 1)", "both")
 check.errors(function() s:fill{ n = 0, speed = 1 } end,
   "bad field 'n' in argument #1 to 'fill' (positive integer expected, got 0)", "no particles")
 check.errors(function() s:run{ steps = 1, dt = 1e-3 } end,
@@ -64,11 +64,11 @@ check.errors(function() s:run{ steps = 1, dt = 1e-3 } end,
 check.eq(s:fill{ n = 1000, speed = 1 }, 1000, "fill returns the count")
 check.errors(function() s:run{ steps = 1, dt = -1 } end,
   "bad field 'dt' in argument #1 to 'run' (positive number expected, got -1)", "negative dt")
-check.errors(function() s:run{ dt = 1e-3 } end, "run: give exactly one of steps and time", "no length")
+check.errors(function() s:run{ dt = 1e-3 } end, "bad field 'steps' in argument #1 to 'run' (step count (or field 'time') expected, got nil)", "no length")
 check.errors(function() s:add{ x = { 0.05 }, y = { 0.2 }, vx = { 0 }, vy = { 0 } } end,
   "add: particle 1: y = 0.2 is outside the box [0, 0.1]", "particle outside")
 check.errors(function() s:add{ x = { 0.05, 0.01 }, y = { 0.02 }, vx = { 0 }, vy = { 0 } } end,
-  "bad field 'y' in argument #1 to 'add' (array as long as x expected", "ragged arrays")
+  "bad field 'y' in argument #1 to 'add' (array as long as 'x' expected", "ragged arrays")
 
 -- walls
 check.errors(function() s:wall{ side = "bottom" } end,

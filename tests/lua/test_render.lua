@@ -397,13 +397,13 @@ do
   fbad({ file = fdir .. "/missing/f.png", values = rows }, "field: cannot write '" .. fdir .. "/missing/f.png'", "field path")
   fbad("x", "bad argument #1 to 'field' (table expected, got string)", "not a table")
   pbad({ file = out, x = { 1, 2 }, y = { 1 } },
-    "bad field 'y' in argument #1 to 'points' (array as long as x (2) expected, got table)", "lengths")
+    "bad field 'y' in argument #1 to 'points' (array as long as 'x' (2) expected, got table)", "lengths")
   pbad({ file = out, x = { 1, 0 / 0 }, y = { 1, 2 } },
     "bad field 'x' in argument #1 to 'points' (finite numbers expected, got", "NaN position")
   pbad({ file = out, x = { 1 }, y = { 1 }, size = 0 },
     "bad field 'size' in argument #1 to 'points' (diameter in (0, 8192] pixels expected, got 0)", "size")
   pbad({ file = out, x = { 1 }, y = { 1 }, values = { 1, 2 } },
-    "bad field 'values' in argument #1 to 'points' (array as long as x (1) expected, got table)", "values length")
+    "bad field 'values' in argument #1 to 'points' (array as long as 'x' (1) expected, got table)", "values length")
   pbad({ file = out, y = { 1 } }, "bad field 'x' in argument #1 to 'points' (array of finite numbers expected, got nil)", "no x")
   pbad({ file = out, x = { 1 }, y = { 1 }, height = 100000 },
     "bad field 'height' in argument #1 to 'points' (integer in [16, 8192] expected, got 100000)", "height")

@@ -1,0 +1,158 @@
+-- Generated bad-input test of grainlab.* (C and Lua parts) and grainlab.pack.* (see
+-- fuzz_driver.lua): every field and argument gets every bad-value class; only the classes
+-- declared below are accepted, everything else must end in an error naming the call and the
+-- field. Files go to a temporary path, removed at the end.
+local fuzz = dofile("fuzz_driver.lua")
+local check = grainlab.check
+local tmp = os.tmpname()
+
+local OPT = { "nil" }
+local TEXT = { "nil", "string" }
+local ALL = {}
+for _, c in ipairs(fuzz.scalar) do ALL[#ALL + 1] = c[1] end
+-- any value at all, including the array-derived classes (pretty prints whatever it is given)
+local ANY = { "short", "long", "entry_nan", "entry_inf", "entry_huge", "entry_string", "entry_table" }
+for _, c in ipairs(ALL) do ANY[#ANY + 1] = c end
+local function self(ctx) return ctx end
+
+local function scene()
+  local s = dem.scene{ dim = 2, box = { { 0, 0 }, { 0.02, 0.02 } }, gravity = { 0, -9.81 } }
+  s:contact{ normal = "hertz", damping = "viscous" }
+  s:add_wall{ point = { 0, 0 }, normal = { 0, 1 } }
+  s:add_wall{ point = { 0, 0 }, normal = { 1, 0 } }
+  s:add_wall{ point = { 0.02, 0 }, normal = { -1, 0 } }
+  return s
+end
+local quartz = grainlab.material{ density = 2650, young = 1e8 }
+
+local calls = {
+  ["grainlab.clock"] = {},
+  ["grainlab.cpu_clock"] = {},
+  ["grainlab.elapsed"] = {},
+  ["grainlab.threads"] = { args = function() return { 1 } end, pos = { OPT } },
+  ["grainlab.rng"] = {
+    args = function() return { { seed = 3, stream = 2 } } end, opts = 1, opts_optional = true,
+    accept = { seed = { "nil", "zero" }, stream = { "nil", "zero" } },
+  },
+  ["grainlab.progress"] = {
+    args = function() return { { label = "x", total = 10, unit = "steps" } } end, opts = 1,
+    accept = { label = TEXT, total = { "nil", "zero" }, unit = TEXT },
+  },
+  ["grainlab.write_file"] = {
+    args = function() return { tmp, "data" } end, pos = { { "string" }, { "string" } },
+    strings = { tmp, "text" },
+  },
+  ["grainlab.doc"] = {
+    args = function() return { function() end, { name = "f", usage = "f()", doc = "d", fields = { "a" } } } end,
+    opts = 2, pos = { { "function", "empty", "nested", "keyed" } },
+    accept = { name = { "string" }, usage = TEXT, doc = TEXT, fields = { "nil", "empty", "short", "long", "entry_string" } },
+  },
+  ["grainlab.doc_of"] = { args = function() return { print } end, pos = { ALL } },
+  ["grainlab.material"] = {
+    args = function() return { { name = "q", density = 2650, young = 1e9, poisson = 0.2, friction = 0.5,
+                                 restitution = 0.5 } } end,
+    opts = 1,
+    accept = { name = TEXT, density = {}, young = {}, poisson = { "nil", "zero" },
+               friction = { "nil", "zero" }, restitution = OPT },
+  },
+  ["grainlab.pack.random"] = {
+    setup = scene, args = function(s) return { s, { n = 2, radius = 1e-3, region = { { 0, 0 }, { 0.02, 0.02 } },
+                                                    seed = 1, material = quartz, max_tries = 1000, speed = 0.1 } } end,
+    opts = 2, pos = { {} },
+    accept = { n = {}, radius = OPT, region = OPT, seed = { "nil", "zero" }, material = OPT,
+               max_tries = OPT, speed = { "nil", "zero" } },
+  },
+  ["grainlab.pack.deposit"] = {
+    setup = scene, args = function(s) return { s, { n = 2, radius = 1e-3, region = { { 0, 0 }, { 0.02, 0.02 } },
+                                                    seed = 1, material = quartz, relax_steps = 0, drag = 1 } } end,
+    opts = 2, pos = { {} },
+    accept = { n = {}, radius = OPT, region = OPT, seed = { "nil", "zero" }, material = OPT,
+               relax_steps = { "nil", "zero" }, drag = { "nil", "zero" } },
+  },
+  ["grainlab.pack.settle"] = {
+    setup = function()
+      local s = scene()
+      s:add_disk{ pos = { 0.01, 0.001 }, radius = 0.001 }
+      return s
+    end,
+    args = function(s) return { s, { max_steps = 10, check_steps = 5, final_steps = 2, min_steps = 0,
+                                     quiet = 1e-5, v_floor = 0.01, collapse = 0, collapse_drag = 20,
+                                     collapse_quiet = 1e-4, verbose = false, drag = 10 } } end,
+    opts = 2, opts_optional = true, pos = { {} },
+    accept = { soften = OPT, drag = { "nil", "zero" }, quiet = OPT, min_steps = { "nil", "zero" },
+               max_steps = OPT, ramp_stages = OPT, ramp_steps = OPT, final_steps = { "nil", "zero" },
+               dt_final = OPT, verbose = { "nil", "boolean" }, dt = OPT, v_floor = OPT,
+               check_steps = OPT, collapse = { "nil", "zero" }, collapse_drag = { "nil", "zero" },
+               collapse_quiet = OPT },
+  },
+  ["grainlab.pack.slab"] = {
+    args = function() return { { size = 1, n = 3, diameter = { 0.1, 0.15, 0.2 }, seed = 1,
+                                 width = 1.8, margin = 0 } } end,
+    opts = 1,
+    slow = { n = { ["nil"] = "the default 369 disks (pack.slab's own test covers it)" },
+             diameter = { ["nil"] = "the paper's 31-250 um disks in the 1 m slab of this base call (millions of steps)" } },
+    accept = { size = {}, n = OPT, diameter = OPT, seed = { "nil", "zero" }, width = OPT,
+               margin = { "nil", "zero" } },
+  },
+  ["grainlab.pretty"] = { args = function() return { { 1, 2 }, { depth = 2 } } end,
+    pos = { ANY, { "nil", "empty" } } },
+  ["grainlab.show"] = { args = function() return { 1 } end, pos = { ALL } },
+  ["grainlab.rng:uniform"] = {
+    setup = function() return grainlab.rng{ seed = 1 } end, self = self,
+    args = function() return { 0, 1 } end, pos = { { "nil", "zero", "negative" }, { "nil", "zero" } },
+  },
+  ["grainlab.rng:normal"] = {
+    setup = function() return grainlab.rng{ seed = 1 } end, self = self,
+    args = function() return { 0, 1 } end, pos = { { "nil", "zero", "negative" }, { "nil", "zero" } },
+  },
+  ["grainlab.rng:integer"] = {
+    setup = function() return grainlab.rng{ seed = 1 } end, self = self,
+    args = function() return { 1, 6 } end, pos = { { "zero", "negative" }, {} },
+  },
+  ["grainlab.rng:raw"] = { setup = function() return grainlab.rng{ seed = 1 } end, self = self },
+  ["grainlab.progress:update"] = {
+    setup = function() return grainlab.progress{ total = 10 } end, self = self,
+    args = function() return { 5 } end, pos = { { "zero" } },
+  },
+  ["grainlab.progress:finish"] = {
+    setup = function() return grainlab.progress{ total = 10 } end, self = self,
+    args = function() return { 5 } end, pos = { { "nil", "zero" } },
+  },
+}
+
+-- Not fuzzed here, each with its reason (printed).
+local skip = {
+  ["grainlab.report"] = "lua/grainlab/report.lua belongs to the report helper (its entry checks are theirs)",
+  ["grainlab.recorder"] = "new in main at 21:25 (i13-recorder, its refusals in test_recorder.lua); its fields are not recorded for this test yet",
+}
+for k, why in pairs(skip) do print(k .. ": not fuzzed: " .. why) end
+
+local grainlab_fns = {}
+for k, v in pairs(grainlab) do
+  if type(v) == "function" then grainlab_fns[k] = v end
+end
+local ok, err = pcall(fuzz.run, {
+  modules = { grainlab = grainlab_fns, ["grainlab.pack"] = grainlab.pack },
+  types = { ["grainlab.rng"] = grainlab.rng{}, ["grainlab.progress"] = grainlab.progress{ total = 1 } },
+  calls = calls, skip = skip })
+os.remove(tmp)
+if not ok then error(err, 0) end
+
+-- A grainlab.material is read-only (issue 12): an assignment is refused, naming the field, and
+-- the value does not change -- for a field that exists as for one that does not.
+local q = grainlab.material{ density = 2650, young = 30e9 }
+check.errors(function() q.density = -5 end,
+  "a grainlab.material is read-only: field 'density' cannot be set", "material read-only")
+check.eq(q.density, 2650, "density unchanged")
+check.errors(function() q.colour = "red" end,
+  "a grainlab.material is read-only: field 'colour' cannot be set", "material read-only (new field)")
+local n = 0
+for k, v in pairs(q) do n = n + 1; check.eq(q[k], v, "pairs gives the fields") end
+check.eq(n, 5, "pairs over a material (name absent)")
+-- grainlab.pack errors name the public call and point at the caller's line.
+local msg = check.errors(function() grainlab.pack.deposit(scene(), { n = -3 }) end,
+  "bad field 'n' in argument #2 to 'grainlab.pack.deposit' (integer in [1, 10000000] expected, got -3)", "deposit n")
+check.contains(msg, "test_fuzz_core.lua:", "at the caller's line")
+check.errors(function() grainlab.pack.settle(nil) end,
+  "bad argument #1 to 'grainlab.pack.settle' (dem.scene expected, got nil)", "settle without a scene")
+check.done()

@@ -1,0 +1,166 @@
+-- Generated bad-input test of the dem module (see fuzz_driver.lua): every field of every dem
+-- function and dem.scene method gets every bad-value class; only the classes declared below are
+-- accepted, everything else must end in an error naming the call and the field.
+local fuzz = dofile("fuzz_driver.lua")
+local check = grainlab.check
+local mat = grainlab.material{ density = 2650, young = 1e7, poisson = 0.3, friction = 0.3 }
+
+local function scene2()
+  local s = dem.scene{ dim = 2, box = { { 0, 0 }, { 1, 1 } }, gravity = { 0, 0 } }
+  s:add_disk{ pos = { 0.5, 0.5 }, radius = 0.01 }
+  s:add_wall{ point = { 0, 0 }, normal = { 0, 1 } }
+  return s
+end
+local function scene3()
+  local s = dem.scene{ dim = 3, box = { { 0, 0, 0 }, { 1, 1, 1 } }, gravity = { 0, 0, 0 } }
+  s:add_sphere{ pos = { 0.5, 0.5, 0.5 }, radius = 0.01 }
+  return s
+end
+local function self(ctx) return ctx end
+local OPT = { "nil" }
+local BOOL = { "nil", "boolean" }
+local ID = {} -- a particle or wall id: nothing but a valid id
+
+local calls = {
+  ["dem.scene"] = {
+    args = function() return { { dim = 2, box = { { 0, 0 }, { 1, 1 } }, gravity = { 0, -9.81 },
+                                 periodic = { false, false }, thickness = 0.01, skin = 0.001 } } end,
+    opts = 1,
+    accept = { dim = OPT, box = {}, gravity = OPT, periodic = OPT, thickness = { "nil", "zero" },
+               skin = { "nil", "zero" } },
+  },
+  ["dem.scene:contact"] = {
+    { setup = scene2, self = self, opts = 1,
+      args = function() return { { normal = "linear", stiffness = 1e4, damping = "viscous",
+                                   gamma_n = 0.1, tangential = "spring", kt = 1e3, clip = true, rolling = false } } end,
+      accept = { normal = {}, stiffness = {}, beta = OPT, damping = {}, gamma_n = { "nil", "zero" },
+                 damping_time = OPT, restitution = OPT, impact_velocity = OPT, tangential = {},
+                 gamma_t = OPT, kt = OPT, v_r = OPT, exponent = OPT, clip = BOOL,
+                 rolling = BOOL } },
+    { setup = scene2, self = self, opts = 1,
+      args = function() return { { normal = "power", stiffness = 1e4, beta = 1.5,
+                                   tangential = "coulomb_regularized", v_r = 1e-3, exponent = 2 } } end,
+      accept = { normal = {}, stiffness = {}, beta = OPT, damping = OPT, gamma_n = OPT,
+                 damping_time = OPT, restitution = OPT, impact_velocity = OPT, tangential = {},
+                 gamma_t = OPT, kt = OPT, v_r = OPT, exponent = OPT, clip = BOOL, rolling = BOOL } },
+    { setup = scene2, self = self, opts = 1,
+      args = function() return { { tangential = "viscous", gamma_t = 0.1, damping = "brilliantov",
+                                   damping_time = 1e-5 } } end,
+      accept = { normal = OPT, stiffness = OPT, beta = OPT, damping = {}, gamma_n = OPT,
+                 damping_time = { "zero" }, restitution = OPT, impact_velocity = OPT, tangential = {},
+                 gamma_t = { "nil", "zero" }, kt = OPT, v_r = OPT, exponent = OPT, clip = BOOL, rolling = BOOL } },
+    { setup = scene2, self = self, opts = 1,
+      args = function() return { { damping = "brilliantov", restitution = 0.7, impact_velocity = 1 } } end,
+      accept = { normal = OPT, stiffness = OPT, beta = OPT, damping = {}, gamma_n = OPT,
+                 damping_time = OPT, restitution = {}, impact_velocity = OPT, tangential = OPT,
+                 gamma_t = OPT, kt = OPT, v_r = OPT, exponent = OPT, clip = BOOL, rolling = BOOL } },
+  },
+  ["dem.scene:add_disk"] = {
+    setup = scene2, self = self, opts = 1,
+    args = function() return { { pos = { 0.2, 0.2 }, radius = 0.01, material = mat, vel = { 1, 0 },
+                                 omega = 1, fixed = false, prescribed = false } } end,
+    accept = { pos = {}, radius = {}, material = OPT, vel = OPT, omega = { "nil", "zero", "negative" },
+               fixed = BOOL, prescribed = BOOL },
+  },
+  ["dem.scene:add_sphere"] = {
+    setup = scene3, self = self, opts = 1,
+    args = function() return { { pos = { 0.2, 0.2, 0.2 }, radius = 0.01, material = mat,
+                                 vel = { 1, 0, 0 }, omega = { 0, 0, 1 }, fixed = false,
+                                 prescribed = false } } end,
+    accept = { pos = {}, radius = {}, material = OPT, vel = OPT, omega = OPT, fixed = BOOL,
+               prescribed = BOOL },
+  },
+  ["dem.scene:add_wall"] = {
+    setup = scene2, self = self, opts = 1,
+    args = function() return { { point = { 0, 1 }, normal = { 0, -1 }, velocity = { 0, 0 },
+                                 friction = 0.3, material = mat } } end,
+    accept = { point = {}, normal = {}, velocity = OPT, friction = { "nil", "zero" }, material = OPT },
+  },
+  ["dem.scene:remove_wall"] = { setup = scene2, self = self, args = function() return { 1 } end, pos = { ID } },
+  ["dem.scene:wall_point"] = { setup = scene2, self = self, args = function() return { 1 } end, pos = { ID } },
+  ["dem.scene:wall_force"] = { setup = scene2, self = self, args = function() return { 1 } end, pos = { ID } },
+  ["dem.scene:wall_velocity"] = {
+    setup = scene2, self = self, args = function() return { 1, { 0, 0.1 } } end, pos = { ID, {} },
+  },
+  ["dem.scene:wall_servo"] = {
+    setup = scene2, self = self, args = function() return { 1, { force = 1, mass = 1, rate = 1 } } end,
+    opts = 2, opts_optional = true, pos = { ID },
+    accept = { force = { "zero" }, mass = {}, rate = { "nil", "zero" } },
+  },
+  ["dem.scene:set_velocity"] = {
+    setup = scene2, self = self, args = function() return { 1, { 0, 0.1 } } end, pos = { ID, {} },
+  },
+  ["dem.scene:timestep"] = {
+    setup = scene2, self = self, args = function() return { { impact_velocity = 1 } } end,
+    opts = 1, opts_optional = true, accept = { impact_velocity = OPT },
+  },
+  ["dem.scene:run"] = {
+    setup = scene2, self = self, opts = 1,
+    args = function() return { { steps = 2, dt = 1e-6, force = false, impact_velocity = 1,
+                                 integrator = "velocity_verlet", m = 2, n = 2, q = 2, every = 1,
+                                 on_step = function() end, progress = false } } end,
+    accept = { steps = { "zero" }, time = OPT, dt = OPT, force = BOOL, impact_velocity = OPT,
+               integrator = OPT, m = OPT, n = OPT, q = { "nil", "zero" }, every = OPT,
+               on_step = { "nil", "function" }, progress = BOOL },
+  },
+  ["dem.scene:measure"] = {
+    { setup = scene2, self = self, args = function() return { "energy" } end, pos = { {} } },
+    { setup = scene2, self = self, mode = "stress", opts = 2, opts_optional = true,
+      args = function() return { "stress", { volume = 1 } } end, accept = { volume = OPT } },
+    { setup = function() local s = scene2(); s:set_reference(); return s end, self = self,
+      mode = "displacement", opts = 2, opts_optional = true,
+      args = function() return { "displacement", { affine = { { 0, 0 }, { 0, 0 } }, center = { 0, 0 } } } end,
+      accept = { center = OPT, affine = OPT } },
+  },
+  ["dem.scene:particles"] = { setup = scene2, self = self },
+  ["dem.scene:set_reference"] = { setup = scene2, self = self },
+  ["dem.scene:clear_forces"] = { setup = scene2, self = self },
+  ["dem.scene:info"] = { setup = scene2, self = self },
+  ["dem.scene:scale_mass"] = { setup = scene2, self = self, args = function() return { 2 } end, pos = { {} } },
+  ["dem.scene:scale_stiffness"] = { setup = scene2, self = self, args = function() return { 2 } end, pos = { {} } },
+  ["dem.scene:drag"] = { setup = scene2, self = self, args = function() return { 1 } end, pos = { { "nil", "zero" } } },
+  ["dem.scene:set_forces"] = {
+    setup = scene2, self = self, opts = 1,
+    args = function() return { { ids = { 1 }, fx = { 1 }, fy = { 0 } } } end,
+    accept = { ids = {}, fx = {}, fy = {}, fz = OPT },
+  },
+  ["dem.scene:damping_time"] = {
+    { setup = function() local s = scene2(); s:add_disk{ pos = { 0.7, 0.5 }, radius = 0.01 }
+        s:contact{ damping = "brilliantov", damping_time = 1e-5 }; return s end,
+      self = self, args = function() return { 1, { wall = 1 } } end, opts = 2, pos = { ID },
+      accept = { wall = {} } },
+    { setup = function() local s = scene2(); s:add_disk{ pos = { 0.7, 0.5 }, radius = 0.01 }
+        s:contact{ damping = "brilliantov", damping_time = 1e-5 }; return s end,
+      self = self, args = function() return { 1, 2 } end, no_opts = true, pos = { ID, ID } },
+  },
+  ["dem.scene:quasistatic"] = {
+    setup = scene2, self = self, opts = 1,
+    args = function() return { { pressure = 1e5, strain_rate = 1 } } end,
+    accept = { pressure = {}, strain_rate = {} },
+  },
+}
+
+-- Registered on dem.scene by lua_analysis.c, whose validation fixes come with the delaunay
+-- helper's branch: fuzzed once that is merged.
+local pending = "boundary-condition methods of lua_analysis.c (pending i12-delaunay)"
+local skip = { ["dem.scene:boundary"] = pending, ["dem.scene:boundary_edges"] = pending,
+               ["dem.scene:boundary_info"] = pending, ["dem.scene:spin"] = pending,
+               ["dem.scene:springs"] = pending, ["dem.scene:tie"] = pending }
+
+fuzz.run{ modules = { dem = dem }, types = { ["dem.scene"] = scene2() }, calls = calls, skip = skip }
+
+-- Absurd sizes are refused with the limit in the message (issue 12).
+check.errors(function() dem.scene{ box = { { 0, 0 }, { 1e300, 1 } } } end,
+  "bad field 'box' in argument #1 to 'scene' (box corners of magnitude at most 1e+100 expected", "box of 1e300 m")
+check.errors(function() scene2():add_disk{ pos = { 0.5, 0.5 }, radius = 0.6 } end,
+  "add_disk: radius 0.6 is larger than half the box's smallest extent 0.5 (field 'radius')", "radius above the box")
+check.errors(function()
+    dem.scene{ box = { { 0, 0 }, { 1e6, 1e6 } } }:add_disk{ pos = { 1, 1 }, radius = 1e-6 }
+  end, "add_disk: radius 1e-06 is below 1e-9 of the largest box coordinate 1e+06", "radius lost in rounding")
+check.errors(function() scene2():run{ time = 1e99, dt = 1e-6 } end,
+  "bad field 'time' in argument #1 to 'run' (time of at most 1e15 steps of dt = 1e-06 s expected, got 1e+99)", "time of 1e99 s")
+check.errors(function() scene2():set_velocity(1, { 0, 0, 1 }) end,
+  "bad argument #2 to 'set_velocity' (array of 2 finite numbers expected, got table)", "3 components in 2D")
+check.errors(function() scene2():wall_velocity(1, { 0, 0, 1 }) end,
+  "bad argument #2 to 'wall_velocity' (array of 2 finite numbers expected, got table)", "wall velocity in 3 components")
+check.done()
