@@ -33,17 +33,23 @@ typedef struct write_opts {
     int contacts, walls, grid, cells; /* -1: not given (the kind's default) */
 } write_opts;
 
+/* The options of each kind's write_vtk (the very lists the calls check), and all of them for a
+ * series, whose kind is known at its first frame only. */
+static const char *const DEM_FIELDS[] = {"contacts", "walls", NULL};
+static const char *const MPM_FIELDS[] = {"grid", NULL};
+static const char *const DSMC_FIELDS[] = {"cells", NULL};
+static const char *const *const KIND_FIELDS[K_NKINDS] = {DEM_FIELDS, MPM_FIELDS, DSMC_FIELDS};
 static const char *const OPT_FIELDS[] = {"contacts", "walls", "grid", "cells", NULL};
 /* Which kind each option belongs to. */
 static const int OPT_KIND[] = {K_DEM, K_DEM, K_MPM, K_DSMC};
 
-static write_opts read_opts(lua_State *L, int arg, const char *call)
+static write_opts read_opts(lua_State *L, int arg, const char *call, const char *const *fields)
 {
     write_opts o = {-1, -1, -1, -1};
     if (lua_isnoneornil(L, arg))
         return o;
     bind_check_table(L, arg, call);
-    bind_check_fields(L, arg, call, OPT_FIELDS);
+    bind_check_fields(L, arg, call, fields);
     o.contacts = bind_field_boolean(L, arg, call, "contacts", -1);
     o.walls = bind_field_boolean(L, arg, call, "walls", -1);
     o.grid = bind_field_boolean(L, arg, call, "grid", -1);
@@ -168,20 +174,27 @@ static void push_paths(lua_State *L, const part *parts, int n)
     }
 }
 
-/* s:write_vtk(path, opts) on every scene type. */
-static int l_write_vtk(lua_State *L)
+/* s:write_vtk(path, opts), one function per scene type (help() keys its docs by function). */
+static int write_vtk(lua_State *L, int kind)
 {
     const char *call = "write_vtk";
-    int kind = scene_kind(L, 1);
-    if (kind < 0)
-        return luaL_error(L, "%s: a dem.scene, mpm.scene or dsmc.scene expected", call);
-    write_opts o = read_opts(L, 3, call);
+    if (scene_kind(L, 1) != kind) {
+        char got[64];
+        bind_describe(L, 1, got, sizeof got);
+        return luaL_error(L, "%s: a %s expected as self, got %s (call it as s:write_vtk(...))",
+                          call, KIND_NAMES[kind], got);
+    }
+    write_opts o = read_opts(L, 3, call, KIND_FIELDS[kind]);
     const char *stem = stem_of(L, 2, ".vtu");
     part parts[MAX_PARTS];
     int n = write_frame(L, 1, kind, stem, 0, &o, call, parts);
     push_paths(L, parts, n);
     return 1;
 }
+
+static int l_dem_write_vtk(lua_State *L) { return write_vtk(L, K_DEM); }
+static int l_mpm_write_vtk(lua_State *L) { return write_vtk(L, K_MPM); }
+static int l_dsmc_write_vtk(lua_State *L) { return write_vtk(L, K_DSMC); }
 
 /* ---- Delaunay meshes ------------------------------------------------------------------------- */
 /* Calls mesh:method(scene [, opts]) and leaves the result table on the stack. */
@@ -224,6 +237,8 @@ static double *scratch(lua_State *L, size_t n)
     return p;
 }
 
+static const char *const MESH_FIELDS[] = {"depth", "stress", "cells", NULL};
+
 /* mesh:write_vtk(path, scene, { depth =, stress =, cells = { name = {...} } }) */
 static int l_mesh_write_vtk(lua_State *L)
 {
@@ -238,9 +253,8 @@ static int l_mesh_write_vtk(lua_State *L)
     double depth = dem_thickness(s);
     int want_stress = -1, opts = 0, cells_t = 0;
     if (!lua_isnoneornil(L, 4)) {
-        static const char *const fields[] = {"depth", "stress", "cells", NULL};
         bind_check_table(L, 4, call);
-        bind_check_fields(L, 4, call, fields);
+        bind_check_fields(L, 4, call, MESH_FIELDS);
         depth = bind_field_number(L, 4, call, "depth", depth, BIND_POSITIVE);
         want_stress = bind_field_boolean(L, 4, call, "stress", -1);
         int t = lua_getfield(L, 4, "cells");
@@ -401,7 +415,7 @@ static int l_series(lua_State *L)
 {
     const char *call = "series";
     const char *path = luaL_checkstring(L, 1);
-    read_opts(L, 2, call); /* checked now, read again at each add */
+    read_opts(L, 2, call, OPT_FIELDS); /* checked now, read again at each add */
     const char *stem = stem_of(L, 1, ".pvd");
     lseries *u = lua_newuserdatauv(L, sizeof *u, 1);
     memset(u, 0, sizeof *u);
@@ -464,7 +478,7 @@ static int l_series_add(lua_State *L)
         }
     }
     lua_getiuservalue(L, 1, 1);
-    write_opts o = read_opts(L, lua_gettop(L), call);
+    write_opts o = read_opts(L, lua_gettop(L), call, OPT_FIELDS);
     part parts[MAX_PARTS];
     long frame = u->frames + 1;
     int n = write_frame(L, 2, kind, u->stem, frame, &o, call, parts);
@@ -564,13 +578,17 @@ static const char *const WRITE_DOC[K_NKINDS] = {
 
 void bind_open_vtk(lua_State *L)
 {
+    static const lua_CFunction WRITE_FN[K_NKINDS] = {l_dem_write_vtk, l_mpm_write_vtk,
+                                                     l_dsmc_write_vtk};
     for (int k = 0; k < K_NKINDS; k++) {
-        const bind_fn m[] = {{"write_vtk", l_write_vtk, WRITE_USAGE[k], WRITE_DOC[k]},
+        const bind_fn m[] = {{"write_vtk", WRITE_FN[k], WRITE_USAGE[k], WRITE_DOC[k]},
                              {NULL, NULL, NULL, NULL}};
         luaL_getmetatable(L, KIND_NAMES[k]);
         lua_getfield(L, -1, "__index");
         bind_register(L, lua_gettop(L), m);
         lua_pop(L, 2);
+        const bind_fields fields[] = {{"write_vtk", NULL, KIND_FIELDS[k]}, {NULL, NULL, NULL}};
+        bind_type_fields(L, KIND_NAMES[k], fields);
     }
     static const bind_fn mesh_methods[] = {
         {"write_vtk", l_mesh_write_vtk,
@@ -585,6 +603,8 @@ void bind_open_vtk(lua_State *L)
     lua_getfield(L, -1, "__index");
     bind_register(L, lua_gettop(L), mesh_methods);
     lua_pop(L, 2);
+    static const bind_fields mesh_fields[] = {{"write_vtk", NULL, MESH_FIELDS}, {NULL, NULL, NULL}};
+    bind_type_fields(L, "analysis.mesh", mesh_fields);
 
     static const bind_fn methods[] = {
         {"add", l_series_add, "series:add(scene [, time])",
@@ -609,6 +629,8 @@ void bind_open_vtk(lua_State *L)
     lua_getglobal(L, "grainlab");
     lua_newtable(L);
     bind_register(L, lua_gettop(L), fns);
+    static const bind_fields series_fields[] = {{"series", NULL, OPT_FIELDS}, {NULL, NULL, NULL}};
+    bind_register_fields(L, -1, series_fields);
     bind_doc(L, -1, "grainlab.vtk", "grainlab.vtk",
              "VTK XML output for ParaView: s:write_vtk, mesh:write_vtk, grainlab.vtk.series.");
     lua_setfield(L, -2, "vtk");
