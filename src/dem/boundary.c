@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/checkpoint.h"
 #include "core/clock.h"
 #include "dem/dem_internal.h"
 
@@ -519,4 +520,224 @@ size_t dem_boundary_edges(const dem_scene *s, const long **a, const long **bb,
     *bb = b->b;
     *loaded = b->loaded;
     return b->ne;
+}
+
+/* ---- checkpoints (called by checkpoint.c) ---------------------------------------------------- *
+ * Everything but the update callback: a boundary rebuilt by a caller's update (the Delaunay mode
+ * of the Lua binding) cannot be restored from a file, and is refused. The nodes and their g_a
+ * are a function of the edges (dem_set_boundary_edges rebuilds them in the same order). */
+core_status dem_boundary_save(const dem_scene *s, ckpt_writer *w, core_error *err)
+{
+    const dem_boundary *b = s->bnd;
+    if (b->has_def && b->def.update)
+        return core_fail(err, CORE_ERR_STATE,
+                         "the scene's boundary edges are rebuilt by a Delaunay triangulation "
+                         "every %ld steps (s:boundary{ mode = 'delaunay' }), which checkpoints "
+                         "do not store yet; fixed edges, the minimal-boundary penalty, springs, "
+                         "ties and spins are stored",
+                         b->def.every);
+    core_status st = ckpt_section_begin(w, "boundary", CKPT_REQUIRED, err);
+    if (st)
+        return st;
+    const dem_boundary_def *d = &b->def;
+    ckpt_put_u32(w, (uint32_t)b->has_def);
+    ckpt_put_f64(w, d->pressure);
+    ckpt_put_f64(w, d->depth);
+    ckpt_put_i64(w, d->every);
+    ckpt_put_f64(w, d->penalty);
+    ckpt_put_u32(w, (uint32_t)d->gradient);
+    ckpt_put_f64s(w, d->target, 4);
+    ckpt_put_f64s(w, d->mask, 4);
+    ckpt_put_f64(w, d->tau);
+    ckpt_put_u64(w, b->ne);
+    for (size_t k = 0; k < b->ne; k++) {
+        ckpt_put_i64(w, b->a[k]);
+        ckpt_put_i64(w, b->b[k]);
+        ckpt_put_u32(w, b->loaded[k]);
+    }
+    ckpt_put_u32(w, (uint32_t)b->closed);
+    ckpt_put_u64(w, b->ns);
+    for (size_t k = 0; k < b->ns; k++) {
+        ckpt_put_i64(w, b->si[k]);
+        ckpt_put_i64(w, b->sj[k]);
+        ckpt_put_f64(w, b->sk[k]);
+        ckpt_put_f64(w, b->srest[k]);
+    }
+    ckpt_put_u64(w, b->nt);
+    for (size_t k = 0; k < b->nt; k++) {
+        ckpt_put_i64(w, b->ti[k]);
+        ckpt_put_i64(w, b->tw[k]);
+        ckpt_put_i64(w, b->ta[k]);
+    }
+    ckpt_put_u64(w, b->nspin);
+    for (size_t k = 0; k < b->nspin; k++) {
+        ckpt_put_i64(w, b->spin_i[k]);
+        ckpt_put_f64(w, b->spin_w[k]);
+    }
+    ckpt_put_i64(w, b->last_update);
+    ckpt_put_i64(w, b->updates);
+    ckpt_put_f64(w, b->update_s);
+    ckpt_put_f64(w, b->apply_s);
+    ckpt_put_f64s(w, b->pen_sum, 2);
+    ckpt_put_f64(w, b->pen_max);
+    ckpt_put_f64(w, b->pres_max);
+    ckpt_put_f64(w, b->stiffness);
+    ckpt_put_f64s(w, b->eint, 4);
+    return ckpt_section_end(w, err);
+}
+
+static core_status corrupt(ckpt_section *sec, const char *what, core_error *err)
+{
+    return core_fail(err, CORE_ERR_IO, "'%s' is corrupt (section '%s': %s)",
+                     ckpt_reader_path(sec->r), sec->tag, what);
+}
+
+/* Reads a count of records of at least `size` bytes each (bounded by the section). */
+static core_status count(ckpt_section *sec, size_t size, size_t *n, core_error *err)
+{
+    uint64_t c;
+    core_status st = ckpt_get_u64(sec, &c, err);
+    if (st)
+        return st;
+    if (c > (sec->size - sec->pos) / size)
+        return corrupt(sec, "bad count", err);
+    *n = (size_t)c;
+    return CORE_OK;
+}
+
+core_status dem_boundary_load(dem_scene *s, ckpt_section *sec, core_error *err)
+{
+    uint32_t has_def = 0, gradient = 0, closed = 0;
+    int64_t every = 0;
+    dem_boundary_def d = dem_default_boundary_def();
+    core_status st = ckpt_get_u32(sec, &has_def, err);
+    if (!st)
+        st = ckpt_get_f64(sec, &d.pressure, err);
+    if (!st)
+        st = ckpt_get_f64(sec, &d.depth, err);
+    if (!st)
+        st = ckpt_get_i64(sec, &every, err);
+    if (!st)
+        st = ckpt_get_f64(sec, &d.penalty, err);
+    if (!st)
+        st = ckpt_get_u32(sec, &gradient, err);
+    if (!st)
+        st = ckpt_get_f64s(sec, d.target, 4, err);
+    if (!st)
+        st = ckpt_get_f64s(sec, d.mask, 4, err);
+    if (!st)
+        st = ckpt_get_f64(sec, &d.tau, err);
+    if (st)
+        return st;
+    d.every = (long)every;
+    d.gradient = (int)gradient;
+    if ((st = ensure(s, err)))
+        return st;
+    if (has_def && (st = dem_set_boundary(s, &d, err)))
+        return corrupt(sec, err->msg, err);
+    size_t ne = 0;
+    if ((st = count(sec, 20, &ne, err)))
+        return st;
+    long *a = malloc((ne ? ne : 1) * sizeof *a), *bb = malloc((ne ? ne : 1) * sizeof *bb);
+    unsigned char *loaded = malloc(ne ? ne : 1);
+    for (size_t k = 0; k < ne && a && bb && loaded && !st; k++) {
+        int64_t x, y;
+        uint32_t l;
+        if (!(st = ckpt_get_i64(sec, &x, err)) && !(st = ckpt_get_i64(sec, &y, err)) &&
+            !(st = ckpt_get_u32(sec, &l, err))) {
+            a[k] = (long)x;
+            bb[k] = (long)y;
+            loaded[k] = (unsigned char)(l != 0);
+        }
+    }
+    if (!st && (!a || !bb || !loaded))
+        st = core_fail(err, CORE_ERR_NOMEM, "out of memory loading the boundary");
+    if (!st)
+        st = ckpt_get_u32(sec, &closed, err);
+    if (!st && ne > 0 && dem_set_boundary_edges(s, ne, a, bb, loaded, (int)closed, err))
+        st = corrupt(sec, err->msg, err);
+    free(a), free(bb), free(loaded);
+    if (st)
+        return st;
+    dem_boundary *b = s->bnd;
+    size_t ns = 0, nt = 0, nspin = 0;
+    if ((st = count(sec, 32, &ns, err)))
+        return st;
+    for (size_t k = 0; k < ns && !st; k++) {
+        int64_t i, j;
+        double kk, rest;
+        if (!(st = ckpt_get_i64(sec, &i, err)) && !(st = ckpt_get_i64(sec, &j, err)) &&
+            !(st = ckpt_get_f64(sec, &kk, err)) && !(st = ckpt_get_f64(sec, &rest, err))) {
+            long li = (long)i, lj = (long)j;
+            if (dem_add_springs(s, 1, &li, &lj, kk, &rest, err))
+                st = corrupt(sec, err->msg, err);
+        }
+    }
+    if (!st)
+        st = count(sec, 24, &nt, err);
+    for (size_t k = 0; k < nt && !st; k++) {
+        int64_t i, wall, axis;
+        if (!(st = ckpt_get_i64(sec, &i, err)) && !(st = ckpt_get_i64(sec, &wall, err)) &&
+            !(st = ckpt_get_i64(sec, &axis, err))) {
+            /* not dem_tie_to_wall: it would also set the velocity, which is stored already */
+            if (i < 0 || (size_t)i >= s->n || wall < 0 || wall >= s->nwalls || axis < 0 ||
+                axis >= s->dim)
+                return corrupt(sec, "bad tie", err);
+            size_t cap = b->cap_t;
+            if ((st = grow((void **)&b->ti, &cap, b->nt + 1, sizeof *b->ti, err)))
+                return st;
+            int *tw = realloc(b->tw, cap * sizeof *tw);
+            if (tw)
+                b->tw = tw;
+            int *ta = realloc(b->ta, cap * sizeof *ta);
+            if (ta)
+                b->ta = ta;
+            if (!tw || !ta)
+                return core_fail(err, CORE_ERR_NOMEM, "out of memory for the ties");
+            b->cap_t = cap;
+            b->ti[b->nt] = (long)i;
+            b->tw[b->nt] = (int)wall;
+            b->ta[b->nt] = (int)axis;
+            b->nt++;
+        }
+    }
+    if (!st)
+        st = count(sec, 16, &nspin, err);
+    if (!st && nspin > sizeof b->spin_i / sizeof b->spin_i[0])
+        return corrupt(sec, "too many spins", err);
+    for (size_t k = 0; k < nspin && !st; k++) {
+        int64_t i;
+        if (!(st = ckpt_get_i64(sec, &i, err)) && !(st = ckpt_get_f64(sec, &b->spin_w[k], err))) {
+            if (i < 0 || (size_t)i >= s->n)
+                return corrupt(sec, "bad spin", err);
+            b->spin_i[k] = (long)i;
+        }
+    }
+    if (st)
+        return st;
+    b->nspin = nspin;
+    int64_t last_update, updates;
+    if (!st)
+        st = ckpt_get_i64(sec, &last_update, err);
+    if (!st)
+        st = ckpt_get_i64(sec, &updates, err);
+    if (!st)
+        st = ckpt_get_f64(sec, &b->update_s, err);
+    if (!st)
+        st = ckpt_get_f64(sec, &b->apply_s, err);
+    if (!st)
+        st = ckpt_get_f64s(sec, b->pen_sum, 2, err);
+    if (!st)
+        st = ckpt_get_f64(sec, &b->pen_max, err);
+    if (!st)
+        st = ckpt_get_f64(sec, &b->pres_max, err);
+    if (!st)
+        st = ckpt_get_f64(sec, &b->stiffness, err);
+    if (!st)
+        st = ckpt_get_f64s(sec, b->eint, 4, err);
+    if (st)
+        return st;
+    b->last_update = (long)last_update;
+    b->updates = (long)updates;
+    return ckpt_section_done(sec, err);
 }

@@ -351,4 +351,14 @@ core_status dem_vtk_particles(const dem_scene *s, const char *path, core_error *
 core_status dem_vtk_contacts(dem_scene *s, const char *path, core_error *err);
 core_status dem_vtk_walls(const dem_scene *s, const char *path, core_error *err);
 
+/* ---- checkpoints (checkpoint.c) ------------------------------------------------------------ *
+ * The whole state a run continues from, laid out by particle id (core/checkpoint.h container,
+ * engine kind "dem"): run N + M steps, or N, save, load (in another process, with another thread
+ * count), M: the same bits. Boundary conditions are stored (edges, pressure, the minimal-boundary
+ * penalty and its integral, springs, ties, spins) except an update callback: a boundary rebuilt
+ * by one is refused. version: the grainlab version recorded in the file. */
+core_status dem_save(const dem_scene *s, const char *path, const char *version, core_error *err);
+/* A new scene from a file; on any error nothing is returned (*out = NULL). */
+core_status dem_load(const char *path, dem_scene **out, core_error *err);
+
 #endif

@@ -76,6 +76,18 @@ int bind_arg_error(lua_State *L, int arg, const char *call, const char *expected
                       expected, got);
 }
 
+const char *bind_arg_path(lua_State *L, int arg, const char *call)
+{
+    size_t len;
+    /* A number would be converted into a file name ("1"): only a string is a path. */
+    if (lua_type(L, arg) != LUA_TSTRING)
+        bind_arg_error(L, arg, call, "file path (string)");
+    const char *path = lua_tolstring(L, arg, &len);
+    if (len == 0 || strlen(path) != len)
+        bind_arg_error(L, arg, call, "non-empty file path without NUL bytes");
+    return path;
+}
+
 double bind_arg_number(lua_State *L, int arg, const char *call, unsigned flags)
 {
     double v = lua_tonumber(L, arg);

@@ -71,6 +71,8 @@ int bind_field_error(lua_State *L, int arg, const char *call, const char *field,
 /* Positional arguments, in the same grammar: "bad argument #N to 'call' (EXPECTED expected, got
  * VALUE)". A number is finite unless BIND_ALLOW_INF; flags as for fields. */
 int bind_arg_error(lua_State *L, int arg, const char *call, const char *expected);
+/* A file path: a non-empty string without NUL bytes (a number is refused, not converted). */
+const char *bind_arg_path(lua_State *L, int arg, const char *call);
 double bind_arg_number(lua_State *L, int arg, const char *call, unsigned flags);
 lua_Integer bind_arg_integer(lua_State *L, int arg, const char *call, lua_Integer min,
                              lua_Integer max);
@@ -173,6 +175,9 @@ void bind_open_dem(lua_State *L);
 
 /* The dem_scene of the dem.scene at idx, or a Lua error naming `call` (for other bindings). */
 struct dem_scene *bind_check_dem_scene(lua_State *L, int idx, const char *call);
+/* Pushes a new, empty dem.scene userdata (metatable, material table) and returns the slot for
+ * its kernel scene, NULL until the caller fills it (dem.scene, dem.load). */
+struct dem_scene **bind_new_dem_scene(lua_State *L);
 
 /* Registers the global `mpm` module (lua_mpm.c). */
 void bind_open_mpm(lua_State *L);
@@ -182,6 +187,8 @@ void bind_open_dsmc(lua_State *L);
 /* Registers the global `analysis` module and the boundary-condition methods of dem.scene
  * (lua_analysis.c); after bind_open_dem. */
 void bind_open_analysis(lua_State *L);
+/* s:save and dem.load (lua_checkpoint.c); after bind_open_dem. */
+void bind_open_checkpoint(lua_State *L);
 
 /* Registers the global `render` module (lua_render.c). */
 void bind_open_render(lua_State *L);

@@ -70,15 +70,21 @@ static int l_scene(lua_State *L)
     }
     def.skin = bind_field_number(L, 1, "scene", "skin", 0, BIND_NONNEG);
 
+    struct dem_scene **slot = bind_new_dem_scene(L);
+    core_error err;
+    if (dem_create(&def, slot, &err) != CORE_OK)
+        return bind_raise(L, "scene", &err);
+    return 1;
+}
+
+struct dem_scene **bind_new_dem_scene(lua_State *L)
+{
     lscene *u = lua_newuserdatauv(L, sizeof *u, 1);
-    u->s = NULL;
+    u->s = NULL; /* safe before the kernel scene exists: __gc and every method check it */
     luaL_setmetatable(L, SCENE);
     lua_newtable(L); /* grainlab.material -> material index */
     lua_setiuservalue(L, -2, 1);
-    core_error err;
-    if (dem_create(&def, &u->s, &err) != CORE_OK)
-        return bind_raise(L, "scene", &err);
-    return 1;
+    return &u->s;
 }
 
 /* Material index for the field `field` of the table at arg: a grainlab.material (registered on

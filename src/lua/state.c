@@ -51,6 +51,7 @@ static int open_grainlab(lua_State *L)
     lua_setglobal(L, "params");
     bind_open_dem(L);
     bind_open_analysis(L);
+    bind_open_checkpoint(L);
     bind_open_mpm(L);
     bind_open_dsmc(L);
     bind_open_render(L);

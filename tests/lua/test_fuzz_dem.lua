@@ -17,6 +17,10 @@ local function scene3()
   return s
 end
 local function self(ctx) return ctx end
+-- Checkpoint files of the save/load cases go to a scratch directory, never the source tree.
+local tmp = os.tmpname()
+os.remove(tmp)
+assert(os.execute("mkdir -p '" .. tmp .. "'"))
 local OPT = { "nil" }
 local BOOL = { "nil", "boolean" }
 local ID = {} -- a particle or wall id: nothing but a valid id
@@ -133,6 +137,15 @@ local calls = {
         s:contact{ damping = "brilliantov", damping_time = 1e-5 }; return s end,
       self = self, args = function() return { 1, 2 } end, no_opts = true, pos = { ID, ID } },
   },
+  ["dem.scene:save"] = {
+    setup = scene2, self = self, args = function() return { tmp .. "/save.ckpt" } end,
+    pos = { { "string" } }, strings = { [1] = tmp .. "/save.ckpt" },
+  },
+  ["dem.load"] = {
+    setup = function() scene2():save(tmp .. "/load.ckpt") end,
+    args = function() return { tmp .. "/load.ckpt" } end,
+    pos = { { "string" } }, strings = { [1] = tmp .. "/load.ckpt" },
+  },
   ["dem.scene:quasistatic"] = {
     setup = scene2, self = self, opts = 1,
     args = function() return { { pressure = 1e5, strain_rate = 1 } } end,
@@ -158,6 +171,7 @@ local skip = { ["dem.scene:boundary"] = pending, ["dem.scene:boundary_edges"] = 
 
 fuzz.run{ modules = { dem = dem }, types = { ["dem.scene"] = scene2() }, calls = calls, skip = skip }
 os.execute("rm -rf '" .. vtkdir .. "'")
+os.execute("rm -rf '" .. tmp .. "'")
 
 -- Absurd sizes are refused with the limit in the message (issue 12).
 check.errors(function() dem.scene{ box = { { 0, 0 }, { 1e300, 1 } } } end,

@@ -1,0 +1,675 @@
+/* DEM checkpoints: the whole scene state in core/checkpoint.h sections, laid out by particle id,
+ * so that a run continues bit for bit after a load, in another process or with another thread
+ * count. Everything a step reads is stored as it is: the particle arrays, the integrators' state
+ * (forces of the last evaluation for velocity Verlet, the Gear derivatives, position Verlet's
+ * last displacement, the two-timescales phase), the Verlet list with its per-pair parameters and
+ * contact history (keyed by the particle pair i < j, in (i, j) order), the walls with their
+ * candidates and histories, the energy watch. Nothing is recomputed on load except tables that
+ * are a pure function of stored values (the power table, the list's incidence arrays). */
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/checkpoint.h"
+#include "dem/dem_internal.h"
+
+/* ---- saving --------------------------------------------------------------------------------- */
+
+/* An array that may be absent: a presence flag, then the values. */
+static void put_opt(ckpt_writer *w, const double *a, size_t n)
+{
+    ckpt_put_u32(w, a != NULL);
+    if (a)
+        ckpt_put_f64s(w, a, n);
+}
+
+static void put_i32s(ckpt_writer *w, const int *a, size_t n)
+{
+    ckpt_put_u64(w, n);
+    for (size_t k = 0; k < n; k++)
+        ckpt_put_i64(w, a[k]);
+}
+
+static core_status end(ckpt_writer *w, core_error *err) { return ckpt_section_end(w, err); }
+
+static void put_contact(ckpt_writer *w, const dem_contact_def *c)
+{
+    ckpt_put_u32(w, (uint32_t)c->normal);
+    ckpt_put_f64(w, c->stiffness);
+    ckpt_put_f64(w, c->beta);
+    ckpt_put_u32(w, (uint32_t)c->damping);
+    ckpt_put_f64(w, c->gamma_n);
+    ckpt_put_f64(w, c->damping_time);
+    ckpt_put_f64(w, c->restitution);
+    ckpt_put_f64(w, c->impact_velocity);
+    ckpt_put_u32(w, (uint32_t)c->tangential);
+    ckpt_put_f64(w, c->gamma_t);
+    ckpt_put_f64(w, c->kt);
+    ckpt_put_f64(w, c->v_r);
+    ckpt_put_f64(w, c->exponent);
+    ckpt_put_u32(w, c->clip);
+    ckpt_put_u32(w, c->rolling);
+}
+
+static core_status write_scene(const dem_scene *s, ckpt_writer *w, core_error *err)
+{
+    const size_t n = s->n;
+    const int D = s->dim, d0 = D == 2 ? 2 : 0;
+    core_status st;
+    if ((st = ckpt_section_begin(w, "scene", CKPT_REQUIRED, err)))
+        return st;
+    ckpt_put_u32(w, (uint32_t)D);
+    ckpt_put_bytes(w, s->lo, sizeof s->lo);
+    ckpt_put_bytes(w, s->hi, sizeof s->hi);
+    for (int d = 0; d < 3; d++)
+        ckpt_put_u32(w, s->periodic[d]);
+    ckpt_put_bytes(w, s->gravity, sizeof s->gravity);
+    ckpt_put_f64(w, s->thickness);
+    ckpt_put_f64(w, s->drag);
+    ckpt_put_f64(w, s->skin_def);
+    ckpt_put_f64(w, s->skin);
+    ckpt_put_f64(w, s->r_max);
+    ckpt_put_u64(w, n);
+    ckpt_put_u32(w, (uint32_t)s->rot);
+    ckpt_put_f64(w, s->time);
+    ckpt_put_i64(w, s->steps);
+    ckpt_put_i64(w, s->force_evals);
+    ckpt_put_i64(w, s->last_integrator);
+    ckpt_put_i64(w, s->tt_phase);
+    ckpt_put_u32(w, (uint32_t)s->gear_ready);
+    ckpt_put_u32(w, (uint32_t)s->prev_ready);
+    ckpt_put_u32(w, (uint32_t)s->forces_ready);
+    ckpt_put_u32(w, (uint32_t)s->suspect);
+    ckpt_put_u32(w, (uint32_t)s->need_rebuild);
+    ckpt_put_f64(w, s->gear_dt);
+    ckpt_put_f64(w, s->prev_dt);
+    ckpt_put_u32(w, (uint32_t)s->watch_on);
+    ckpt_put_i64(w, s->watch_next);
+    ckpt_put_i64(w, s->watch_min_step);
+    ckpt_put_f64(w, s->watch_min);
+    ckpt_put_f64(w, s->watch_min_t);
+    ckpt_put_f64(w, s->watch_scale);
+    ckpt_put_f64(w, s->brill_c);
+    if ((st = end(w, err)))
+        return st;
+
+    if ((st = ckpt_section_begin(w, "contact", CKPT_REQUIRED, err)))
+        return st;
+    put_contact(w, &s->contact);
+    if ((st = end(w, err)))
+        return st;
+
+    if ((st = ckpt_section_begin(w, "materials", CKPT_REQUIRED, err)))
+        return st;
+    ckpt_put_u64(w, (uint64_t)s->nmat);
+    for (int k = 0; k < s->nmat; k++) {
+        const dem_material *m = &s->mats[k];
+        const double v[5] = {m->density, m->young, m->poisson, m->friction, m->restitution};
+        ckpt_put_f64s(w, v, 5);
+    }
+    if ((st = end(w, err)))
+        return st;
+
+    /* Particles by id: every per-particle array the steps read. */
+    if ((st = ckpt_section_begin(w, "particles", CKPT_REQUIRED, err)))
+        return st;
+    for (int d = 0; d < D; d++) {
+        ckpt_put_f64s(w, s->x[d], n);
+        ckpt_put_f64s(w, s->v[d], n);
+        ckpt_put_f64s(w, s->f[d], n);
+        ckpt_put_f64s(w, s->x_build[d], n);
+    }
+    ckpt_put_f64s(w, s->r, n);
+    ckpt_put_f64s(w, s->m, n);
+    ckpt_put_f64s(w, s->inv_m, n);
+    ckpt_put_f64s(w, s->inv_inertia, n);
+    put_i32s(w, s->mat, n);
+    ckpt_put_u64(w, n);
+    ckpt_put_bytes(w, s->flags, n);
+    for (int d = d0; d < 3; d++) {
+        put_opt(w, s->w[d], n);
+        put_opt(w, s->tq[d], n);
+    }
+    put_opt(w, s->angle, n);
+    for (int d = 0; d < D; d++) {
+        put_opt(w, s->fext[d], n);
+        put_opt(w, s->x_ref[d], n);
+        put_opt(w, s->x_prev[d], n);
+    }
+    for (int k = 0; k < 6; k++) {
+        for (int d = 0; d < D; d++)
+            put_opt(w, s->gear[k][d], n);
+        for (int d = d0; d < 3; d++)
+            put_opt(w, s->gear_w[k][d], n);
+    }
+    if ((st = end(w, err)))
+        return st;
+
+    if ((st = ckpt_section_begin(w, "walls", CKPT_REQUIRED, err)))
+        return st;
+    ckpt_put_u64(w, (uint64_t)s->nwalls);
+    for (int k = 0; k < s->nwalls; k++) {
+        const dem_wall *wl = &s->walls[k];
+        ckpt_put_u32(w, (uint32_t)wl->active);
+        ckpt_put_bytes(w, wl->point, sizeof wl->point);
+        ckpt_put_bytes(w, wl->normal, sizeof wl->normal);
+        ckpt_put_bytes(w, wl->velocity, sizeof wl->velocity);
+        ckpt_put_f64(w, wl->friction);
+        ckpt_put_i64(w, wl->material);
+        ckpt_put_bytes(w, wl->point_build, sizeof wl->point_build);
+        ckpt_put_f64(w, wl->fn);
+        ckpt_put_u32(w, (uint32_t)wl->servo);
+        ckpt_put_f64(w, wl->servo_force);
+        ckpt_put_f64(w, wl->servo_mass);
+        ckpt_put_f64(w, wl->servo_rate);
+        for (int d = 0; d < 4; d++)
+            put_opt(w, wl->hist[d], n);
+        ckpt_put_u32s(w, wl->cand, wl->ncand);
+    }
+    if ((st = end(w, err)))
+        return st;
+
+    /* The Verlet list as built, with what each pair carries between steps. */
+    const dem_pairs *p = &s->pairs;
+    if ((st = ckpt_section_begin(w, "pairs", CKPT_REQUIRED, err)))
+        return st;
+    ckpt_put_u32(w, p->start != NULL);
+    ckpt_put_u64(w, p->np);
+    ckpt_put_u32s(w, p->i, p->n);
+    ckpt_put_u32s(w, p->j, p->n);
+    ckpt_put_f64s(w, p->k, p->n);
+    ckpt_put_f64s(w, p->gamma, p->n);
+    ckpt_put_f64s(w, p->mu, p->n);
+    for (int d = 0; d < 3; d++) {
+        put_opt(w, p->f[d], p->n);
+        put_opt(w, p->c[d], p->n);
+    }
+    for (int d = 0; d < 4; d++)
+        put_opt(w, p->hist[d], p->n);
+    if ((st = end(w, err)))
+        return st;
+    return s->bnd ? dem_boundary_save(s, w, err) : CORE_OK;
+}
+
+core_status dem_save(const dem_scene *s, const char *path, const char *version, core_error *err)
+{
+    ckpt_writer *w;
+    core_status st = ckpt_writer_open(&w, path, "dem", version, err);
+    if (st)
+        return st;
+    if ((st = write_scene(s, w, err))) {
+        ckpt_writer_abort(w);
+        return st;
+    }
+    return ckpt_writer_commit(w, err);
+}
+
+/* ---- loading -------------------------------------------------------------------------------- */
+
+typedef struct reader {
+    ckpt_section sec;
+    core_error *err;
+    core_status st; /* sticky: the first failure */
+} reader;
+
+static uint32_t u32(reader *r)
+{
+    uint32_t v = 0;
+    if (!r->st)
+        r->st = ckpt_get_u32(&r->sec, &v, r->err);
+    return v;
+}
+
+static uint64_t u64(reader *r)
+{
+    uint64_t v = 0;
+    if (!r->st)
+        r->st = ckpt_get_u64(&r->sec, &v, r->err);
+    return v;
+}
+
+static int64_t i64(reader *r)
+{
+    int64_t v = 0;
+    if (!r->st)
+        r->st = ckpt_get_i64(&r->sec, &v, r->err);
+    return v;
+}
+
+static double f64(reader *r)
+{
+    double v = 0;
+    if (!r->st)
+        r->st = ckpt_get_f64(&r->sec, &v, r->err);
+    return v;
+}
+
+static void bytes(reader *r, void *out, size_t len)
+{
+    if (!r->st)
+        r->st = ckpt_get_bytes(&r->sec, out, len, r->err);
+}
+
+static void bad(reader *r, const char *what)
+{
+    if (!r->st)
+        r->st = core_fail(r->err, CORE_ERR_IO, "'%s' is corrupt (section '%s': %s)",
+                          ckpt_reader_path(r->sec.r), r->sec.tag, what);
+}
+
+/* n values into a new array of cap >= n entries. */
+static double *get_new(reader *r, size_t n, size_t cap)
+{
+    if (r->st)
+        return NULL;
+    double *a = malloc((cap ? cap : 1) * sizeof *a);
+    if (!a) {
+        r->st = core_fail(r->err, CORE_ERR_NOMEM, "out of memory loading a checkpoint");
+        return NULL;
+    }
+    if ((r->st = ckpt_get_f64s(&r->sec, a, n, r->err))) {
+        free(a);
+        return NULL;
+    }
+    return a;
+}
+
+static void get_into(reader *r, double **a, size_t n, size_t cap)
+{
+    double *v = get_new(r, n, cap);
+    if (v) {
+        free(*a);
+        *a = v;
+    }
+}
+
+static void get_opt(reader *r, double **a, size_t n, size_t cap)
+{
+    uint32_t present = u32(r);
+    if (present > 1)
+        bad(r, "bad presence flag");
+    if (present && !r->st)
+        get_into(r, a, n, cap);
+}
+
+static uint32_t *get_u32_new(reader *r, size_t max, size_t *n)
+{
+    if (r->st)
+        return NULL;
+    if ((r->st = ckpt_peek_count(&r->sec, max, n, r->err)))
+        return NULL;
+    uint32_t *a = malloc((*n ? *n : 1) * sizeof *a);
+    if (!a) {
+        r->st = core_fail(r->err, CORE_ERR_NOMEM, "out of memory loading a checkpoint");
+        return NULL;
+    }
+    if ((r->st = ckpt_get_u32s(&r->sec, a, *n, r->err))) {
+        free(a);
+        return NULL;
+    }
+    return a;
+}
+
+static void open_section(reader *r, ckpt_reader *ck, const char *tag)
+{
+    if (!r->st)
+        r->st = ckpt_find(ck, tag, &r->sec, r->err);
+}
+
+static void close_section(reader *r)
+{
+    if (!r->st)
+        r->st = ckpt_section_done(&r->sec, r->err);
+}
+
+static void read_contact(reader *r, dem_contact_def *c)
+{
+    uint32_t normal = u32(r);
+    c->stiffness = f64(r);
+    c->beta = f64(r);
+    uint32_t damping = u32(r);
+    c->gamma_n = f64(r);
+    c->damping_time = f64(r);
+    c->restitution = f64(r);
+    c->impact_velocity = f64(r);
+    uint32_t tangential = u32(r);
+    c->gamma_t = f64(r);
+    c->kt = f64(r);
+    c->v_r = f64(r);
+    c->exponent = f64(r);
+    c->clip = u32(r) != 0;
+    c->rolling = u32(r) != 0;
+    if (normal > DEM_NORMAL_HERTZ || damping > DEM_DAMPING_BRILLIANTOV ||
+        tangential > DEM_TANGENT_REGULARIZED)
+        bad(r, "unknown contact law");
+    c->normal = (dem_normal_law)normal;
+    c->damping = (dem_damping_law)damping;
+    c->tangential = (dem_tangential_law)tangential;
+}
+
+/* The list's per-particle index arrays from the stored (i, j) order. */
+static core_status index_pairs(dem_pairs *p, core_error *err)
+{
+    const size_t np = p->np;
+    p->start = calloc(np + 1, sizeof *p->start);
+    p->jstart = calloc(np + 1, sizeof *p->jstart);
+    p->jpair = malloc((p->n ? p->n : 1) * sizeof *p->jpair);
+    size_t *fill = malloc((np ? np : 1) * sizeof *fill);
+    if (!p->start || !p->jstart || !p->jpair || !fill) {
+        free(fill);
+        return core_fail(err, CORE_ERR_NOMEM, "out of memory loading a checkpoint");
+    }
+    for (size_t q = 0; q < p->n; q++) {
+        p->start[p->i[q] + 1]++;
+        p->jstart[p->j[q] + 1]++;
+    }
+    for (size_t i = 0; i < np; i++) {
+        p->start[i + 1] += p->start[i];
+        p->jstart[i + 1] += p->jstart[i];
+    }
+    if (np > 0)
+        memcpy(fill, p->jstart, np * sizeof *fill);
+    for (size_t q = 0; q < p->n; q++)
+        p->jpair[fill[p->j[q]]++] = (uint32_t)q;
+    free(fill);
+    return CORE_OK;
+}
+
+static void read_pairs(reader *r, dem_scene *s)
+{
+    dem_pairs *p = &s->pairs;
+    uint32_t built = u32(r);
+    p->np = (size_t)u64(r);
+    if (built > 1 || p->np > s->n)
+        bad(r, "bad list header");
+    size_t ni = 0, nj = 0;
+    p->i = get_u32_new(r, SIZE_MAX / 16, &ni);
+    p->j = get_u32_new(r, SIZE_MAX / 16, &nj);
+    if (r->st)
+        return;
+    if (ni != nj) {
+        bad(r, "pair arrays differ in length");
+        return;
+    }
+    p->n = p->cap = ni;
+    /* (i, j) must be strictly increasing with i < j < np: the list order the steps rely on. */
+    for (size_t q = 0; q < p->n; q++) {
+        int ok = p->i[q] < p->j[q] && p->j[q] < p->np;
+        if (q > 0)
+            ok = ok && (p->i[q - 1] < p->i[q] || (p->i[q - 1] == p->i[q] && p->j[q - 1] < p->j[q]));
+        if (!ok) {
+            bad(r, "pair list out of order");
+            return;
+        }
+    }
+    get_into(r, &p->k, p->n, p->n);
+    get_into(r, &p->gamma, p->n, p->n);
+    get_into(r, &p->mu, p->n, p->n);
+    for (int d = 0; d < 3; d++) {
+        get_opt(r, &p->f[d], p->n, p->n);
+        get_opt(r, &p->c[d], p->n, p->n);
+    }
+    for (int d = 0; d < 4; d++)
+        get_opt(r, &p->hist[d], p->n, p->n);
+    if (!r->st && built)
+        r->st = index_pairs(p, r->err);
+}
+
+/* A file that passed the checksum but was not written by dem_save (forged, or a bug) must not
+ * make a step read arrays that are not there: the kernels allocate their state in whole sets,
+ * and a list in use covers every particle. Returns what is wrong, or NULL. */
+static const char *inconsistent(const dem_scene *s, int gear_ready, int prev_ready,
+                                int need_rebuild)
+{
+    const int D = s->dim, d0 = D == 2 ? 2 : 0;
+    if (gear_ready && !s->gear[0][0])
+        return "Gear state marked ready but absent";
+    for (int k = 0; k < 6 && s->gear[0][0]; k++)
+        for (int d = d0; s->rot && d < 3; d++)
+            if (!s->gear_w[k][d])
+                return "Gear rotation state missing";
+    if (prev_ready && !s->x_prev[0])
+        return "position Verlet state marked ready but absent";
+    for (int w = 0; w < s->nwalls; w++)
+        for (int d = 1; d < 4; d++)
+            if ((d < D || d == 3) && !s->walls[w].hist[d] != !s->walls[w].hist[0])
+                return "incomplete wall history";
+    const dem_pairs *p = &s->pairs;
+    if (!need_rebuild) {
+        if (!p->start || p->np != s->n)
+            return "the pair list in use does not cover every particle";
+        for (int d = 0; d < 3 && p->n > 0; d++) { /* an empty list allocates nothing */
+            if (d < D && !p->f[d])
+                return "pair forces missing";
+            if (s->rot && (D == 3 || d == 2) && !p->c[d])
+                return "pair torques missing";
+            if (s->contact.tangential == DEM_TANGENT_SPRING && d < D && !p->hist[d])
+                return "contact history missing";
+        }
+        if (s->contact.tangential == DEM_TANGENT_SPRING && p->n > 0 && !p->hist[3])
+            return "contact history missing";
+    }
+    return NULL;
+}
+
+static void read_all(reader *r, ckpt_reader *ck, dem_scene **out)
+{
+    dem_scene_def def = dem_default_scene_def();
+    open_section(r, ck, "scene");
+    uint32_t dim = u32(r);
+    if (dim != 2 && dim != 3)
+        bad(r, "dimension not 2 or 3");
+    def.dim = (int)dim;
+    bytes(r, def.lo, sizeof def.lo);
+    bytes(r, def.hi, sizeof def.hi);
+    for (int d = 0; d < 3; d++)
+        def.periodic[d] = u32(r) != 0;
+    bytes(r, def.gravity, sizeof def.gravity);
+    def.thickness = f64(r);
+    double drag = f64(r);
+    def.skin = f64(r);
+    if (r->st)
+        return;
+    if ((r->st = dem_create(&def, out, r->err)))
+        return;
+    dem_scene *s = *out;
+    const int D = s->dim, d0 = D == 2 ? 2 : 0;
+    s->drag = drag;
+    s->skin = f64(r);
+    s->r_max = f64(r);
+    const uint64_t n64 = u64(r);
+    if (n64 >= UINT32_MAX - 1)
+        bad(r, "too many particles");
+    const size_t n = (size_t)n64;
+    s->rot = (int)u32(r);
+    s->time = f64(r);
+    s->steps = (long)i64(r);
+    s->force_evals = (long)i64(r);
+    s->last_integrator = (int)i64(r);
+    s->tt_phase = (long)i64(r);
+    /* set at the end: restoring the boundary goes through calls that reset them */
+    const int gear_ready = (int)u32(r), prev_ready = (int)u32(r), forces_ready = (int)u32(r);
+    s->suspect = (int)u32(r);
+    const int need_rebuild = (int)u32(r);
+    s->gear_dt = f64(r);
+    s->prev_dt = f64(r);
+    const int watch_on = (int)u32(r);
+    s->watch_next = (long)i64(r);
+    s->watch_min_step = (long)i64(r);
+    s->watch_min = f64(r);
+    s->watch_min_t = f64(r);
+    s->watch_scale = f64(r);
+    s->brill_c = f64(r);
+    close_section(r);
+
+    open_section(r, ck, "contact");
+    read_contact(r, &s->contact);
+    close_section(r);
+    if (r->st)
+        return;
+    dem_power_init(&s->slip_pow,
+                   s->contact.tangential == DEM_TANGENT_REGULARIZED ? 1 / s->contact.exponent : 0);
+
+    open_section(r, ck, "materials");
+    uint64_t nmat = u64(r);
+    if (nmat > (uint64_t)r->sec.size / 48)
+        bad(r, "bad material count");
+    if (r->st)
+        return;
+    s->mats = calloc(nmat ? nmat : 1, sizeof *s->mats);
+    if (!s->mats) {
+        r->st = core_fail(r->err, CORE_ERR_NOMEM, "out of memory loading a checkpoint");
+        return;
+    }
+    s->cap_mat = (int)(nmat ? nmat : 1);
+    s->nmat = (int)nmat;
+    for (int k = 0; k < s->nmat && !r->st; k++) {
+        double v[5];
+        if ((r->st = ckpt_get_f64s(&r->sec, v, 5, r->err)))
+            break;
+        s->mats[k] = (dem_material){v[0], v[1], v[2], v[3], v[4]};
+    }
+    close_section(r);
+
+    open_section(r, ck, "particles");
+    if (r->st)
+        return;
+    const size_t cap = n ? n : 1;
+    s->n = n;
+    s->cap = cap;
+    for (int d = 0; d < D; d++) {
+        get_into(r, &s->x[d], n, cap);
+        get_into(r, &s->v[d], n, cap);
+        get_into(r, &s->f[d], n, cap);
+        get_into(r, &s->x_build[d], n, cap);
+    }
+    get_into(r, &s->r, n, cap);
+    get_into(r, &s->m, n, cap);
+    get_into(r, &s->inv_m, n, cap);
+    get_into(r, &s->inv_inertia, n, cap);
+    s->mat = malloc(cap * sizeof *s->mat);
+    s->flags = malloc(cap);
+    if (!s->mat || !s->flags) {
+        r->st = core_fail(r->err, CORE_ERR_NOMEM, "out of memory loading a checkpoint");
+        return;
+    }
+    if (u64(r) != n)
+        bad(r, "material array length");
+    for (size_t i = 0; i < n && !r->st; i++) {
+        int64_t m = i64(r);
+        if (m < 0 || m >= s->nmat)
+            bad(r, "unknown material");
+        s->mat[i] = (int)m;
+    }
+    if (u64(r) != n)
+        bad(r, "flag array length");
+    bytes(r, s->flags, n);
+    for (int d = d0; d < 3; d++) {
+        get_opt(r, &s->w[d], n, cap);
+        get_opt(r, &s->tq[d], n, cap);
+    }
+    get_opt(r, &s->angle, n, cap);
+    for (int d = 0; d < D; d++) {
+        get_opt(r, &s->fext[d], n, cap);
+        get_opt(r, &s->x_ref[d], n, cap);
+        get_opt(r, &s->x_prev[d], n, cap);
+    }
+    for (int k = 0; k < 6; k++) {
+        for (int d = 0; d < D; d++)
+            get_opt(r, &s->gear[k][d], n, cap);
+        for (int d = d0; d < 3; d++)
+            get_opt(r, &s->gear_w[k][d], n, cap);
+    }
+    close_section(r);
+    if (r->st)
+        return;
+    /* Optional arrays come in whole sets, as the kernels allocate them. */
+    int rot_ok = s->rot ? s->w[d0] && s->tq[d0] && (D == 3 || s->angle) : !s->w[d0] && !s->angle;
+    for (int d = d0 + 1; d < 3; d++)
+        rot_ok = rot_ok && !s->w[d] == !s->w[d0] && !s->tq[d] == !s->tq[d0];
+    for (int d = 1; d < D; d++)
+        rot_ok = rot_ok && !s->fext[d] == !s->fext[0] && !s->x_ref[d] == !s->x_ref[0] &&
+                 !s->x_prev[d] == !s->x_prev[0];
+    for (int k = 0; k < 6; k++)
+        for (int d = 0; d < D; d++)
+            rot_ok = rot_ok && !s->gear[k][d] == !s->gear[0][0];
+    if (!rot_ok)
+        bad(r, "incomplete set of optional arrays");
+
+    open_section(r, ck, "walls");
+    uint64_t nw = u64(r);
+    if (nw > (uint64_t)r->sec.size / 64)
+        bad(r, "bad wall count");
+    if (r->st)
+        return;
+    s->walls = calloc(nw ? nw : 1, sizeof *s->walls);
+    if (!s->walls) {
+        r->st = core_fail(r->err, CORE_ERR_NOMEM, "out of memory loading a checkpoint");
+        return;
+    }
+    s->cap_walls = (int)(nw ? nw : 1);
+    for (uint64_t k = 0; k < nw && !r->st; k++) {
+        dem_wall *wl = &s->walls[s->nwalls++];
+        wl->active = (int)u32(r);
+        bytes(r, wl->point, sizeof wl->point);
+        bytes(r, wl->normal, sizeof wl->normal);
+        bytes(r, wl->velocity, sizeof wl->velocity);
+        wl->friction = f64(r);
+        int64_t mat = i64(r);
+        if (mat < -1 || mat >= s->nmat)
+            bad(r, "unknown wall material");
+        wl->material = (int)mat;
+        bytes(r, wl->point_build, sizeof wl->point_build);
+        wl->fn = f64(r);
+        wl->servo = (int)u32(r);
+        wl->servo_force = f64(r);
+        wl->servo_mass = f64(r);
+        wl->servo_rate = f64(r);
+        for (int d = 0; d < 4; d++)
+            get_opt(r, &wl->hist[d], n, cap);
+        wl->cand = get_u32_new(r, n, &wl->ncand);
+        wl->cap_cand = wl->ncand;
+        for (size_t c = 0; c < wl->ncand && !r->st; c++)
+            if (wl->cand[c] >= n)
+                bad(r, "wall candidate out of range");
+    }
+    close_section(r);
+
+    open_section(r, ck, "pairs");
+    read_pairs(r, s);
+    close_section(r);
+    if (!r->st && ckpt_has(ck, "boundary")) {
+        open_section(r, ck, "boundary");
+        if (!r->st)
+            r->st = dem_boundary_load(s, &r->sec, r->err);
+    }
+    const char *wrong = r->st ? NULL : inconsistent(s, gear_ready, prev_ready, need_rebuild);
+    if (wrong)
+        r->st = core_fail(r->err, CORE_ERR_IO, "'%s' is corrupt (inconsistent state: %s)",
+                          ckpt_reader_path(ck), wrong);
+    s->gear_ready = gear_ready;
+    s->prev_ready = prev_ready;
+    s->forces_ready = forces_ready;
+    s->need_rebuild = need_rebuild;
+    s->watch_on = watch_on;
+    if (!r->st)
+        r->st = ckpt_reader_finish(ck, r->err);
+}
+
+core_status dem_load(const char *path, dem_scene **out, core_error *err)
+{
+    *out = NULL;
+    ckpt_reader *ck;
+    core_status st = ckpt_reader_open(&ck, path, "dem", err);
+    if (st)
+        return st;
+    reader r = {.err = err, .st = CORE_OK};
+    dem_scene *s = NULL;
+    read_all(&r, ck, &s);
+    ckpt_reader_close(ck);
+    if (r.st) { /* nothing half-loaded reaches the caller */
+        dem_destroy(s);
+        return r.st;
+    }
+    *out = s;
+    return CORE_OK;
+}
