@@ -351,6 +351,71 @@ core_status dem_vtk_particles(const dem_scene *s, const char *path, core_error *
 core_status dem_vtk_contacts(dem_scene *s, const char *path, core_error *err);
 core_status dem_vtk_walls(const dem_scene *s, const char *path, core_error *err);
 
+/* ---- LAMMPS data and dump files (lammps.c) -------------------------------------------------- *
+ * Data files in atom_style sphere (LIGGGHTS: granular): Atoms "id type diameter density x y z
+ * [ix iy iz]", Velocities "id vx vy vz wx wy wz". The density column is the material's density
+ * (kg/m^3); LAMMPS's mass rule density 4/3 pi r^3 is grainlab's for spheres and for 2D disks
+ * of thickness 0. Atom type k is material k - 1 unless a map is given. */
+typedef struct dem_lammps_data {
+    char *path;            /* for messages */
+    char title[256];       /* the first line */
+    size_t n;              /* atoms, sorted by id */
+    int ntypes;
+    double lo[3], hi[3];   /* xlo xhi, ylo yhi, zlo zhi */
+    int has_velocities;
+    int flat;              /* every z, vz, wx, wy is exactly 0 and zlo < 0 < zhi (a 2D file) */
+    long long *id;
+    int *type;
+    double *radius, *density;
+    double *x[3], *v[3], *w[3];  /* x as in the file */
+    int *image[3];         /* image flags (0 when the file has none) */
+    long *line;            /* the Atoms line of each atom */
+} dem_lammps_data;
+
+/* Parses the file strictly (every malformed line is an error "path:line: problem"); nothing of it
+ * depends on a scene. Free with dem_lammps_free (also after a failure). */
+core_status dem_lammps_read(const char *path, dem_lammps_data *out, core_error *err);
+void dem_lammps_free(dem_lammps_data *d);
+
+typedef enum dem_lammps_density {
+    DEM_LAMMPS_DENSITY_STRICT,   /* the file's density must be the material's (1e-9 relative) */
+    DEM_LAMMPS_DENSITY_FILE,     /* a copy of the material per distinct file density */
+    DEM_LAMMPS_DENSITY_MATERIAL  /* the material's density; the file's is ignored */
+} dem_lammps_density;
+
+typedef struct dem_lammps_type {
+    int mapped;                  /* 0: an atom of this type is an error */
+    dem_material material;
+    dem_lammps_density density;
+    unsigned flags;              /* DEM_FIXED: the type's atoms are fixed particles */
+} dem_lammps_type;
+
+/* Adds every atom of d to s (all or nothing: on failure the scene is as before). types[t - 1]
+ * describes atom type t; type_material[t - 1] receives the material index that carries the
+ * type's own material (-1 when no atom used it). Positions outside the box are errors, or wrapped
+ * on periodic axes; a 2D scene needs z = vz = wx = wy = 0. *first: index of the first atom. */
+core_status dem_lammps_add(dem_scene *s, const dem_lammps_data *d, const dem_lammps_type *types,
+                           int *type_material, size_t *first, core_error *err);
+
+typedef struct dem_lammps_write_def {
+    const int *type_of_material; /* [dem_material_count]: atom type, or 0 if unmapped; NULL:
+                                  * material index + 1 */
+    int ntypes;                  /* "atom types" in the header; 0: the largest type written */
+    const char *title;           /* data file: the first line; NULL: a default */
+    int append;                  /* dump: append a frame instead of writing a new file */
+} dem_lammps_write_def;
+
+/* A data file, written whole (temporary file + rename). */
+core_status dem_write_lammps_data(const dem_scene *s, const char *path,
+                                  const dem_lammps_write_def *def, core_error *err);
+/* One `dump custom` frame (id type radius mass x y z vx vy vz fx fy fz omegax omegay omegaz): a
+ * new file written whole, or appended; an append that fails is cut back to the old length. */
+core_status dem_write_lammps_dump(const dem_scene *s, const char *path,
+                                  const dem_lammps_write_def *def, core_error *err);
+
+int dem_material_count(const dem_scene *s);
+const dem_material *dem_material_get(const dem_scene *s, int index); /* NULL if out of range */
+
 /* ---- checkpoints (checkpoint.c) ------------------------------------------------------------ *
  * The whole state a run continues from, laid out by particle id (core/checkpoint.h container,
  * engine kind "dem"): run N + M steps, or N, save, load (in another process, with another thread

@@ -150,11 +150,10 @@ static int write_frame(lua_State *L, int idx, int kind, const char *stem, long f
 
 /* The stem of a path that must end in ext ("foo/pile.vtu" -> "foo/pile"), in a buffer on the
  * stack; a Lua error otherwise. */
-static const char *stem_of(lua_State *L, int arg, const char *ext)
+static const char *stem_of(lua_State *L, int arg, const char *ext, const char *call)
 {
-    size_t len;
-    const char *path = luaL_checklstring(L, arg, &len);
-    size_t el = strlen(ext);
+    const char *path = bind_arg_path(L, arg, call);
+    size_t len = strlen(path), el = strlen(ext);
     if (len <= el || strcmp(path + len - el, ext) != 0) {
         char got[64], msg[128];
         bind_describe(L, arg, got, sizeof got);
@@ -185,7 +184,7 @@ static int write_vtk(lua_State *L, int kind)
                           call, KIND_NAMES[kind], got);
     }
     write_opts o = read_opts(L, 3, call, KIND_FIELDS[kind]);
-    const char *stem = stem_of(L, 2, ".vtu");
+    const char *stem = stem_of(L, 2, ".vtu", call);
     part parts[MAX_PARTS];
     int n = write_frame(L, 1, kind, stem, 0, &o, call, parts);
     push_paths(L, parts, n);
@@ -244,9 +243,9 @@ static int l_mesh_write_vtk(lua_State *L)
 {
     const char *call = "write_vtk";
     luaL_checkudata(L, 1, "analysis.mesh");
-    const char *path = luaL_checkstring(L, 2);
-    stem_of(L, 2, ".vtu");
+    stem_of(L, 2, ".vtu", call); /* checks the name; the stem is not needed */
     lua_pop(L, 1);
+    const char *path = lua_tostring(L, 2);
     dem_scene *s = bind_check_dem_scene(L, 3, call);
     if (dem_dim(s) != 2)
         return luaL_error(L, "%s: the Delaunay cells are 2D; this dem.scene is 3D", call);
@@ -414,9 +413,9 @@ static lseries *check_series(lua_State *L, int idx)
 static int l_series(lua_State *L)
 {
     const char *call = "series";
-    const char *path = luaL_checkstring(L, 1);
+    const char *path = bind_arg_path(L, 1, call);
     read_opts(L, 2, call, OPT_FIELDS); /* checked now, read again at each add */
-    const char *stem = stem_of(L, 1, ".pvd");
+    const char *stem = stem_of(L, 1, ".pvd", call);
     lseries *u = lua_newuserdatauv(L, sizeof *u, 1);
     memset(u, 0, sizeof *u);
     u->kind = -1;

@@ -8,6 +8,8 @@
 #include "lua/bind.h"
 #include "lua/embedded.h"
 
+void bind_open_lammps(lua_State *L);
+
 /* package.preload loader for embedded module number upvalue(1). */
 static int load_embedded(lua_State *L)
 {
@@ -56,6 +58,7 @@ static int open_grainlab(lua_State *L)
     bind_open_dsmc(L);
     bind_open_render(L);
     bind_open_vtk(L); /* after the engines: adds write_vtk to their scene types */
+    bind_open_lammps(L); /* LAMMPS files for dem (lua_lammps.c) */
 
     /* The Lua-side library completes the table: report, check, help. */
     lua_getglobal(L, "require");

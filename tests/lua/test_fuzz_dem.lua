@@ -168,6 +168,8 @@ local pending = "boundary-condition methods of lua_analysis.c (pending i12-delau
 local skip = { ["dem.scene:boundary"] = pending, ["dem.scene:boundary_edges"] = pending,
                ["dem.scene:boundary_info"] = pending, ["dem.scene:spin"] = pending,
                ["dem.scene:springs"] = pending, ["dem.scene:tie"] = pending }
+for _, k in ipairs{ "dem.read_lammps_data", "dem.scene:read_lammps_data", "dem.scene:write_lammps_data",
+                    "dem.scene:write_lammps_dump" } do skip[k] = "fuzzed by test_lammps_fuzz.lua" end
 
 fuzz.run{ modules = { dem = dem }, types = { ["dem.scene"] = scene2() }, calls = calls, skip = skip }
 os.execute("rm -rf '" .. vtkdir .. "'")
