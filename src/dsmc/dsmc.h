@@ -222,4 +222,13 @@ core_status dsmc_measure_histogram(const dsmc_scene *s, int what, int nbins, dou
 core_status dsmc_save(const dsmc_scene *s, const char *path, const char *version, core_error *err);
 core_status dsmc_load(const char *path, dsmc_scene **out, core_error *err);
 
+/* ---- output for other tools (dsmc/vtk.c) ----------------------------------------------------- */
+/* VTK XML for ParaView, written whole. Particles (.vtu): one vertex per particle with point data
+ * id (the position in the current order, 1-based: particles are re-sorted by cell every step and
+ * carry no identity), radius, velocity (3-vector, z = 0 in 2D), mass, cell (1-based). Cells
+ * (.vti image over the box): cell data count, density, packing, velocity, temperature, a2, as
+ * dsmc_measure_fields. */
+core_status dsmc_vtk_particles(const dsmc_scene *s, const char *path, core_error *err);
+core_status dsmc_vtk_cells(const dsmc_scene *s, const char *path, core_error *err);
+
 #endif

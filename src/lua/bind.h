@@ -208,5 +208,7 @@ struct dsmc_scene *bind_check_dsmc_scene(lua_State *L, int idx, const char *call
 struct dsmc_scene **bind_new_dsmc_scene(lua_State *L);
 /* m:save, mpm.load, s:save, dsmc.load (lua_checkpoint_mpm.c); after bind_open_mpm and _dsmc. */
 void bind_open_checkpoint_mpm(lua_State *L);
+/* Adds write_vtk to the scene and mesh types and grainlab.vtk (lua_vtk.c); after the engines. */
+void bind_open_vtk(lua_State *L);
 
 #endif

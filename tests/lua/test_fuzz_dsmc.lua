@@ -97,7 +97,16 @@ local calls = {
   ["dsmc.scene:info"] = { setup = scene, self = self },
 }
 
+-- VTK output (lua_vtk.c): the files go to a scratch directory.
+local vtkdir = os.tmpname()
+os.remove(vtkdir)
+os.execute("mkdir -p '" .. vtkdir .. "'")
+calls["dsmc.scene:write_vtk"] = {
+  setup = scene, self = self, opts = 2, opts_optional = true, pos = { {} },
+  args = function() return { vtkdir .. "/f.vtu", { cells = true } } end, accept = { cells = BOOL },
+}
 fuzz.run{ modules = { dsmc = dsmc }, types = { ["dsmc.scene"] = scene() }, calls = calls }
+os.execute("rm -rf '" .. vtkdir .. "'")
 
 -- Absurd sizes are refused with the limit in the message.
 check.errors(function() dsmc.scene{ size = { 1, 1 }, cells = { 1000000, 1000000 }, radius = 1e-9 } end,

@@ -114,7 +114,16 @@ local calls = {
   },
 }
 
+-- VTK output (lua_vtk.c): the files go to a scratch directory.
+local vtkdir = os.tmpname()
+os.remove(vtkdir)
+os.execute("mkdir -p '" .. vtkdir .. "'")
+calls["mpm.scene:write_vtk"] = {
+  setup = scene, self = self, opts = 2, opts_optional = true, pos = { {} },
+  args = function() return { vtkdir .. "/f.vtu", { grid = true } } end, accept = { grid = BOOL },
+}
 fuzz.run{ modules = { mpm = mpm }, types = { ["mpm.scene"] = scene() }, calls = calls }
+os.execute("rm -rf '" .. vtkdir .. "'")
 
 -- An mpm.material is read-only: an assignment is refused, naming the field.
 check.errors(function() mat.density = -5 end, "an mpm.material is read-only: field 'density' cannot be set",
