@@ -22,7 +22,8 @@
 --       steps=200 threads=1 callgrind=true   (instructions per particle-step: total / (n steps))
 --   grainlab scripts/bench/dem_dense.lua n=2000 export=out/pile.data
 --       writes the prepared pile as a LAMMPS data file (atom type 1 = quartz, velocities included)
---       and stops before timing: scripts/bench/vs_lammps.sh runs that same pile in both codes.
+--       and as a grainlab checkpoint PATH.ckpt (the same state with its walls: a settled pile
+--       touches its walls, which add_wall would refuse on a re-read), and stops before timing: scripts/bench/vs_lammps.sh runs that same pile in both codes.
 -- Metrics: particle_steps_per_s (per thread count), wall_s, contacts_per_particle.
 local n = params.n or 20000
 local steps = params.steps or 20000
@@ -60,6 +61,7 @@ io.stderr:write(string.format(
 if params.export then
   s:write_lammps_data(params.export, { types = { [1] = quartz },
                                        title = string.format("dem_dense.lua n=%d, settled", n) })
+  s:save(params.export .. ".ckpt")
   io.stderr:write(string.format("wrote %s (%d disks, z %.4f, damping time of pair 1-2 %.4g s)\n",
                                 params.export, n, z.z, T))
   return

@@ -1,0 +1,151 @@
+#!/bin/sh
+# grainlab against LAMMPS on the same input, in one run (issue 13).
+#
+# 1. scripts/bench/dem_dense.lua n=N export=... prepares the benchmark pile (deposition + settle,
+#    the same as the benchmark's) and writes it as a LAMMPS data file (atom_style sphere, 2D).
+# 2. Both codes read that file and evaluate the forces once (grainlab: s:run{steps = 0} and
+#    s:particles().fx/fy; LAMMPS: run 0 and dump fx fy). The per-particle forces are compared:
+#      elastic  : Hertz + walls + gravity, no damping (damping velocity 0 in LAMMPS);
+#      damped   : grainlab with one damping time T for every pair, LAMMPS damping viscoelastic
+#                 with eta_n0 = 4/3 E* T / m_ref (m_ref: the mean pair's effective mass). The two
+#                 forms agree only for pairs of effective mass m_ref (see docs/dem.md).
+#    LAMMPS starts every tangential spring at zero and does not advance it during run 0's setup,
+#    and so does grainlab's fresh scene (its first evaluation adds kt * slip * dt, ~1e-12 of the
+#    normal forces at the pile's creep speeds).
+# 3. Timing: the same pile, the same laws (benchmark's per-pair Brilliantov damping in grainlab,
+#    viscoelastic damping in LAMMPS, Cundall-Strack / linear_history tangential springs), `steps`
+#    steps at dt = 1e-7 s; grainlab on 1 and 2 threads, LAMMPS on 1 and `mpirun -np 2`, runs
+#    alternated (A B A B ..., `reps` each), with uptime recorded next to every figure.
+#
+#   scripts/bench/vs_lammps.sh [n=2000] [steps=2000] [reps=3] [grainlab=build/grainlab] [out=out/vs_lammps]
+#
+# Not part of the test suite: it needs Debian's LAMMPS (`apt-get install lammps openmpi-bin`).
+# Prints a Markdown table (particle-steps/s, contacts per particle, load) at the end.
+set -eu
+N=2000 STEPS=2000 REPS=3 GL=build/grainlab OUT=out/vs_lammps
+for a in "$@"; do
+  case $a in
+    n=*) N=${a#n=} ;; steps=*) STEPS=${a#steps=} ;; reps=*) REPS=${a#reps=} ;;
+    grainlab=*) GL=${a#grainlab=} ;; out=*) OUT=${a#out=} ;;
+    *) echo "vs_lammps.sh: unknown argument '$a' (n=, steps=, reps=, grainlab=, out=)" >&2; exit 2 ;;
+  esac
+done
+LMP=$(command -v lmp || command -v lmp_serial || command -v lmp_mpi || true)
+if [ -z "$LMP" ]; then
+  echo "vs_lammps.sh: LAMMPS not found: apt-get install lammps openmpi-bin" >&2; exit 1
+fi
+[ -x "$GL" ] || { echo "vs_lammps.sh: no grainlab at $GL (build first, or grainlab=PATH)" >&2; exit 1; }
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMP_WAIT_POLICY=passive
+mkdir -p "$OUT"
+DATA=$OUT/pile$N.data
+if [ ! -s "$DATA" ] || [ ! -s "$DATA.ckpt" ]; then
+  "$GL" scripts/bench/dem_dense.lua n="$N" export="$DATA"
+fi
+
+# ---- the grainlab side ------------------------------------------------------------------------
+cat > "$OUT/grainlab_side.lua" <<'LUA'
+-- mode=forces: one evaluation, forces to a file; mode=time: steps steps on threads threads.
+-- The checkpoint holds the data file's state bit for bit, with the box's four walls (which touch
+-- the settled pile, so add_wall would refuse them on a fresh read). Switching the tangential law
+-- off and on clears the spring histories: LAMMPS starts from zero springs too.
+local s = dem.load(params.data .. ".ckpt")
+s:contact{ normal = "hertz" }
+local dt = 1e-7
+if params.mode == "forces" then
+  if params.law == "elastic" then
+    s:contact{ normal = "hertz", tangential = "spring" }
+  else
+    s:contact{ normal = "hertz", damping = "brilliantov", damping_time = params.T, tangential = "spring" }
+  end
+  -- one step of 1e-20 s: forces at the file's positions and velocities to round-off (a run of 0
+  -- steps evaluates nothing; the drift and the spring increment are ~1e-20 of the forces)
+  s:run{ steps = 1, dt = 1e-20, progress = false }
+  local p = s:particles()
+  local f = assert(io.open(params.forces, "w"))
+  for i = 1, p.count do f:write(string.format("%d %.17g %.17g %.17g\n", i, p.fx[i], p.fy[i], p.mass[i] * 9.81)) end
+  f:close()
+else
+  s:contact{ normal = "hertz", damping = "brilliantov", restitution = 0.5, impact_velocity = 1,
+             tangential = "spring" }
+  grainlab.threads(params.threads)
+  local w0 = grainlab.clock()
+  s:run{ steps = params.steps, dt = dt, progress = false }
+  local wall = grainlab.clock() - w0
+  local z = s:measure("coordination")
+  print(string.format("RATE %.6g WALL %.4g Z %.4f", s:particles().count * params.steps / wall, wall, z.z))
+end
+LUA
+
+# The damping constants: T of the benchmark's mean pair, its effective mass, E* (quartz with quartz).
+cat > "$OUT/constants.lua" <<'LUA'
+local quartz = grainlab.material{ name = "quartz", density = 2650, young = 30e9, poisson = 0.3,
+                                  friction = 0.45, restitution = 0.5 }
+local s = dem.load(params.data .. ".ckpt")
+s:contact{ normal = "hertz", damping = "brilliantov", restitution = 0.5, impact_velocity = 1,
+           tangential = "spring" }
+local p = s:particles()
+local m, r = 0, 0
+for i = 1, p.count do m = m + p.mass[i]; r = r + p.radius[i] end
+m, r = m / p.count, r / p.count
+local meff = m / 2                                     -- two mean grains
+local Estar = 30e9 / (2 * (1 - 0.3 ^ 2))
+local K = 4 / 3 * Estar * math.sqrt(r / 2)
+local T = 0.698 * (meff / K) ^ 0.4                      -- lambda(0.5) at v = 1 m/s (docs/dem.md)
+-- the benchmark's kt: 2/7 of the Hertz tangent stiffness 3/2 K sqrt(delta) at the mean overlap
+local c = s:measure("contacts")
+local d = 0
+for k = 1, #c.i do d = d + c.overlap[k] end
+d = d / math.max(1, #c.i)
+print(string.format("%.10g %.10g %.10g %.10g", T, 4 / 3 * Estar * T / meff, 2 / 7 * 1.5 * K * math.sqrt(d), meff))
+LUA
+set -- $("$GL" "$OUT/constants.lua" data="$DATA")
+T=$1 ETA=$2 KT=$3 MEFF=$4
+echo "mean pair: T = $T s, m_eff = $MEFF kg -> LAMMPS eta_n0 = $ETA; kt = $KT N/m (2/7 of the Hertz tangent stiffness at the mean overlap)"
+
+# ---- the LAMMPS side -------------------------------------------------------------------------
+# fix wall/gran's hertz/material (this LAMMPS, 2021/2022) sets E* = 4/3 E / (2 (1 - nu)), not
+# E / (2 (1 - nu^2)) as pair granular does: the wall gets E (1 - nu) / (1 - nu^2) = E / (1 + nu)
+# so that its contacts have grainlab's (and pair granular's) E* = E / (2 (1 - nu^2)).
+EWALL=$(awk 'BEGIN { printf "%.17g", 30e9 / 1.3 }')
+lammps_input() { # $1 = eta_n0, $2 = damping model, $3 = run line(s)
+  cat <<LMPIN
+units           si
+atom_style      sphere
+dimension       2
+boundary        f f p
+newton          off
+comm_modify     vel yes
+read_data       $DATA
+neighbor        0.0001 bin
+neigh_modify    delay 0 every 1 check yes
+pair_style      granular
+pair_coeff      * * hertz/material 30e9 $1 0.3 damping $2 tangential linear_history $KT 0 0.45
+fix             integrate all nve/sphere
+fix             gravity all gravity 9.81 vector 0 -1 0
+fix             xwalls all wall/gran granular hertz/material $EWALL $1 0.3 damping $2 tangential linear_history $KT 0 0.45 xplane 0 0.25
+fix             ywalls all wall/gran granular hertz/material $EWALL $1 0.3 damping $2 tangential linear_history $KT 0 0.45 yplane 0 0.3
+fix             flat all enforce2d
+compute         z all contact/atom
+compute         zsum all reduce sum c_z
+thermo_style    custom step atoms c_zsum
+timestep        1e-7
+$3
+LMPIN
+}
+
+compare() { # $1 = law name, $2 = LAMMPS eta_n0, $3 = LAMMPS damping model
+  lammps_input "$2" "$3" "dump f all custom 1 $OUT/lammps_$1.dump id fx fy
+dump_modify f sort id format float %.17g
+run 0" > "$OUT/in.forces_$1"
+  "$LMP" -in "$OUT/in.forces_$1" -log "$OUT/log.forces_$1" -screen none
+  "$GL" "$OUT/grainlab_side.lua" mode=forces law="$1" T="$T" data="$DATA" forces="$OUT/grainlab_$1.txt"
+  awk -v law="$1" 'NR == FNR { gx[$1] = $2; gy[$1] = $3; w[$1] = $4; next }
+    /^ITEM: ATOMS/ { on = 1; next } /^ITEM/ { on = 0 }
+    on { dx = $2 - gx[$1]; dy = $3 - gy[$1]; d = sqrt(dx*dx + dy*dy); m = sqrt($2*$2 + $3*$3)
+         if (d > dmax) dmax = d; if (m > fmax) fmax = m; if (d / w[$1] > rmax) { rmax = d / w[$1]; worst = $1 }
+         s2 += d * d; f2 += m * m; n++ }
+    END { printf "%-8s %d particles: max |f_lammps - f_grainlab| = %.3g N (largest net force %.3g N); rms |df| / rms |f| = %.3g; worst particle %d: |df| = %.3g of its weight\n",
+          law, n, dmax, fmax, sqrt(s2 / f2), worst, rmax }' "$OUT/grainlab_$1.txt" "$OUT/lammps_$1.dump"
+}
+compare elastic 0 velocity
+compare damped "$ETA" viscoelastic
