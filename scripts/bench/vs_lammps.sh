@@ -71,8 +71,12 @@ else
   local w0 = grainlab.clock()
   s:run{ steps = params.steps, dt = dt, progress = false }
   local wall = grainlab.clock() - w0
-  local z = s:measure("coordination")
-  print(string.format("RATE %.6g WALL %.4g Z %.4f", s:particles().count * params.steps / wall, wall, z.z))
+  -- contacts per particle between particles only (LAMMPS's compute contact/atom does not count
+  -- fix wall/gran's contacts; s:measure("coordination") does)
+  local c, np = s:measure("contacts"), s:particles().count
+  local pairs = 0
+  for k = 1, #c.j do pairs = pairs + (c.j[k] > 0 and 1 or 0) end
+  print(string.format("RATE %.6g WALL %.4g Z %.4f", np * params.steps / wall, wall, 2 * pairs / np))
 end
 LUA
 
@@ -149,3 +153,38 @@ run 0" > "$OUT/in.forces_$1"
 }
 compare elastic 0 velocity
 compare damped "$ETA" viscoelastic
+
+# ---- timing: A B A B ... ----------------------------------------------------------------------
+# LAMMPS: the "Loop time" of its log (the run's steps, no setup), contacts from compute
+# contact/atom at the last step; grainlab: s:run's wall time, s:measure("coordination").
+lammps_input "$ETA" viscoelastic "thermo $STEPS
+run $STEPS" > "$OUT/in.time"
+load() { uptime | sed 's/.*load average: //; s/,.*//'; }
+run_gl() { OMP_NUM_THREADS=$1 "$GL" "$OUT/grainlab_side.lua" mode=time threads="$1" steps="$STEPS" data="$DATA" | awk '/^RATE/'; }
+run_lmp() {
+  if [ "$1" = 1 ]; then "$LMP" -in "$OUT/in.time" -log "$OUT/log.time" -screen none
+  else mpirun --oversubscribe -np "$1" "$LMP" -in "$OUT/in.time" -log "$OUT/log.time" -screen none; fi
+  awk -v n="$N" -v s="$STEPS" '/^Loop time of/ { w = $4 } $1 == s && NF == 3 { z = $3 / n }
+    END { printf "RATE %.6g WALL %.4g Z %.4f", n * s / w, w, z }' "$OUT/log.time"
+}
+: > "$OUT/times.txt"
+for cores in 1 2; do
+  r=1
+  while [ "$r" -le "$REPS" ]; do
+    l=$(load); echo "grainlab $cores $(run_gl "$cores") LOAD $l" | tee -a "$OUT/times.txt"
+    l=$(load); echo "lammps $cores $(run_lmp "$cores") LOAD $l" | tee -a "$OUT/times.txt"
+    r=$((r + 1))
+  done
+done
+# the medians, as a Markdown table
+echo
+echo "| cores | grainlab particle-steps/s | contacts/particle | LAMMPS particle-steps/s | contacts/particle | ratio | load (1 min) |"
+echo "|---:|---:|---:|---:|---:|---:|---|"
+for cores in 1 2; do
+  g=$(awk -v c="$cores" '$1 == "grainlab" && $2 == c { print $4 }' "$OUT/times.txt" | sort -g | awk '{ a[NR] = $1 } END { print a[int((NR + 1) / 2)] }')
+  l=$(awk -v c="$cores" '$1 == "lammps" && $2 == c { print $4 }' "$OUT/times.txt" | sort -g | awk '{ a[NR] = $1 } END { print a[int((NR + 1) / 2)] }')
+  zg=$(awk -v c="$cores" '$1 == "grainlab" && $2 == c { z = $8 } END { print z }' "$OUT/times.txt")
+  zl=$(awk -v c="$cores" '$1 == "lammps" && $2 == c { z = $8 } END { print z }' "$OUT/times.txt")
+  ld=$(awk -v c="$cores" '$2 == c { printf "%s%s", s, $10; s = " " }' "$OUT/times.txt")
+  echo "| $cores | $g | $zg | $l | $zl | $(awk -v a="$g" -v b="$l" 'BEGIN { printf "%.2f", a / b }') | $ld |"
+done
