@@ -67,16 +67,21 @@ if params.mode == "forces" then
 else
   s:contact{ normal = "hertz", damping = "brilliantov", restitution = 0.5, impact_velocity = 1,
              tangential = "spring" }
+  local function pair_z()
+    local c, np = s:measure("contacts"), s:particles().count
+    local pairs = 0
+    for k = 1, #c.j do pairs = pairs + (c.j[k] > 0 and 1 or 0) end
+    return 2 * pairs / np
+  end
+  local z0 = pair_z()
   grainlab.threads(params.threads)
   local w0 = grainlab.clock()
   s:run{ steps = params.steps, dt = dt, progress = false }
   local wall = grainlab.clock() - w0
   -- contacts per particle between particles only (LAMMPS's compute contact/atom does not count
   -- fix wall/gran's contacts; s:measure("coordination") does)
-  local c, np = s:measure("contacts"), s:particles().count
-  local pairs = 0
-  for k = 1, #c.j do pairs = pairs + (c.j[k] > 0 and 1 or 0) end
-  print(string.format("RATE %.6g WALL %.4g Z %.4f", np * params.steps / wall, wall, 2 * pairs / np))
+  print(string.format("RATE %.6g WALL %.4g Z %.4f Z0 %.4f", s:particles().count * params.steps / wall,
+                      wall, pair_z(), z0))
 end
 LUA
 
@@ -165,7 +170,8 @@ run_lmp() {
   if [ "$1" = 1 ]; then "$LMP" -in "$OUT/in.time" -log "$OUT/log.time" -screen none
   else mpirun --oversubscribe -np "$1" "$LMP" -in "$OUT/in.time" -log "$OUT/log.time" -screen none; fi
   awk -v n="$N" -v s="$STEPS" '/^Loop time of/ { w = $4 } $1 == s && NF == 3 { z = $3 / n }
-    END { printf "RATE %.6g WALL %.4g Z %.4f", n * s / w, w, z }' "$OUT/log.time"
+    $1 == 0 && NF == 3 { z0 = $3 / n }
+    END { printf "RATE %.6g WALL %.4g Z %.4f Z0 %.4f", n * s / w, w, z, z0 }' "$OUT/log.time"
 }
 : > "$OUT/times.txt"
 for cores in 1 2; do
@@ -178,13 +184,13 @@ for cores in 1 2; do
 done
 # the medians, as a Markdown table
 echo
-echo "| cores | grainlab particle-steps/s | contacts/particle | LAMMPS particle-steps/s | contacts/particle | ratio | load (1 min) |"
+echo "| cores | grainlab particle-steps/s | contacts/particle (start → end) | LAMMPS particle-steps/s | contacts/particle (start → end) | grainlab / LAMMPS | load (1 min) per run |"
 echo "|---:|---:|---:|---:|---:|---:|---|"
 for cores in 1 2; do
   g=$(awk -v c="$cores" '$1 == "grainlab" && $2 == c { print $4 }' "$OUT/times.txt" | sort -g | awk '{ a[NR] = $1 } END { print a[int((NR + 1) / 2)] }')
   l=$(awk -v c="$cores" '$1 == "lammps" && $2 == c { print $4 }' "$OUT/times.txt" | sort -g | awk '{ a[NR] = $1 } END { print a[int((NR + 1) / 2)] }')
-  zg=$(awk -v c="$cores" '$1 == "grainlab" && $2 == c { z = $8 } END { print z }' "$OUT/times.txt")
-  zl=$(awk -v c="$cores" '$1 == "lammps" && $2 == c { z = $8 } END { print z }' "$OUT/times.txt")
-  ld=$(awk -v c="$cores" '$2 == c { printf "%s%s", s, $10; s = " " }' "$OUT/times.txt")
+  zg=$(awk -v c="$cores" '$1 == "grainlab" && $2 == c { z = $10 " → " $8 } END { print z }' "$OUT/times.txt")
+  zl=$(awk -v c="$cores" '$1 == "lammps" && $2 == c { z = $10 " → " $8 } END { print z }' "$OUT/times.txt")
+  ld=$(awk -v c="$cores" '$2 == c { printf "%s%s", s, $12; s = " " }' "$OUT/times.txt")
   echo "| $cores | $g | $zg | $l | $zl | $(awk -v a="$g" -v b="$l" 'BEGIN { printf "%.2f", a / b }') | $ld |"
 done
