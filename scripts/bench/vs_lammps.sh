@@ -52,14 +52,18 @@ local s = dem.load(params.data .. ".ckpt")
 s:contact{ normal = "hertz" }
 local dt = 1e-7
 if params.mode == "forces" then
-  if params.law == "elastic" then
+  if params.law ~= "damped" then
     s:contact{ normal = "hertz", tangential = "spring" }
   else
     s:contact{ normal = "hertz", damping = "brilliantov", damping_time = params.T, tangential = "spring" }
   end
-  -- one step of 1e-20 s: forces at the file's positions and velocities to round-off (a run of 0
-  -- steps evaluates nothing; the drift and the spring increment are ~1e-20 of the forces)
-  s:run{ steps = 1, dt = 1e-20, progress = false }
+  if (params.steps or 0) > 0 then -- the tangential springs at work: steps steps at dt
+    s:run{ steps = params.steps, dt = dt, progress = false }
+  else
+    -- one step of 1e-20 s: forces at the file's positions and velocities to round-off (a run of
+    -- 0 steps evaluates nothing; the drift and the spring increment are ~1e-20 of the forces)
+    s:run{ steps = 1, dt = 1e-20, progress = false }
+  end
   local p = s:particles()
   local f = assert(io.open(params.forces, "w"))
   for i = 1, p.count do f:write(string.format("%d %.17g %.17g %.17g\n", i, p.fx[i], p.fy[i], p.mass[i] * 9.81)) end
@@ -100,16 +104,13 @@ local meff = m / 2                                     -- two mean grains
 local Estar = 30e9 / (2 * (1 - 0.3 ^ 2))
 local K = 4 / 3 * Estar * math.sqrt(r / 2)
 local T = 0.698 * (meff / K) ^ 0.4                      -- lambda(0.5) at v = 1 m/s (docs/dem.md)
--- the benchmark's kt: 2/7 of the Hertz tangent stiffness 3/2 K sqrt(delta) at the mean overlap
-local c = s:measure("contacts")
-local d = 0
-for k = 1, #c.i do d = d + c.overlap[k] end
-d = d / math.max(1, #c.i)
-print(string.format("%.10g %.10g %.10g %.10g", T, 4 / 3 * Estar * T / meff, 2 / 7 * 1.5 * K * math.sqrt(d), meff))
+-- grainlab's kt is 2/7 of the Hertz tangent stiffness, 2/7 * 3/2 * 4/3 E* sqrt(R delta) = 4/7 E* a:
+-- LAMMPS's `tangential mindlin k_t` is k_t * a, so k_t = 4/7 E* gives every contact grainlab's kt.
+print(string.format("%.17g %.17g %.17g %.17g", T, 4 / 3 * Estar * T / meff, 4 / 7 * Estar, meff))
 LUA
 set -- $("$GL" "$OUT/constants.lua" data="$DATA")
 T=$1 ETA=$2 KT=$3 MEFF=$4
-echo "mean pair: T = $T s, m_eff = $MEFF kg -> LAMMPS eta_n0 = $ETA; kt = $KT N/m (2/7 of the Hertz tangent stiffness at the mean overlap)"
+echo "mean pair: T = $T s, m_eff = $MEFF kg -> LAMMPS eta_n0 = $ETA; mindlin k_t = $KT Pa (k_t a = grainlab's kt = 2/7 of the Hertz tangent stiffness)"
 
 # ---- the LAMMPS side -------------------------------------------------------------------------
 # fix wall/gran's hertz/material (this LAMMPS, 2021/2022) sets E* = 4/3 E / (2 (1 - nu)), not
@@ -128,11 +129,11 @@ read_data       $DATA
 neighbor        0.0001 bin
 neigh_modify    delay 0 every 1 check yes
 pair_style      granular
-pair_coeff      * * hertz/material 30e9 $1 0.3 damping $2 tangential linear_history $KT 0 0.45
+pair_coeff      * * hertz/material 30e9 $1 0.3 damping $2 tangential mindlin $KT 0 0.45
 fix             integrate all nve/sphere
 fix             gravity all gravity 9.81 vector 0 -1 0
-fix             xwalls all wall/gran granular hertz/material $EWALL $1 0.3 damping $2 tangential linear_history $KT 0 0.45 xplane 0 0.25
-fix             ywalls all wall/gran granular hertz/material $EWALL $1 0.3 damping $2 tangential linear_history $KT 0 0.45 yplane 0 0.3
+fix             xwalls all wall/gran granular hertz/material $EWALL $1 0.3 damping $2 tangential mindlin $KT 0 0.45 xplane 0 0.25
+fix             ywalls all wall/gran granular hertz/material $EWALL $1 0.3 damping $2 tangential mindlin $KT 0 0.45 yplane 0 0.3
 fix             flat all enforce2d
 compute         z all contact/atom
 compute         zsum all reduce sum c_z
@@ -142,14 +143,14 @@ $3
 LMPIN
 }
 
-compare() { # $1 = law name, $2 = LAMMPS eta_n0, $3 = LAMMPS damping model
-  lammps_input "$2" "$3" "dump f all custom 1 $OUT/lammps_$1.dump id fx fy
+compare() { # $1 = law name, $2 = LAMMPS eta_n0, $3 = LAMMPS damping model, $4 = steps (0: one evaluation)
+  lammps_input "$2" "$3" "dump f all custom ${4:-1} $OUT/lammps_$1.dump id fx fy
 dump_modify f sort id format float %.17g
-run 0" > "$OUT/in.forces_$1"
+run ${4:-0}" > "$OUT/in.forces_$1"
   "$LMP" -in "$OUT/in.forces_$1" -log "$OUT/log.forces_$1" -screen none
-  "$GL" "$OUT/grainlab_side.lua" mode=forces law="$1" T="$T" data="$DATA" forces="$OUT/grainlab_$1.txt"
+  "$GL" "$OUT/grainlab_side.lua" mode=forces law="$1" T="$T" steps="${4:-0}" data="$DATA" forces="$OUT/grainlab_$1.txt"
   awk -v law="$1" 'NR == FNR { gx[$1] = $2; gy[$1] = $3; w[$1] = $4; next }
-    /^ITEM: ATOMS/ { on = 1; next } /^ITEM/ { on = 0 }
+    /^ITEM: TIMESTEP/ { getline ts; on = 0 } /^ITEM: ATOMS/ { on = ts == '"${4:-0}"'; next } /^ITEM/ { on = 0 }
     on { dx = $2 - gx[$1]; dy = $3 - gy[$1]; d = sqrt(dx*dx + dy*dy); m = sqrt($2*$2 + $3*$3)
          if (d > dmax) dmax = d; if (m > fmax) fmax = m; if (d / w[$1] > rmax) { rmax = d / w[$1]; worst = $1 }
          s2 += d * d; f2 += m * m; n++ }
@@ -158,6 +159,7 @@ run 0" > "$OUT/in.forces_$1"
 }
 compare elastic 0 velocity
 compare damped "$ETA" viscoelastic
+compare springs 0 velocity 100
 
 # ---- timing: A B A B ... ----------------------------------------------------------------------
 # LAMMPS: the "Loop time" of its log (the run's steps, no setup), contacts from compute
