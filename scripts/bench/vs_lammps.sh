@@ -3,19 +3,25 @@
 #
 # 1. scripts/bench/dem_dense.lua n=N export=... prepares the benchmark pile (deposition + settle,
 #    the same as the benchmark's) and writes it as a LAMMPS data file (atom_style sphere, 2D).
-# 2. Both codes read that file and evaluate the forces once (grainlab: s:run{steps = 0} and
-#    s:particles().fx/fy; LAMMPS: run 0 and dump fx fy). The per-particle forces are compared:
-#      elastic  : Hertz + walls + gravity, no damping (damping velocity 0 in LAMMPS);
-#      damped   : grainlab with one damping time T for every pair, LAMMPS damping viscoelastic
-#                 with eta_n0 = 4/3 E* T / m_ref (m_ref: the mean pair's effective mass). The two
-#                 forms agree only for pairs of effective mass m_ref (see docs/dem.md).
-#    LAMMPS starts every tangential spring at zero and does not advance it during run 0's setup,
-#    and so does grainlab's fresh scene (its first evaluation adds kt * slip * dt, ~1e-12 of the
-#    normal forces at the pile's creep speeds).
-# 3. Timing: the same pile, the same laws (benchmark's per-pair Brilliantov damping in grainlab,
-#    viscoelastic damping in LAMMPS, Cundall-Strack / linear_history tangential springs), `steps`
-#    steps at dt = 1e-7 s; grainlab on 1 and 2 threads, LAMMPS on 1 and `mpirun -np 2`, runs
-#    alternated (A B A B ..., `reps` each), with uptime recorded next to every figure.
+# 2. Both codes start from that state (grainlab from the checkpoint written with the data file,
+#    bit for bit the same; LAMMPS from read_data) with every tangential spring at zero, and the
+#    per-particle forces are compared (grainlab: s:particles().fx/fy; LAMMPS: dump fx fy):
+#      elastic : one evaluation (LAMMPS run 0; grainlab one step of 1e-20 s). Hertz
+#                (hertz/material, E* = E / (2 (1 - nu^2)) in both), the four walls (fix wall/gran,
+#                given E / (1 + nu) to undo its E / (2 (1 - nu))), gravity; no damping.
+#      damped  : one evaluation, grainlab with one damping time T (the mean pair's) for every pair,
+#                LAMMPS damping viscoelastic with eta_n0 = 4/3 E* T / m_ref (m_ref: the mean pair's
+#                effective mass). LAMMPS's damping is eta_n0 m* a, grainlab's T 4/3 E* a: they agree
+#                only for pairs of effective mass m_ref (no constant eta_n0 matches the per-pair T
+#                of Brilliantov-from-restitution either: that T goes as m*^(2/5) R*^(-1/5)).
+#      springs : after 100 steps of dt = 1e-7 s, no damping: grainlab's Cundall-Strack spring
+#                (kt = 2/7 of the Hertz tangent stiffness = 4/7 E* a) against LAMMPS's
+#                `tangential mindlin 4/7 E*` (k_t a, the same stiffness for every contact).
+# 3. Timing: the same pile and laws (grainlab: the benchmark's per-pair Brilliantov damping;
+#    LAMMPS: viscoelastic at the mean pair; mindlin tangential in both), `steps` steps at
+#    dt = 1e-7 s; grainlab on 1 and 2 threads, LAMMPS on 1 and `mpirun -np 2`, runs alternated
+#    (A B A B ..., `reps` each), the 1-minute load average recorded with every run. Contacts per
+#    particle count particle-particle contacts only (compute contact/atom ignores wall/gran).
 #
 #   scripts/bench/vs_lammps.sh [n=2000] [steps=2000] [reps=3] [grainlab=build/grainlab] [out=out/vs_lammps]
 #
