@@ -7,14 +7,19 @@
 set -euo pipefail
 cd "$(dirname "$0")"
 
-# Debian packages: compiler and build tools, the libraries grainlab links, and jq (tests read
-# report JSON with it).
+# Debian packages: compiler and build tools, the libraries grainlab links, jq (tests read
+# report JSON with it) and python3-vtk9 (tests open the VTK files with VTK's readers).
 packages=(build-essential cmake pkg-config liblua5.4-dev libreadline-dev libosmesa6-dev
-          libpng-dev libfreetype-dev fonts-dejavu-core libcmocka-dev jq libqhull-dev)
+          libpng-dev libfreetype-dev fonts-dejavu-core libcmocka-dev jq libqhull-dev
+          python3-vtk9)
 
 install_packages() {
     local missing=()
     for p in "${packages[@]}"; do
+        # ParaView's python3-paraview provides the same `vtk` module and conflicts with
+        # python3-vtk9: installing the latter would remove ParaView.
+        [ "$p" = python3-vtk9 ] && dpkg-query -W -f='${Status}' python3-paraview 2>/dev/null |
+            grep -q 'install ok installed' && continue
         dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed' || missing+=("$p")
     done
     [ ${#missing[@]} -eq 0 ] && return 0

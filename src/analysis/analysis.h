@@ -109,4 +109,19 @@ core_status analysis_rasterize(const analysis_mesh *m, const double *x, const do
                                const double *values, int nx, int ny, const double extent[4],
                                double *out, core_error *err);
 
+/* ---- output for other tools (analysis/vtk.c) ------------------------------------------------- */
+/* One cell array: ncells x ncomp values (ncomp 1, 3, or 9 for a 3 x 3 tensor row-major). */
+typedef struct analysis_vtk_field {
+    const char *name;
+    int ncomp;
+    const double *values;
+} analysis_vtk_field;
+
+/* The cells as a VTK XML unstructured grid of triangles (.vtu), written whole: np points (x, y;
+ * point data id, 1-based), the triangles tri (3 per cell, 0-based point indices) and the given
+ * cell arrays; field data TimeValue = time. */
+core_status analysis_vtk_cells(const char *path, size_t np, const double *x, const double *y,
+                               size_t ncells, const long *tri, size_t nfields,
+                               const analysis_vtk_field *fields, double time, core_error *err);
+
 #endif

@@ -336,6 +336,21 @@ size_t dem_boundary_edges(const dem_scene *s, const long **a, const long **b,
 /* The out-of-plane thickness given at creation (0 for spheres in the plane and in 3D). */
 double dem_thickness(const dem_scene *s);
 
+/* ---- output for other tools (dem/vtk.c) ------------------------------------------------------ */
+/* Total force on each particle at the last force evaluation (N; contacts, walls, gravity,
+ * external and boundary forces), component d < dim; zeros before the first evaluation. */
+const double *dem_forces(const dem_scene *s, int d);
+/* VTK XML unstructured grids (.vtu) for ParaView, written whole. Particles: one vertex cell per
+ * particle with point data id (1-based), radius, velocity, angular_velocity, force (3-vectors,
+ * z = 0 in 2D), mass, material (1-based), angle (2D with rotations). Contacts: a line per contact
+ * from i's centre to j's (its image across a periodic boundary) or to the contact point on a wall,
+ * cell data i, j (walls: minus the wall id), fn, ft, overlap, normal, force (on i),
+ * normal_force, tangential_force (0 for walls, which report the normal force only). Walls: each
+ * active wall's plane clipped to the box (a line in 2D, a polygon in 3D) with id, normal, force. */
+core_status dem_vtk_particles(const dem_scene *s, const char *path, core_error *err);
+core_status dem_vtk_contacts(dem_scene *s, const char *path, core_error *err);
+core_status dem_vtk_walls(const dem_scene *s, const char *path, core_error *err);
+
 /* ---- LAMMPS data and dump files (lammps.c) -------------------------------------------------- *
  * Data files in atom_style sphere (LIGGGHTS: granular): Atoms "id type diameter density x y z
  * [ix iy iz]", Velocities "id vx vy vz wx wy wz". The density column is the material's density

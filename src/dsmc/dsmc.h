@@ -212,4 +212,23 @@ core_status dsmc_measure_profile(const dsmc_scene *s, int axis, int nbins, doubl
 core_status dsmc_measure_histogram(const dsmc_scene *s, int what, int nbins, double lo,
                                    double hi, double *counts, double *outside, core_error *err);
 
+/* ---- checkpoints (src/dsmc/checkpoint.c) ---------------------------------------------------
+ * dsmc_save writes everything a bit-exact continuation needs into a grainlab checkpoint at path
+ * (core/checkpoint.h: written whole through a temporary file and a rename); version is the
+ * grainlab version recorded in its header. dsmc_load reads one into a new scene (*out), refusing
+ * a missing, truncated, corrupt, foreign (another engine's) or newer file with nothing allocated
+ * left behind. Running the loaded scene gives the same bits as continuing the saved one, with any
+ * number of threads. */
+core_status dsmc_save(const dsmc_scene *s, const char *path, const char *version, core_error *err);
+core_status dsmc_load(const char *path, dsmc_scene **out, core_error *err);
+
+/* ---- output for other tools (dsmc/vtk.c) ----------------------------------------------------- */
+/* VTK XML for ParaView, written whole. Particles (.vtu): one vertex per particle with point data
+ * id (the position in the current order, 1-based: particles are re-sorted by cell every step and
+ * carry no identity), radius, velocity (3-vector, z = 0 in 2D), mass, cell (1-based). Cells
+ * (.vti image over the box): cell data count, density, packing, velocity, temperature, a2, as
+ * dsmc_measure_fields. */
+core_status dsmc_vtk_particles(const dsmc_scene *s, const char *path, core_error *err);
+core_status dsmc_vtk_cells(const dsmc_scene *s, const char *path, core_error *err);
+
 #endif

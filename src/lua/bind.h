@@ -200,4 +200,15 @@ int bind_check_option(lua_State *L, int arg, const char *def, const char *const 
 /* The name of `names` closest to s (a unique prefix, or within a few edits), or NULL. */
 const char *bind_closest_name(const char *s, const char *const names[]);
 
+/* The kernel scene of the mpm.scene / dsmc.scene at idx, or a Lua error naming `call`; and a new
+ * scene userdata pushed closed (NULL), whose slot the caller fills (lua_mpm.c, lua_dsmc.c). */
+struct mpm_scene *bind_check_mpm_scene(lua_State *L, int idx, const char *call);
+struct mpm_scene **bind_new_mpm_scene(lua_State *L);
+struct dsmc_scene *bind_check_dsmc_scene(lua_State *L, int idx, const char *call);
+struct dsmc_scene **bind_new_dsmc_scene(lua_State *L);
+/* m:save, mpm.load, s:save, dsmc.load (lua_checkpoint_mpm.c); after bind_open_mpm and _dsmc. */
+void bind_open_checkpoint_mpm(lua_State *L);
+/* Adds write_vtk to the scene and mesh types and grainlab.vtk (lua_vtk.c); after the engines. */
+void bind_open_vtk(lua_State *L);
+
 #endif

@@ -891,3 +891,25 @@ void bind_open_dsmc(lua_State *L)
              "Bird): stochastic collisions within cells, 2D and 3D.");
     lua_setglobal(L, "dsmc");
 }
+
+/* ---- for other bindings (lua_checkpoint_mpm.c) --------------------------------------------- */
+dsmc_scene *bind_check_dsmc_scene(lua_State *L, int idx, const char *call)
+{
+    lscene *u = luaL_testudata(L, idx, SCENE);
+    if (!u) {
+        char got[64];
+        bind_describe(L, idx, got, sizeof got);
+        luaL_error(L, "bad argument #%d to '%s' (dsmc.scene expected, got %s)", idx, call, got);
+    }
+    if (!u->s)
+        luaL_error(L, "%s: the dsmc.scene was closed", call);
+    return u->s;
+}
+
+dsmc_scene **bind_new_dsmc_scene(lua_State *L)
+{
+    lscene *u = lua_newuserdatauv(L, sizeof *u, 0);
+    u->s = NULL;
+    luaL_setmetatable(L, SCENE);
+    return &u->s;
+}

@@ -1030,3 +1030,28 @@ void bind_open_mpm(lua_State *L)
              "Material points: deformable grains on a background grid (Bardenhagen et al. 1998).");
     lua_setglobal(L, "mpm");
 }
+
+/* ---- for other bindings (lua_checkpoint_mpm.c) --------------------------------------------- */
+mpm_scene *bind_check_mpm_scene(lua_State *L, int idx, const char *call)
+{
+    lscene *u = luaL_testudata(L, idx, SCENE);
+    if (!u) {
+        char got[64];
+        bind_describe(L, idx, got, sizeof got);
+        luaL_error(L, "bad argument #%d to '%s' (mpm.scene expected, got %s)", idx, call, got);
+    }
+    if (!u->s)
+        luaL_error(L, "%s: the mpm.scene was closed", call);
+    return u->s;
+}
+
+mpm_scene **bind_new_mpm_scene(lua_State *L)
+{
+    lscene *u = lua_newuserdatauv(L, sizeof *u, 1);
+    u->s = NULL;
+    luaL_setmetatable(L, SCENE);
+    lua_newtable(L); /* mpm.material -> material index (none yet: loaded materials have no
+                      * Lua object, and a material used later is added anew) */
+    lua_setiuservalue(L, -2, 1);
+    return &u->s;
+}

@@ -312,4 +312,24 @@ double mpm_shear_strain(const mpm_scene *s);
 /* Total linear momentum and angular momentum about the origin. */
 void mpm_measure_momentum(const mpm_scene *s, double p[2], double *lz);
 
+/* ---- checkpoints (src/mpm/checkpoint.c) ----------------------------------------------------
+ * mpm_save writes everything a bit-exact continuation needs into a grainlab checkpoint at path
+ * (core/checkpoint.h: written whole through a temporary file and a rename); version is the
+ * grainlab version recorded in its header. mpm_load reads one into a new scene (*out), refusing a
+ * missing, truncated, corrupt, foreign (another engine's) or newer file with nothing allocated
+ * left behind. Running the loaded scene gives the same bits as continuing the saved one. */
+core_status mpm_save(const mpm_scene *s, const char *path, const char *version, core_error *err);
+core_status mpm_load(const char *path, mpm_scene **out, core_error *err);
+
+/* ---- output for other tools (mpm/vtk.c) ------------------------------------------------------ */
+/* VTK XML for ParaView, written whole. Points (.vtu): one vertex per material point with point
+ * data id (1-based), grain, material (1-based), mass, volume (V0 det F), velocity, displacement
+ * (3-vectors, z = 0), stress and deformation_gradient (3 x 3 row-major, plane strain: the zz
+ * stress, F_zz = 1), pressure (-(xx + yy)/2, as mpm_field), eps_p. Grid (.vti, nodes as points):
+ * point data mass and velocity from a linear-shape transfer of the current points, cell data the
+ * mpm_field kinds named as the Lua m:field names them (vx, vy, speed, ux, uy, displacement, sxx,
+ * syy, sxy, pressure, psd, eps_p, grain, mass). */
+core_status mpm_vtk_points(const mpm_scene *s, const char *path, core_error *err);
+core_status mpm_vtk_grid(const mpm_scene *s, const char *path, core_error *err);
+
 #endif

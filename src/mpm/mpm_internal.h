@@ -112,4 +112,9 @@ struct mpm_scene {
  * "friction"; no allocation happens inside the step loop). */
 core_status mpm_contact_reserve(mpm_scene *s, core_error *err);
 
+/* For mpm_add_plane and checkpoints (src/mpm/checkpoint.c): grows the point arrays to n points;
+ * appends plane p as given (n already unit and into the wall) and marks its nodes. */
+core_status mpm_reserve_points(mpm_scene *s, size_t n, core_error *err);
+core_status mpm_install_plane(mpm_scene *s, const mpm_plane *p, core_error *err);
+
 #endif

@@ -721,24 +721,13 @@ core_status mpm_add_plane(mpm_scene *s, const mpm_plane_def *d, core_error *err)
     for (int a = 0; a < 2; a++)
         if (!isfinite(d->point[a]) || !isfinite(d->velocity[a]))
             return core_fail(err, CORE_ERR_ARG, "the plane's point and velocity must be finite");
-    const int k = s->nplanes++;
-    mpm_plane *pl = &s->planes[k];
-    pl->kind = d->kind;
-    pl->mu = d->mu;
+    mpm_plane pl = {.kind = d->kind, .mu = d->mu};
     for (int a = 0; a < 2; a++) {
-        pl->n[a] = -d->normal[a] / len;
-        pl->v[a] = d->velocity[a];
-        pl->point[a] = d->point[a];
+        pl.n[a] = -d->normal[a] / len;
+        pl.v[a] = d->velocity[a];
+        pl.point[a] = d->point[a];
     }
-    for (int j = 0; j < s->nny; j++)
-        for (int i = 0; i < s->nnx; i++) {
-            double x = s->def.origin[0] + (i - s->gl[0]) * s->hx;
-            double y = s->def.origin[1] + (j - s->gl[1]) * s->hy;
-            /* inside the body: (x - point) . normal_out <= 0, i.e. . n >= 0 */
-            if ((x - pl->point[0]) * pl->n[0] + (y - pl->point[1]) * pl->n[1] >= 0)
-                s->nwall[(size_t)j * s->nnx + i] |= (unsigned char)(1u << k);
-        }
-    return plane_reference(s, k, err);
+    return mpm_install_plane(s, &pl, err);
 }
 
 core_status mpm_hydrostatic(mpm_scene *s, size_t grain, core_error *err)
@@ -830,4 +819,28 @@ double mpm_grain_overlap(const mpm_scene *s, size_t id, size_t *other)
         }
     }
     return best;
+}
+
+/* ---- for checkpoints (src/mpm/checkpoint.c) ------------------------------------------------ */
+core_status mpm_reserve_points(mpm_scene *s, size_t n, core_error *err)
+{
+    return reserve_points(s, n, err);
+}
+
+core_status mpm_install_plane(mpm_scene *s, const mpm_plane *p, core_error *err)
+{
+    if (s->nplanes >= 4 + MPM_MAX_PLANES)
+        return core_fail(err, CORE_ERR_ARG, "at most %d planes", MPM_MAX_PLANES);
+    const int k = s->nplanes++;
+    mpm_plane *pl = &s->planes[k];
+    *pl = *p;
+    for (int j = 0; j < s->nny; j++)
+        for (int i = 0; i < s->nnx; i++) {
+            double x = s->def.origin[0] + (i - s->gl[0]) * s->hx;
+            double y = s->def.origin[1] + (j - s->gl[1]) * s->hy;
+            /* inside the body: (x - point) . normal_out <= 0, i.e. . n >= 0 */
+            if ((x - pl->point[0]) * pl->n[0] + (y - pl->point[1]) * pl->n[1] >= 0)
+                s->nwall[(size_t)j * s->nnx + i] |= (unsigned char)(1u << k);
+        }
+    return plane_reference(s, k, err);
 }

@@ -120,6 +120,14 @@ local calls = {
   },
 }
 
+-- grainlab.vtk.series (lua_vtk.c): the options are checked at creation, nothing is written.
+calls["grainlab.vtk.series"] = {
+  args = function() return { "r.pvd", { contacts = true, walls = true, grid = true, cells = true } } end,
+  opts = 2, opts_optional = true, pos = { {} },
+  accept = { contacts = { "nil", "boolean" }, walls = { "nil", "boolean" }, grid = { "nil", "boolean" },
+             cells = { "nil", "boolean" } },
+}
+
 -- Not fuzzed here, each with its reason (printed).
 local skip = {
   ["grainlab.report"] = "lua/grainlab/report.lua belongs to the report helper (its entry checks are theirs)",
@@ -132,7 +140,7 @@ for k, v in pairs(grainlab) do
   if type(v) == "function" then grainlab_fns[k] = v end
 end
 local ok, err = pcall(fuzz.run, {
-  modules = { grainlab = grainlab_fns, ["grainlab.pack"] = grainlab.pack },
+  modules = { grainlab = grainlab_fns, ["grainlab.pack"] = grainlab.pack, ["grainlab.vtk"] = grainlab.vtk },
   types = { ["grainlab.rng"] = grainlab.rng{}, ["grainlab.progress"] = grainlab.progress{ total = 1 } },
   calls = calls, skip = skip })
 os.remove(tmp)

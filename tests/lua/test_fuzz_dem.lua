@@ -155,6 +155,15 @@ local calls = {
 
 -- Registered on dem.scene by lua_analysis.c, whose validation fixes come with the delaunay
 -- helper's branch: fuzzed once that is merged.
+-- VTK output (lua_vtk.c): the files go to a scratch directory.
+local vtkdir = os.tmpname()
+os.remove(vtkdir)
+os.execute("mkdir -p '" .. vtkdir .. "'")
+calls["dem.scene:write_vtk"] = {
+  setup = scene2, self = self, opts = 2, opts_optional = true, pos = { {} },
+  args = function() return { vtkdir .. "/f.vtu", { contacts = true, walls = false } } end,
+  accept = { contacts = BOOL, walls = BOOL },
+}
 local pending = "boundary-condition methods of lua_analysis.c (pending i12-delaunay)"
 local skip = { ["dem.scene:boundary"] = pending, ["dem.scene:boundary_edges"] = pending,
                ["dem.scene:boundary_info"] = pending, ["dem.scene:spin"] = pending,
@@ -163,6 +172,7 @@ for _, k in ipairs{ "dem.read_lammps_data", "dem.scene:read_lammps_data", "dem.s
                     "dem.scene:write_lammps_dump" } do skip[k] = "fuzzed by test_lammps_fuzz.lua" end
 
 fuzz.run{ modules = { dem = dem }, types = { ["dem.scene"] = scene2() }, calls = calls, skip = skip }
+os.execute("rm -rf '" .. vtkdir .. "'")
 os.execute("rm -rf '" .. tmp .. "'")
 
 -- Absurd sizes are refused with the limit in the message (issue 12).

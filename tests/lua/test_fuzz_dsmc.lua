@@ -18,7 +18,18 @@ local function self(ctx) return ctx end
 local OPT = { "nil" }
 local BOOL = { "nil", "boolean" }
 
+-- A checkpoint file for the save and load entries (removed at the end).
+local ckpt = os.tmpname()
+
 local calls = {
+  ["dsmc.scene:save"] = {
+    setup = scene, self = self, args = function() return { ckpt } end,
+    pos = { { "string" } }, strings = { ckpt },
+  },
+  ["dsmc.load"] = {
+    setup = function() scene():save(ckpt) end, args = function() return { ckpt } end,
+    pos = { { "string" } }, strings = { ckpt },
+  },
   ["dsmc.scene"] = {
     { args = function() return { { dim = 2, box = { { 0, 0 }, { 1, 1 } }, cells = { 4, 4 },
                                    periodic = { true, false }, gravity = { 0, -1 }, restitution = 0.9,
@@ -86,7 +97,16 @@ local calls = {
   ["dsmc.scene:info"] = { setup = scene, self = self },
 }
 
+-- VTK output (lua_vtk.c): the files go to a scratch directory.
+local vtkdir = os.tmpname()
+os.remove(vtkdir)
+os.execute("mkdir -p '" .. vtkdir .. "'")
+calls["dsmc.scene:write_vtk"] = {
+  setup = scene, self = self, opts = 2, opts_optional = true, pos = { {} },
+  args = function() return { vtkdir .. "/f.vtu", { cells = true } } end, accept = { cells = BOOL },
+}
 fuzz.run{ modules = { dsmc = dsmc }, types = { ["dsmc.scene"] = scene() }, calls = calls }
+os.execute("rm -rf '" .. vtkdir .. "'")
 
 -- Absurd sizes are refused with the limit in the message.
 check.errors(function() dsmc.scene{ size = { 1, 1 }, cells = { 1000000, 1000000 }, radius = 1e-9 } end,
@@ -99,4 +119,5 @@ check.errors(function() scene():fill{ n = 1000000, temperature = 1 } end,
 check.errors(function()
     dsmc.scene{ size = { 1, 1 }, cells = { 4, 4 }, radius = 1e-9 }:fill{ n = 1e12, temperature = 1 }
   end, "above the limit of 8.59e+09 bytes (8 GiB) (field 'n')", "a trillion particles in a large box")
+os.remove(ckpt)
 check.done()

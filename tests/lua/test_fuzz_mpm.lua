@@ -14,7 +14,18 @@ local function self(ctx) return ctx end
 local OPT = { "nil" }
 local BOOL = { "nil", "boolean" }
 
+-- A checkpoint file for the save and load entries (removed at the end).
+local ckpt = os.tmpname()
+
 local calls = {
+  ["mpm.scene:save"] = {
+    setup = scene, self = self, args = function() return { ckpt } end,
+    pos = { { "string" } }, strings = { ckpt },
+  },
+  ["mpm.load"] = {
+    setup = function() scene():save(ckpt) end, args = function() return { ckpt } end,
+    pos = { { "string" } }, strings = { ckpt },
+  },
   ["mpm.scene"] = {
     args = function() return { { cells = { 8, 8 }, size = { 1, 1 }, origin = { 0, 0 },
                                  periodic = { false, false }, gravity = { 0, -9.81 }, walls = "slip",
@@ -103,7 +114,16 @@ local calls = {
   },
 }
 
+-- VTK output (lua_vtk.c): the files go to a scratch directory.
+local vtkdir = os.tmpname()
+os.remove(vtkdir)
+os.execute("mkdir -p '" .. vtkdir .. "'")
+calls["mpm.scene:write_vtk"] = {
+  setup = scene, self = self, opts = 2, opts_optional = true, pos = { {} },
+  args = function() return { vtkdir .. "/f.vtu", { grid = true } } end, accept = { grid = BOOL },
+}
 fuzz.run{ modules = { mpm = mpm }, types = { ["mpm.scene"] = scene() }, calls = calls }
+os.execute("rm -rf '" .. vtkdir .. "'")
 
 -- An mpm.material is read-only: an assignment is refused, naming the field.
 check.errors(function() mat.density = -5 end, "an mpm.material is read-only: field 'density' cannot be set",
@@ -117,4 +137,5 @@ check.errors(function() mpm.scene{ cells = { 8, 8 }, size = { 1e300, 1 } } end,
   "bad field 'size' in argument #1 to 'scene' (array of 2 positive numbers of at most 1e+100 expected", "size 1e300")
 check.errors(function() scene():run{ time = 1e99 } end,
   "bad field 'time' in argument #1 to 'run' (time of at most 1e15 steps of dt", "time of 1e99 s")
+os.remove(ckpt)
 check.done()
