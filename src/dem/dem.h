@@ -426,9 +426,4 @@ core_status dem_save(const dem_scene *s, const char *path, const char *version, 
 /* A new scene from a file; on any error nothing is returned (*out = NULL). */
 core_status dem_load(const char *path, dem_scene **out, core_error *err);
 
-/* Total force (N) on each particle along axis d at the last force evaluation: contacts, walls,
- * gravity, external forces and drag (what the integrator kicks with); for comparing one force
- * evaluation with another code. */
-const double *dem_forces(const dem_scene *s, int d);
-
 #endif

@@ -694,5 +694,3 @@ core_status dem_quasistatic(const dem_scene *s, double pressure, double strain_r
     }
     return CORE_OK;
 }
-
-const double *dem_forces(const dem_scene *s, int d) { return s->f[d]; }
