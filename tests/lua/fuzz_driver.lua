@@ -20,6 +20,8 @@
 --     pos = { [i] = { "nil", ... } },              -- positional args to fuzz and what they take
 --     strings = { [i or field] = "..." },          -- the "string" class there (a file path)
 --     slow = { field = { class = "why" } },        -- an accepted class printed, not run (cost)
+--     nested = { mbc = { "K", ... } },            -- sub-tables args[opts].mbc: fields fuzzed
+--                                                  --   in place, declared in accept as "mbc.K"
 --     no_opts = true,                              -- a variant without the options table
 --     todo = { field = "why" },                    -- printed, not fuzzed (a fix pending elsewhere)
 --     name = "add_disk" }                          -- the name errors use (default: the key's)
@@ -141,9 +143,13 @@ local function fuzz_entry(key, e, fn, doc)
   for k in pairs(accept) do
     local known = false
     for _, f in ipairs(fields or {}) do known = known or f == k end
+    local parent, sf = k:match("^([%w_]+)%.([%w_]+)$")
+    for _, f in ipairs(parent and e.nested and e.nested[parent] or {}) do known = known or f == sf end
     if not known then fail(key, "declared field '" .. k .. "' is not a field of the binding") end
   end
-  for _, f in ipairs(fields or {}) do
+  -- One field (or a nested field "parent.f" of a sub-table the entry lists in `nested`):
+  -- every class, at the place get/set reach in the arguments.
+  local function fuzz_field(f, get, set)
     if e.todo and e.todo[f] then
       print(key .. ": field '" .. f .. "' not fuzzed yet: " .. e.todo[f])
     elseif not accept[f] then
@@ -151,7 +157,7 @@ local function fuzz_entry(key, e, fn, doc)
     else
       local ok_set = set_of(accept[f])
       local probe = e.args and e.args(e.setup and e.setup() or {}) or {}
-      local base = probe[e.opts] and probe[e.opts][f]
+      local base = get(probe)
       local classes = {}
       for _, c in ipairs(M.scalar) do classes[#classes + 1] = c end
       for _, c in ipairs(derived(base)) do classes[#classes + 1] = c end
@@ -162,10 +168,26 @@ local function fuzz_entry(key, e, fn, doc)
         if slow then
           print(key .. ": field '" .. f .. "' = " .. cname .. " not run (accepted, but slow): " .. slow)
         else case(key, e, fn, "field '" .. f .. "' = " .. cname .. " (" .. describe(v) .. ")",
-          function(args) args[e.opts][f] = copy(v) end, ok_set[cname],
+          function(args) set(args, copy(v)) end, ok_set[cname],
           { "'" .. f .. "'", "'" .. f .. ".", "'" .. f .. "[" })
         end
       end
+    end
+  end
+  for _, f in ipairs(fields or {}) do
+    fuzz_field(f, function(a) return a[e.opts] and a[e.opts][f] end,
+      function(a, v) a[e.opts][f] = v end)
+  end
+  -- nested = { parent = { fields } }: the sub-table args[opts][parent] must be in the base call;
+  -- its fields are declared in accept as "parent.field".
+  for parent, subs in pairs(e.nested or {}) do
+    local known = false
+    for _, f in ipairs(fields or {}) do known = known or f == parent end
+    if not known then fail(key, "nested table '" .. parent .. "' is not a field of the binding") end
+    for _, sf in ipairs(subs) do
+      fuzz_field(parent .. "." .. sf,
+        function(a) return a[e.opts] and a[e.opts][parent] and a[e.opts][parent][sf] end,
+        function(a, v) a[e.opts][parent][sf] = v end)
     end
   end
   -- The options table itself and positional arguments.
