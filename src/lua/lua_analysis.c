@@ -989,11 +989,11 @@ static void push_boundary_info(lua_State *L, dem_scene *s)
 }
 
 static const char *const MODES[] = {"delaunay", "edges", "none", NULL};
-static const char *const BOUNDARY_FIELDS[] = {"mode",  "pressure", "depth",  "every",
-                                              "alpha", "sides",    "ids",    "edges",
-                                              "closed", "mbc",     "band",   NULL};
-static const char *const MBC_FIELDS[] = {"strain_rate", "gradient", "mask", "K", "kappa", "rate",
-                                         "dt",          "tau",      NULL};
+static const char *const BOUNDARY_FIELDS[] = {"mode",   "pressure", "depth", "every",
+                                              "alpha",  "sides",    "ids",   "edges",
+                                              "closed", "mbc",      "band",  NULL};
+static const char *const MBC_FIELDS[] = {"strain_rate", "gradient", "mask", "K", "kappa",
+                                         "rate",        "dt",       "tau",  NULL};
 static const char *const SIDES[] = {"all", "lateral", NULL};
 
 /* s:boundary{ mode =, pressure =, depth =, every =, alpha =, sides =, ids =, edges =, closed =,
@@ -1051,12 +1051,16 @@ static int l_boundary(lua_State *L)
         if (has_e && has_g) {
             char got[64];
             bind_describe(L, -1, got, sizeof got);
-            return field_fail(L, 2, call, "mbc.gradient", "nil (exactly one of strain_rate and gradient; 'mbc.strain_rate' is given)", got);
+            return field_fail(
+                L, 2, call, "mbc.gradient",
+                "nil (exactly one of strain_rate and gradient; 'mbc.strain_rate' is given)", got);
         }
         lua_pop(L, 2);
         if (!has_e && !has_g)
-            return field_fail(L, 2, call, "mbc.strain_rate",
-                              "2x2 matrix (exactly one of strain_rate and gradient; nor is 'mbc.gradient' given)", "nil");
+            return field_fail(
+                L, 2, call, "mbc.strain_rate",
+                "2x2 matrix (exactly one of strain_rate and gradient; nor is 'mbc.gradient' given)",
+                "nil");
         def.gradient = has_g;
         read_matrix(L, mbc, has_g ? "gradient" : "strain_rate", 2, call,
                     has_g ? "mbc.gradient" : "mbc.strain_rate", def.target);
@@ -1138,8 +1142,7 @@ static int l_boundary(lua_State *L)
         dem_boundary_info_get(s, &bi, &err);
         if (!bi.closed && mode == 1)
             return field_fail(L, 2, call, "closed",
-                              "true (the minimal boundary conditions need a closed loop)",
-                              "false");
+                              "true (the minimal boundary conditions need a closed loop)", "false");
         if (!bi.closed)
             return luaL_error(L, "%s: the minimal boundary conditions need a closed boundary "
                                  "loop (mode 'delaunay', or edges with closed = true)", call);
@@ -1322,12 +1325,10 @@ void bind_open_analysis(lua_State *L)
     bind_new_type(L, MESH, methods, meta,
                   "A Delaunay mesh of particle centres from analysis.delaunay; it keeps the "
                   "positions it was built on as the reference configuration.");
-    static const bind_fields mesh_fields[] = {{"cells", NULL, STATE_FIELDS},
-                                              {"strain", NULL, STATE_FIELDS},
-                                              {"strain_rate", NULL, STATE_FIELDS},
-                                              {"stress", NULL, STRESS_FIELDS},
-                                              {"raster", NULL, RASTER_FIELDS},
-                                              {NULL, NULL, NULL}};
+    static const bind_fields mesh_fields[] = {
+        {"cells", NULL, STATE_FIELDS},       {"strain", NULL, STATE_FIELDS},
+        {"strain_rate", NULL, STATE_FIELDS}, {"stress", NULL, STRESS_FIELDS},
+        {"raster", NULL, RASTER_FIELDS},     {NULL, NULL, NULL}};
     bind_type_fields(L, MESH, mesh_fields);
     static const bind_fn fns[] = {
         {"delaunay", l_delaunay,
