@@ -1378,7 +1378,9 @@ void bind_open_analysis(lua_State *L)
          "tau > 0 (default 1000 dt when dt is given, else 0) adds the integral of the error over "
          "tau, so that the capped K does not let the strain lag (a proportional-integral "
          "penalty; tau = 0 is the paper's rate penalty alone). A run stops with an error when K is too stiff for its dt. mode none removes the boundary, "
-         "springs and ties. Returns s:boundary_info() plus K."},
+         "springs and ties. A field of another mode (edges in mode delaunay, ids in mode edges, "
+         "anything but mode in mode none) is refused, not ignored. Returns s:boundary_info() "
+         "plus K."},
         {"boundary_info", l_boundary_info, "s:boundary_info()",
          "edges, loaded, nodes, closed, area (inside the loop), gradient and strain_rate (coarse, "
          "Eq. 3.2, from the velocities now), penalty_sum {fx, fy} and penalty_max (N, last "
