@@ -20,6 +20,10 @@
 --                                        [collapse=0|0.5] [prep_threads=1] [verbose=1]
 --   valgrind --tool=callgrind --instr-atstart=no grainlab scripts/bench/dem_dense.lua \
 --       steps=200 threads=1 callgrind=true   (instructions per particle-step: total / (n steps))
+--   grainlab scripts/bench/dem_dense.lua n=2000 export=out/pile.data
+--       writes the prepared pile as a LAMMPS data file (atom type 1 = quartz, velocities included)
+--       and as a grainlab checkpoint PATH.ckpt (the same state with its walls: a settled pile
+--       touches its walls, which add_wall would refuse on a re-read), and stops before timing: scripts/bench/vs_lammps.sh runs that same pile in both codes.
 -- Metrics: particle_steps_per_s (per thread count), wall_s, contacts_per_particle.
 local n = params.n or 20000
 local steps = params.steps or 20000
@@ -53,6 +57,15 @@ io.stderr:write(string.format(
   "v_rms %.2g m/s (v_max %.2g), z %.4f; after %d drag-free steps at dt %g: v_rms %.2g m/s, z %.4f\n",
   n, t_prep, t_deposit, settle.steps - check_steps, settle.dt, settle.drag, settle.v_rms_settled,
   settle.v_max_settled, settle.z_settled, check_steps, dt, settle.v_rms, z.z))
+
+if params.export then
+  s:write_lammps_data(params.export, { types = { [1] = quartz },
+                                       title = string.format("dem_dense.lua n=%d, settled", n) })
+  s:save(params.export .. ".ckpt")
+  io.stderr:write(string.format("wrote %s (%d disks, z %.4f, damping time of pair 1-2 %.4g s)\n",
+                                params.export, n, z.z, T))
+  return
+end
 
 -- callgrind=true: run under `valgrind --tool=callgrind --instr-atstart=no`; instrumentation is
 -- switched on for the timed steps only, so the profile's total / (n * steps) is the instruction

@@ -5,6 +5,7 @@
 #include "core/checkpoint.h"
 
 #include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -587,6 +588,34 @@ core_status ckpt_get_u32s(ckpt_section *s, uint32_t *out, size_t n, core_error *
 core_status ckpt_get_u64s(ckpt_section *s, uint64_t *out, size_t n, core_error *err)
 {
     return get_array(s, out, n, sizeof *out, "uint64 values", err);
+}
+
+core_status ckpt_get_int_in(ckpt_section *s, long lo, long hi, const char *what, long *out,
+                            core_error *err)
+{
+    int64_t v = 0;
+    *out = 0; /* defined on every path */
+    core_status st = ckpt_get_i64(s, &v, err);
+    if (st)
+        return st;
+    if (v < lo || v > hi)
+        return core_fail(err, CORE_ERR_ARG,
+                         "'%s' is a corrupt %s checkpoint: %s = %lld is outside [%ld, %ld]",
+                         s->r->path, s->r->engine, what, (long long)v, lo, hi);
+    *out = (long)v;
+    return CORE_OK;
+}
+
+core_status ckpt_get_finite(ckpt_section *s, const char *what, double *out, core_error *err)
+{
+    *out = 0;
+    core_status st = ckpt_get_f64(s, out, err);
+    if (st)
+        return st;
+    if (!isfinite(*out))
+        return core_fail(err, CORE_ERR_ARG, "'%s' is a corrupt %s checkpoint: %s is not finite",
+                         s->r->path, s->r->engine, what);
+    return CORE_OK;
 }
 
 core_status ckpt_section_done(ckpt_section *s, core_error *err)

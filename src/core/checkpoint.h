@@ -111,6 +111,12 @@ core_status ckpt_get_u32s(ckpt_section *s, uint32_t *out, size_t n, core_error *
 core_status ckpt_get_u64s(ckpt_section *s, uint64_t *out, size_t n, core_error *err);
 /* The count of the array that follows, without consuming it (to size a buffer); at most max. */
 core_status ckpt_peek_count(ckpt_section *s, size_t max, size_t *n, core_error *err);
+/* An int64 in [lo, hi] into *out, or "'PATH' is a corrupt ENGINE checkpoint: WHAT = V is outside
+ * [lo, hi]"; a finite double, or "... WHAT is not finite". Values a checksum cannot vouch for
+ * (a forged file) never reach an engine. */
+core_status ckpt_get_int_in(ckpt_section *s, long lo, long hi, const char *what, long *out,
+                            core_error *err);
+core_status ckpt_get_finite(ckpt_section *s, const char *what, double *out, core_error *err);
 /* The section must have been read to its end (a size mismatch is corruption). */
 core_status ckpt_section_done(ckpt_section *s, core_error *err);
 

@@ -827,6 +827,9 @@ static int l_particles(lua_State *L)
             bind_push_array(L, dem_angular_velocities(s, d), n, ws[d]);
     bind_push_array(L, dem_radii(s), n, "radius");
     bind_push_array(L, dem_masses(s), n, "mass");
+    static const char *const fs[3] = {"fx", "fy", "fz"};
+    for (int d = 0; d < D && dem_forces(s, d); d++) /* the last force evaluation's */
+        bind_push_array(L, dem_forces(s, d), n, fs[d]);
     lua_pushinteger(L, (lua_Integer)n);
     lua_setfield(L, -2, "count");
     return 1;
@@ -1094,7 +1097,8 @@ void bind_open_dem(lua_State *L)
          "set_reference, minus opts.affine (displacement gradient) about opts.center."},
         {"particles", l_particles, "s:particles()",
          "Arrays x, y (z), vx, vy (vz), omega (2D) or wx, wy, wz (3D), angle (2D: the integrated "
-         "rotation in rad), radius and mass; count."},
+         "rotation in rad), radius and mass; fx, fy (fz): the total force (N) of the last force "
+         "evaluation (zero before any run); count."},
         {"set_reference", l_set_reference, "s:set_reference()",
          "Remembers the current positions for displacement measurements."},
         {"scale_mass", l_scale_mass, "s:scale_mass(factor)",

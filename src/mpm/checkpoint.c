@@ -178,29 +178,12 @@ typedef struct reader {
 
 static core_status get_int(reader *rd, long lo, long hi, const char *what, long *out)
 {
-    int64_t v = 0;
-    *out = 0; /* defined on every path */
-    core_status st = ckpt_get_i64(&rd->sec, &v, rd->err);
-    if (st)
-        return st;
-    if (v < lo || v > hi)
-        return core_fail(rd->err, CORE_ERR_ARG,
-                         "'%s' is a corrupt mpm checkpoint: %s = %lld is outside [%ld, %ld]",
-                         rd->path, what, (long long)v, lo, hi);
-    *out = (long)v;
-    return CORE_OK;
+    return ckpt_get_int_in(&rd->sec, lo, hi, what, out, rd->err);
 }
 
 static core_status get_num(reader *rd, const char *what, double *out)
 {
-    *out = 0;
-    core_status st = ckpt_get_f64(&rd->sec, out, rd->err);
-    if (st)
-        return st;
-    if (!isfinite(*out))
-        return core_fail(rd->err, CORE_ERR_ARG,
-                         "'%s' is a corrupt mpm checkpoint: %s is not finite", rd->path, what);
-    return CORE_OK;
+    return ckpt_get_finite(&rd->sec, what, out, rd->err);
 }
 
 static core_status corrupt(const reader *rd, const char *what)
