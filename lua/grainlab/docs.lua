@@ -94,7 +94,7 @@ document(grainlab.biax, "grainlab.biax.", {
 })
 
 local recorder = require("grainlab.recorder")
-grainlab.doc(grainlab.recorder, { name = "grainlab.recorder",
+grainlab.doc(grainlab.recorder, { name = "grainlab.recorder", fields = recorder.fields,
   usage = "grainlab.recorder{ file = 'out/x.csv', columns = { { 't', fn }, ... } | { name = fn, ... }, order = { names }, units = { name = 'unit' }, flush = 10 }",
   doc = wrap("A time series: each sample is one row, one number per column. A column is { name, fn } " ..
     "(fn(s) returns a number; the row comes from rec:sample(s), or rec(s) as on_step) or a bare name " ..

@@ -53,7 +53,7 @@ local function read_columns(t)
   local out = {}
   if #cols > 0 then -- an array: { "name" } (filled by rec:add) or { "name", fn }
     if t.order ~= nil then
-      bad_field("recorder", "order", "nil (the columns array already gives the order)", t.order, 3)
+      bad_field("recorder", "order", "nil (the 'columns' array already gives the order)", t.order, 3)
     end
     for k in pairs(cols) do
       if math.type(k) ~= "integer" or k < 1 or k > #cols then
@@ -80,12 +80,12 @@ local function read_columns(t)
   else -- a map name -> fn, in the order `order` gives
     if type(t.order) ~= "table" then
       bad_field("recorder", "order",
-                "array of the column names (columns given by name have no order of their own)", t.order, 3)
+                "array of the column names (the 'columns' given by name have no order of their own)", t.order, 3)
     end
     local seen = {}
     for i, name in ipairs(t.order) do
       if cols[name] == nil then
-        bad_field("recorder", "order[" .. i .. "]", "name of a column", name, 3)
+        bad_field("recorder", "order[" .. i .. "]", "name of one of the 'columns'", name, 3)
       end
       seen[name] = true
       out[i] = { name = name, fn = cols[name] }
@@ -102,7 +102,10 @@ local function read_columns(t)
   end
   local names = {}
   for i, c in ipairs(out) do
-    if names[c.name] then bad_field("recorder", "columns", "distinct column names", c.name, 3) end
+    -- in the map form a name can only repeat in `order`
+    if names[c.name] then
+      bad_field("recorder", #cols > 0 and "columns" or "order", "distinct column names", c.name, 3)
+    end
     names[c.name] = i
   end
   return out, names
@@ -131,7 +134,7 @@ local function new(t)
   local units = t.units or {}
   if type(units) ~= "table" then bad_field("recorder", "units", "table name -> unit", units, 2) end
   for name, u in pairs(units) do
-    if not index[name] then bad_field("recorder", "units", "names of columns", name, 2) end
+    if not index[name] then bad_field("recorder", "units", "names of the 'columns'", name, 2) end
     if not clean_text(u) then
       bad_field("recorder", "units." .. name, "unit text without , \" or a line break", u, 2)
     end
@@ -362,4 +365,9 @@ MT.__gc = finish
 -- tests/lua/test_help_all.lua find its methods the way they find dem.scene's.
 debug.getregistry()["grainlab.recorder"] = MT
 
-return { new = new, methods = M, type = MT }
+-- The fields of grainlab.recorder{...} (for help and the generated test, test_fuzz_core.lua).
+local fields = {}
+for k in pairs(FIELDS) do fields[#fields + 1] = k end
+table.sort(fields)
+
+return { new = new, methods = M, type = MT, fields = fields }

@@ -216,7 +216,7 @@ end
 
 M.report = report
 grainlab.doc(report, {
-  name = "grainlab.report",
+  name = "grainlab.report", fields = { "checks", "metrics", "params", "scenario" },
   usage = "grainlab.report{ scenario = 'name', params = {…}, metrics = {…}, checks = {{ name =, value =, limit =, op = '<=' }, …} }",
   doc = [[Reports a scenario's figures: prints a readable table and, with --report FILE.json or
 GRAINLAB_REPORT=FILE, writes them as JSON (written whole; keys sorted):

@@ -194,6 +194,10 @@ static void set_tensor_arrays(lua_State *L, const double *t, size_t n, const cha
 
 /* ---- analysis.delaunay ------------------------------------------------------------------------ */
 static const char *const DELAUNAY_FIELDS[] = {"alpha", "ids", NULL};
+/* A state table {x =, y =, vx =, vy =} (mesh:cells, strain, strain_rate, raster's state). */
+static const char *const STATE_FIELDS[] = {"x", "y", "vx", "vy", NULL};
+static const char *const STRESS_FIELDS[] = {"depth", NULL};
+static const char *const RASTER_FIELDS[] = {"nx", "ny", "extent", "state", NULL};
 
 static int l_delaunay(lua_State *L)
 {
@@ -324,28 +328,32 @@ static void config_at(lua_State *L, lmesh *u, int arg, int uarg, const char *nes
         }
         return;
     }
-    static const char *const fields[] = {"x", "y", "vx", "vy", NULL};
     if (nest) {
         if (!lua_istable(L, arg)) {
             char got[64];
             bind_describe(L, arg, got, sizeof got);
             field_fail(L, uarg, call, nest, "dem.scene or {x =, y =}", got);
         }
-        nested_check_fields(L, arg, uarg, call, nest, fields);
+        nested_check_fields(L, arg, uarg, call, nest, STATE_FIELDS);
     } else {
         bind_check_table(L, arg, call);
-        bind_check_fields(L, arg, call, fields);
+        bind_check_fields(L, arg, call, STATE_FIELDS);
     }
     static const char *const keys[4] = {"x", "y", "vx", "vy"};
     const double **out[4] = {x, y, vx, vy};
     size_t len = n;
-    for (int q = 0; q < (vx ? 4 : 2); q++) {
+    /* vx, vy are read (checked) even where only positions are used: a state table made for
+     * strain_rate passes to strain as it is, but garbage in it is not ignored. */
+    const double *unused[2];
+    if (!vx) {
+        out[2] = &unused[0];
+        out[3] = &unused[1];
+    }
+    for (int q = 0; q < 4; q++) {
         char label[48];
         snprintf(label, sizeof label, "%s%s%s", nest ? nest : "", nest ? "." : "", keys[q]);
-        *out[q] = read_array_at(L, arg, keys[q], uarg, call, label, &len, q < 2);
+        *out[q] = read_array_at(L, arg, keys[q], uarg, call, label, &len, q < 2 || vx != NULL);
     }
-    if (vx && (!*vx || !*vy))
-        luaL_error(L, "%s: give vx and vy (or a dem.scene)", call);
 }
 
 static int l_mesh_info(lua_State *L)
@@ -420,7 +428,7 @@ static int l_mesh_strain(lua_State *L)
     const analysis_mesh *m = u->m;
     const double *x, *y;
     if (lua_isnoneornil(L, 2))
-        return luaL_error(L, "strain: give the current state (a dem.scene or {x =, y =})");
+        return bind_arg_error(L, 2, "strain", "the current state (a dem.scene or {x =, y =})");
     config(L, u, 2, "strain", &x, &y, NULL, NULL);
     double *ux = scratch(L, m->np), *uy = scratch(L, m->np);
     for (size_t i = 0; i < m->np; i++) {
@@ -458,7 +466,8 @@ static int l_mesh_strain_rate(lua_State *L)
     const analysis_mesh *m = u->m;
     const double *x, *y, *vx, *vy;
     if (lua_isnoneornil(L, 2))
-        return luaL_error(L, "strain_rate: give the current state (a dem.scene or {x, y, vx, vy})");
+        return bind_arg_error(L, 2, "strain_rate",
+                              "the current state (a dem.scene or {x =, y =, vx =, vy =})");
     config(L, u, 2, "strain_rate", &x, &y, &vx, &vy);
     double *g = scratch(L, 4 * m->ncells), *lii = scratch(L, m->ncells);
     core_error err;
@@ -548,9 +557,8 @@ static int l_mesh_stress(lua_State *L)
     dem_scene *s = bind_check_dem_scene(L, 2, call);
     double depth = dem_thickness(s);
     if (!lua_isnoneornil(L, 3)) {
-        static const char *const fields[] = {"depth", NULL};
         bind_check_table(L, 3, call);
-        bind_check_fields(L, 3, call, fields);
+        bind_check_fields(L, 3, call, STRESS_FIELDS);
         depth = bind_field_number(L, 3, call, "depth", depth, BIND_POSITIVE);
     }
     if (!(depth > 0))
@@ -609,9 +617,8 @@ static int l_mesh_raster(lua_State *L)
                           "bad argument #1 to '%s' (array of %I cell values expected, got "
                           "%I values)",
                           call, (lua_Integer)m->ncells, (lua_Integer)lua_rawlen(L, 2));
-    static const char *const fields[] = {"nx", "ny", "extent", "state", NULL};
     bind_check_table(L, 3, call);
-    bind_check_fields(L, 3, call, fields);
+    bind_check_fields(L, 3, call, RASTER_FIELDS);
     int nx = (int)bind_field_integer(L, 3, call, "nx", 0, 1, 8192, BIND_REQUIRED);
     int ny = (int)bind_field_integer(L, 3, call, "ny", 0, 1, 8192, BIND_REQUIRED);
     double ext[4], lo[2], hi[2];
@@ -874,7 +881,8 @@ static void read_matrix(lua_State *L, int tab, const char *key, int arg, const c
         for (int c = 0; c < 2; c++) {
             lua_rawgeti(L, -1, c + 1);
             out[2 * r + c] = lua_tonumber(L, -1);
-            if (lua_type(L, -1) != LUA_TNUMBER || !isfinite(out[2 * r + c])) {
+            if (lua_type(L, -1) != LUA_TNUMBER || !isfinite(out[2 * r + c]) ||
+                fabs(out[2 * r + c]) > 1e100) { /* the bindings' magnitude cap */
                 char v[48];
                 bind_describe(L, -1, v, sizeof v);
                 snprintf(got, sizeof got, "%s at row %d, column %d", v, r + 1, c + 1);
@@ -924,7 +932,9 @@ static double nested_number(lua_State *L, int tab, const char *key, int arg, con
         return def;
     }
     double v = lua_tonumber(L, -1);
-    if (lua_type(L, -1) != LUA_TNUMBER || !isfinite(v) || (positive ? !(v > 0) : !(v >= 0))) {
+    /* finite, and within the bindings' magnitude cap (1e100) as the arrays are */
+    if (lua_type(L, -1) != LUA_TNUMBER || !isfinite(v) || fabs(v) > 1e100 ||
+        (positive ? !(v > 0) : !(v >= 0))) {
         char got[64];
         bind_describe(L, -1, got, sizeof got);
         field_fail(L, arg, call, label, positive ? "positive number" : "non-negative number", got);
@@ -979,6 +989,11 @@ static void push_boundary_info(lua_State *L, dem_scene *s)
 }
 
 static const char *const MODES[] = {"delaunay", "edges", "none", NULL};
+static const char *const BOUNDARY_FIELDS[] = {"mode",   "pressure", "depth", "every",
+                                              "alpha",  "sides",    "ids",   "edges",
+                                              "closed", "mbc",      "band",  NULL};
+static const char *const MBC_FIELDS[] = {"strain_rate", "gradient", "mask", "K", "kappa",
+                                         "rate",        "dt",       "tau",  NULL};
 static const char *const SIDES[] = {"all", "lateral", NULL};
 
 /* s:boundary{ mode =, pressure =, depth =, every =, alpha =, sides =, ids =, edges =, closed =,
@@ -986,16 +1001,27 @@ static const char *const SIDES[] = {"all", "lateral", NULL};
 static int l_boundary(lua_State *L)
 {
     const char *call = "boundary";
-    static const char *const fields[] = {"mode", "pressure", "depth", "every", "alpha", "sides",
-                                         "ids", "edges", "closed", "mbc", "band", NULL};
-    static const char *const mfields[] = {"strain_rate", "gradient", "mask", "K", "kappa", "rate",
-                                          "dt", "tau", NULL};
     dem_scene *s = bind_check_dem_scene(L, 1, call);
     bind_check_table(L, 2, call);
-    bind_check_fields(L, 2, call, fields);
+    bind_check_fields(L, 2, call, BOUNDARY_FIELDS);
     if (dem_dim(s) != 2)
         return luaL_error(L, "%s: boundary conditions are 2D only", call);
     int mode = bind_field_option(L, 2, call, "mode", MODES, 0, 0);
+    /* A field of another mode would be ignored without a word: refused, naming it. */
+    static const char *const not_in[3][10] = {
+        {"edges", "closed", NULL},
+        {"every", "alpha", "sides", "ids", "band", NULL},
+        {"pressure", "depth", "every", "alpha", "sides", "ids", "edges", "closed", "mbc", "band"}};
+    for (int k = 0; k < 10 && not_in[mode][k]; k++) {
+        if (lua_getfield(L, 2, not_in[mode][k]) != LUA_TNIL) {
+            char want[80], got[64];
+            snprintf(want, sizeof want, "nil (a field of another mode; 'mode' is '%s')",
+                     MODES[mode]);
+            bind_describe(L, -1, got, sizeof got);
+            return field_fail(L, 2, call, not_in[mode][k], want, got);
+        }
+        lua_pop(L, 1);
+    }
     if (mode == 2) {
         dem_clear_boundary(s);
         return 0;
@@ -1019,12 +1045,22 @@ static int l_boundary(lua_State *L)
             bind_describe(L, mbc, got, sizeof got);
             return field_fail(L, 2, call, "mbc", "table", got);
         }
-        nested_check_fields(L, mbc, 2, call, "mbc", mfields);
+        nested_check_fields(L, mbc, 2, call, "mbc", MBC_FIELDS);
         int has_e = lua_getfield(L, mbc, "strain_rate") != LUA_TNIL;
         int has_g = lua_getfield(L, mbc, "gradient") != LUA_TNIL;
+        if (has_e && has_g) {
+            char got[64];
+            bind_describe(L, -1, got, sizeof got);
+            return field_fail(
+                L, 2, call, "mbc.gradient",
+                "nil (exactly one of strain_rate and gradient; 'mbc.strain_rate' is given)", got);
+        }
         lua_pop(L, 2);
-        if (has_e == has_g)
-            return luaL_error(L, "%s: mbc needs exactly one of strain_rate and gradient", call);
+        if (!has_e && !has_g)
+            return field_fail(
+                L, 2, call, "mbc.strain_rate",
+                "2x2 matrix (exactly one of strain_rate and gradient; nor is 'mbc.gradient' given)",
+                "nil");
         def.gradient = has_g;
         read_matrix(L, mbc, has_g ? "gradient" : "strain_rate", 2, call,
                     has_g ? "mbc.gradient" : "mbc.strain_rate", def.target);
@@ -1063,6 +1099,11 @@ static int l_boundary(lua_State *L)
         int band = bind_field_boolean(L, 2, call, "band", 1);
         size_t nids = 0;
         const long *ids = read_ids(L, 2, call, "ids", dem_count(s), 1, 0, &nids);
+        if (ids && nids < 3) {
+            char got[64];
+            snprintf(got, sizeof got, "%d ids", (int)nids);
+            return field_fail(L, 2, call, "ids", "array of at least 3 particle ids", got);
+        }
         delaunay_ctx *c = calloc(1, sizeof *c);
         if (!c)
             return luaL_error(L, "%s: out of memory", call);
@@ -1099,15 +1140,26 @@ static int l_boundary(lua_State *L)
         dem_boundary_info bi;
         core_error err;
         dem_boundary_info_get(s, &bi, &err);
+        if (!bi.closed && mode == 1)
+            return field_fail(L, 2, call, "closed",
+                              "true (the minimal boundary conditions need a closed loop)", "false");
         if (!bi.closed)
             return luaL_error(L, "%s: the minimal boundary conditions need a closed boundary "
                                  "loop (mode 'delaunay', or edges with closed = true)", call);
         if (K == 0) {
             /* K so that a strain-rate error equal to the imposed rate gives forces kappa times
              * the typical contact force p d depth (d ~ |g_a|): K = kappa p depth V / rate. */
-            if (!(def.pressure > 0) || !(rate > 0))
-                return luaL_error(L, "%s: mbc needs K, or a pressure and a rate scale (rate = , "
-                                     "or a nonzero target) to choose it", call);
+            if (!(def.pressure > 0)) {
+                char got[64];
+                snprintf(got, sizeof got, "%g", def.pressure);
+                return field_fail(L, 2, call, "pressure",
+                                  "positive pressure (mbc without K chooses K from it)", got);
+            }
+            if (!(rate > 0))
+                return field_fail(L, 2, call, "mbc.rate",
+                                  "positive rate (mbc without K and with a zero target chooses "
+                                  "K from it)",
+                                  "nil");
             K = kappa * def.pressure * def.depth * bi.area / rate;
             if (mdt > 0) {
                 /* ... but at most half the explicit limit for steps of mdt: the penalty damps
@@ -1273,6 +1325,11 @@ void bind_open_analysis(lua_State *L)
     bind_new_type(L, MESH, methods, meta,
                   "A Delaunay mesh of particle centres from analysis.delaunay; it keeps the "
                   "positions it was built on as the reference configuration.");
+    static const bind_fields mesh_fields[] = {
+        {"cells", NULL, STATE_FIELDS},       {"strain", NULL, STATE_FIELDS},
+        {"strain_rate", NULL, STATE_FIELDS}, {"stress", NULL, STRESS_FIELDS},
+        {"raster", NULL, RASTER_FIELDS},     {NULL, NULL, NULL}};
+    bind_type_fields(L, MESH, mesh_fields);
     static const bind_fn fns[] = {
         {"delaunay", l_delaunay,
          "analysis.delaunay(scene | { x =, y =, radius = }, { alpha = 1.5, ids = {...} })",
@@ -1321,7 +1378,9 @@ void bind_open_analysis(lua_State *L)
          "tau > 0 (default 1000 dt when dt is given, else 0) adds the integral of the error over "
          "tau, so that the capped K does not let the strain lag (a proportional-integral "
          "penalty; tau = 0 is the paper's rate penalty alone). A run stops with an error when K is too stiff for its dt. mode none removes the boundary, "
-         "springs and ties. Returns s:boundary_info() plus K."},
+         "springs and ties. A field of another mode (edges in mode delaunay, ids in mode edges, "
+         "anything but mode in mode none) is refused, not ignored. Returns s:boundary_info() "
+         "plus K."},
         {"boundary_info", l_boundary_info, "s:boundary_info()",
          "edges, loaded, nodes, closed, area (inside the loop), gradient and strain_rate (coarse, "
          "Eq. 3.2, from the velocities now), penalty_sum {fx, fy} and penalty_max (N, last "
@@ -1343,7 +1402,8 @@ void bind_open_analysis(lua_State *L)
     lua_getfield(L, -1, "__index");
     bind_register(L, lua_gettop(L), scene_methods);
     lua_pop(L, 2);
-    static const bind_fields method_fields[] = {{"springs", NULL, SPRINGS_FIELDS},
+    static const bind_fields method_fields[] = {{"boundary", NULL, BOUNDARY_FIELDS},
+                                                {"springs", NULL, SPRINGS_FIELDS},
                                                 {"spin", NULL, SPIN_FIELDS},
                                                 {"tie", NULL, TIE_FIELDS},
                                                 {NULL, NULL, NULL}};

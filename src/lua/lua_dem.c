@@ -27,11 +27,8 @@ static dem_scene *check_scene(lua_State *L, int idx)
 struct dem_scene *bind_check_dem_scene(lua_State *L, int idx, const char *call)
 {
     lscene *u = luaL_testudata(L, idx, SCENE);
-    if (!u) {
-        char got[64];
-        bind_describe(L, idx, got, sizeof got);
-        luaL_error(L, "bad argument #%d to '%s' (dem.scene expected, got %s)", idx, call, got);
-    }
+    if (!u) /* numbered as the user counts (a method's self is not #1) */
+        bind_arg_error(L, idx, call, "dem.scene");
     if (!u->s)
         luaL_error(L, "%s: the dem.scene was closed", call);
     return u->s;

@@ -20,6 +20,9 @@
 --     pos = { [i] = { "nil", ... } },              -- positional args to fuzz and what they take
 --     strings = { [i or field] = "..." },          -- the "string" class there (a file path)
 --     slow = { field = { class = "why" } },        -- an accepted class printed, not run (cost)
+--     nested = { mbc = { "K", ... } },            -- sub-tables args[opts].mbc (or a path such as
+--                                                  --   "checks.1"): fields fuzzed in place, declared
+--                                                  --   in accept as "mbc.K" ("checks[1].name")
 --     no_opts = true,                              -- a variant without the options table
 --     todo = { field = "why" },                    -- printed, not fuzzed (a fix pending elsewhere)
 --     name = "add_disk" }                          -- the name errors use (default: the key's)
@@ -141,9 +144,15 @@ local function fuzz_entry(key, e, fn, doc)
   for k in pairs(accept) do
     local known = false
     for _, f in ipairs(fields or {}) do known = known or f == k end
+    for path, subs in pairs(e.nested or {}) do
+      local label = path:gsub("%.(%d+)", "[%1]")
+      for _, f in ipairs(subs) do known = known or k == label .. "." .. f end
+    end
     if not known then fail(key, "declared field '" .. k .. "' is not a field of the binding") end
   end
-  for _, f in ipairs(fields or {}) do
+  -- One field (or a nested field "parent.f" of a sub-table the entry lists in `nested`):
+  -- every class, at the place get/set reach in the arguments.
+  local function fuzz_field(f, get, set)
     if e.todo and e.todo[f] then
       print(key .. ": field '" .. f .. "' not fuzzed yet: " .. e.todo[f])
     elseif not accept[f] then
@@ -151,7 +160,7 @@ local function fuzz_entry(key, e, fn, doc)
     else
       local ok_set = set_of(accept[f])
       local probe = e.args and e.args(e.setup and e.setup() or {}) or {}
-      local base = probe[e.opts] and probe[e.opts][f]
+      local base = get(probe)
       local classes = {}
       for _, c in ipairs(M.scalar) do classes[#classes + 1] = c end
       for _, c in ipairs(derived(base)) do classes[#classes + 1] = c end
@@ -162,10 +171,37 @@ local function fuzz_entry(key, e, fn, doc)
         if slow then
           print(key .. ": field '" .. f .. "' = " .. cname .. " not run (accepted, but slow): " .. slow)
         else case(key, e, fn, "field '" .. f .. "' = " .. cname .. " (" .. describe(v) .. ")",
-          function(args) args[e.opts][f] = copy(v) end, ok_set[cname],
+          function(args) set(args, copy(v)) end, ok_set[cname],
           { "'" .. f .. "'", "'" .. f .. ".", "'" .. f .. "[" })
         end
       end
+    end
+  end
+  for _, f in ipairs(fields or {}) do
+    fuzz_field(f, function(a) return a[e.opts] and a[e.opts][f] end,
+      function(a, v) a[e.opts][f] = v end)
+  end
+  -- nested = { path = { fields } }: the sub-table args[opts].path must be in the base call (a path
+  -- "mbc", or "checks.1" for an array entry); its fields are declared in accept under the name
+  -- errors use: "mbc.K", "checks[1].name".
+  for path, subs in pairs(e.nested or {}) do
+    local steps = {}
+    for part in path:gmatch("[^.]+") do steps[#steps + 1] = math.tointeger(tonumber(part)) or part end
+    local label = steps[1]
+    for i = 2, #steps do
+      label = label .. (math.type(steps[i]) == "integer" and "[" .. steps[i] .. "]" or "." .. steps[i])
+    end
+    local known = false
+    for _, f in ipairs(fields or {}) do known = known or f == steps[1] end
+    if not known then fail(key, "nested table '" .. path .. "' is not in a field of the binding") end
+    local function sub(a)
+      local t = a[e.opts]
+      for _, st in ipairs(steps) do t = type(t) == "table" and t[st] or nil end
+      return t
+    end
+    for _, sf in ipairs(subs) do
+      fuzz_field(label .. "." .. sf, function(a) local t = sub(a); return t and t[sf] end,
+        function(a, v) sub(a)[sf] = v end)
     end
   end
   -- The options table itself and positional arguments.

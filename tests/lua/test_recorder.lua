@@ -91,9 +91,9 @@ check.errors(R, "bad field 'order' in argument #1 to 'recorder' (array of the co
              { columns = { a = function() return 1 end } })
 check.errors(R, "bad field 'order' in argument #1 to 'recorder' (array naming every column expected, got 'b')",
              "order missing a column", { columns = { a = print, b = print }, order = { "a" } })
-check.errors(R, "bad field 'order[2]' in argument #1 to 'recorder' (name of a column expected, got 'c')",
+check.errors(R, "bad field 'order[2]' in argument #1 to 'recorder' (name of one of the 'columns' expected, got 'c')",
              "order naming no column", { columns = { a = print }, order = { "a", "c" } })
-check.errors(R, "bad field 'units' in argument #1 to 'recorder' (names of columns expected, got 'z')",
+check.errors(R, "bad field 'units' in argument #1 to 'recorder' (names of the 'columns' expected, got 'z')",
              "unit of no column", { columns = { "a" }, units = { z = "m" } })
 check.errors(R, "bad field 'units.a'", "comma in a unit", { columns = { "a" }, units = { a = "m,s" } })
 check.errors(R, "bad field 'flush' in argument #1 to 'recorder' (seconds >= 0 or false expected, got -1)",
