@@ -81,7 +81,8 @@ local area = math.pi * (rmax ^ 3 - rmin ^ 3) / (3 * (rmax - rmin)) / 0.82
 local W0 = 2 * rf * math.floor(math.sqrt(n * area / aspect) / (2 * rf) + 0.5) -- whole floor disks
 local H0 = n * area / W0
 local L = W0 * (1 + 3.5 * aspect)   -- room for the runout
-local top = 1.12 * H0
+-- Headroom: 12 %, but at least two grain diameters (a column of a few rows packs less evenly).
+local top = math.max(1.12 * H0, H0 + 4 * rmax)
 
 local t_start = grainlab.clock()
 local mat = grainlab.material{ density = rho, young = young, poisson = nu, friction = mu }
