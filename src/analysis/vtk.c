@@ -40,8 +40,5 @@ core_status analysis_vtk_cells(const char *path, size_t np, const double *x, con
     }
     if (!st)
         st = vtk_set_time(f, time, 0, err);
-    if (!st)
-        st = vtk_file_write(f, path, err);
-    vtk_file_free(f);
-    return st;
+    return vtk_file_finish(f, path, st, err);
 }

@@ -440,3 +440,11 @@ core_status vtk_pvd_write(const char *path, size_t n, const double *times, const
     }
     return atomic_commit(&af, err);
 }
+
+core_status vtk_file_finish(vtk_file *f, const char *path, core_status st, core_error *err)
+{
+    if (st == CORE_OK)
+        st = vtk_file_write(f, path, err);
+    vtk_file_free(f);
+    return st;
+}

@@ -72,6 +72,8 @@ core_status vtk_set_time(vtk_file *f, double time, long step, core_error *err);
 
 /* Writes the file whole (temporary file + rename). */
 core_status vtk_file_write(const vtk_file *f, const char *path, core_error *err);
+/* The exporters' last step: writes f when st is CORE_OK, frees it either way, returns the status. */
+core_status vtk_file_finish(vtk_file *f, const char *path, core_status st, core_error *err);
 
 /* A .pvd collection: n data sets with their times, written whole. files are written as given
  * (relative to the .pvd's directory). part may be NULL (all part 0). */

@@ -22,14 +22,6 @@ static void interleave(double *out, const double *const c[3], size_t n)
             out[3 * i + d] = c[d] ? c[d][i] : 0;
 }
 
-static core_status finish(vtk_file *f, const char *path, core_status st, core_error *err)
-{
-    if (st == CORE_OK)
-        st = vtk_file_write(f, path, err);
-    vtk_file_free(f);
-    return st;
-}
-
 core_status dem_vtk_particles(const dem_scene *s, const char *path, core_error *err)
 {
     const size_t n = dem_count(s);
@@ -59,7 +51,7 @@ core_status dem_vtk_particles(const dem_scene *s, const char *path, core_error *
     double *angle =
         mat && D == 2 && dem_angles(s) ? vtk_f64(f, VTK_POINT_DATA, "angle", 1, n, err) : NULL;
     if (!mat || (D == 2 && dem_angles(s) && !angle))
-        return finish(f, path, err ? err->status : CORE_ERR_NOMEM, err);
+        return vtk_file_finish(f, path, err ? err->status : CORE_ERR_NOMEM, err);
     interleave(x, pos, n);
     interleave(v, vel, n);
     interleave(w, omega, n);
@@ -80,7 +72,7 @@ core_status dem_vtk_particles(const dem_scene *s, const char *path, core_error *
         st = vtk_set_active(f, VTK_POINT_DATA, "Scalars", "radius", err);
     if (!st)
         st = vtk_set_active(f, VTK_POINT_DATA, "Vectors", "velocity", err);
-    return finish(f, path, st, err);
+    return vtk_file_finish(f, path, st, err);
 }
 
 /* ---- contacts -------------------------------------------------------------------------------- */
@@ -161,7 +153,7 @@ core_status dem_vtk_contacts(dem_scene *s, const char *path, core_error *err)
     double *pfn = ftv ? vtk_f64(f, VTK_POINT_DATA, "fn", 1, 2 * n, err) : NULL;
     if (!pfn) {
         free(l.c);
-        return finish(f, path, err ? err->status : CORE_ERR_NOMEM, err);
+        return vtk_file_finish(f, path, err ? err->status : CORE_ERR_NOMEM, err);
     }
     for (size_t k = 0; k < n; k++) {
         const contact_rec *c = &l.c[k];
@@ -189,7 +181,7 @@ core_status dem_vtk_contacts(dem_scene *s, const char *path, core_error *err)
         st = vtk_set_active(f, VTK_CELL_DATA, "Scalars", "fn", err);
     if (!st)
         st = vtk_set_active(f, VTK_CELL_DATA, "Vectors", "force", err);
-    return finish(f, path, st, err);
+    return vtk_file_finish(f, path, st, err);
 }
 
 /* ---- walls ----------------------------------------------------------------------------------- */
@@ -328,5 +320,5 @@ core_status dem_vtk_walls(const dem_scene *s, const char *path, core_error *err)
     free(poly), free(nv), free(ids), free(types), free(normal);
     if (!f)
         return st;
-    return finish(f, path, st, err);
+    return vtk_file_finish(f, path, st, err);
 }

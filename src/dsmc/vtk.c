@@ -7,14 +7,6 @@
 #include "core/vtk.h"
 #include "dsmc/dsmc.h"
 
-static core_status finish(vtk_file *f, const char *path, core_status st, core_error *err)
-{
-    if (st == CORE_OK)
-        st = vtk_file_write(f, path, err);
-    vtk_file_free(f);
-    return st;
-}
-
 core_status dsmc_vtk_particles(const dsmc_scene *s, const char *path, core_error *err)
 {
     const size_t n = dsmc_count(s);
@@ -33,7 +25,7 @@ core_status dsmc_vtk_particles(const dsmc_scene *s, const char *path, core_error
     double *m = v ? vtk_f64(f, VTK_POINT_DATA, "mass", 1, n, err) : NULL;
     int64_t *cell = m ? vtk_i64(f, VTK_POINT_DATA, "cell", 1, n, err) : NULL;
     if (!cell)
-        return finish(f, path, err ? err->status : CORE_ERR_NOMEM, err);
+        return vtk_file_finish(f, path, err ? err->status : CORE_ERR_NOMEM, err);
     const double mass = dsmc_mass(s);
     for (size_t i = 0; i < n; i++) {
         conn[i] = (int64_t)i;
@@ -49,7 +41,7 @@ core_status dsmc_vtk_particles(const dsmc_scene *s, const char *path, core_error
     st = vtk_set_time(f, dsmc_time(s), dsmc_steps_done(s), err);
     if (!st)
         st = vtk_set_active(f, VTK_POINT_DATA, "Vectors", "velocity", err);
-    return finish(f, path, st, err);
+    return vtk_file_finish(f, path, st, err);
 }
 
 core_status dsmc_vtk_cells(const dsmc_scene *s, const char *path, core_error *err)
@@ -76,7 +68,7 @@ core_status dsmc_vtk_cells(const dsmc_scene *s, const char *path, core_error *er
     if (!uc) {
         if (a2)
             core_fail(err, CORE_ERR_NOMEM, "out of memory for the cells of '%s'", path);
-        return finish(f, path, err ? err->status : CORE_ERR_NOMEM, err);
+        return vtk_file_finish(f, path, err ? err->status : CORE_ERR_NOMEM, err);
     }
     dsmc_fields fl = {.count = count,
                       .density = density,
@@ -92,5 +84,5 @@ core_status dsmc_vtk_cells(const dsmc_scene *s, const char *path, core_error *er
     st = vtk_set_time(f, dsmc_time(s), dsmc_steps_done(s), err);
     if (!st)
         st = vtk_set_active(f, VTK_CELL_DATA, "Scalars", "temperature", err);
-    return finish(f, path, st, err);
+    return vtk_file_finish(f, path, st, err);
 }

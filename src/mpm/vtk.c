@@ -8,14 +8,6 @@
 #include "core/vtk.h"
 #include "mpm/mpm.h"
 
-static core_status finish(vtk_file *f, const char *path, core_status st, core_error *err)
-{
-    if (st == CORE_OK)
-        st = vtk_file_write(f, path, err);
-    vtk_file_free(f);
-    return st;
-}
-
 core_status mpm_vtk_points(const mpm_scene *s, const char *path, core_error *err)
 {
     const size_t n = mpm_point_count(s);
@@ -39,7 +31,7 @@ core_status mpm_vtk_points(const mpm_scene *s, const char *path, core_error *err
     double *pr = F ? vtk_f64(f, VTK_POINT_DATA, "pressure", 1, n, err) : NULL;
     double *ep = pr ? vtk_f64(f, VTK_POINT_DATA, "eps_p", 1, n, err) : NULL;
     if (!ep)
-        return finish(f, path, err ? err->status : CORE_ERR_NOMEM, err);
+        return vtk_file_finish(f, path, err ? err->status : CORE_ERR_NOMEM, err);
     for (size_t i = 0; i < n; i++) {
         conn[i] = (int64_t)i;
         id[i] = (int64_t)i + 1;
@@ -68,7 +60,7 @@ core_status mpm_vtk_points(const mpm_scene *s, const char *path, core_error *err
         st = vtk_set_active(f, VTK_POINT_DATA, "Vectors", "velocity", err);
     if (!st)
         st = vtk_set_active(f, VTK_POINT_DATA, "Tensors", "stress", err);
-    return finish(f, path, st, err);
+    return vtk_file_finish(f, path, st, err);
 }
 
 /* The cell fields written to the grid file, named as m:field names them. */
@@ -101,11 +93,11 @@ core_status mpm_vtk_grid(const mpm_scene *s, const char *path, core_error *err)
     double *nm = vtk_f64(f, VTK_POINT_DATA, "mass", 1, nn, err);
     double *nv = nm ? vtk_f64(f, VTK_POINT_DATA, "velocity", 3, nn, err) : NULL;
     if (!nv)
-        return finish(f, path, err ? err->status : CORE_ERR_NOMEM, err);
+        return vtk_file_finish(f, path, err ? err->status : CORE_ERR_NOMEM, err);
     for (size_t k = 0; k < sizeof CELL_FIELDS / sizeof CELL_FIELDS[0]; k++) {
         double *c = vtk_f64(f, VTK_CELL_DATA, CELL_FIELDS[k].name, 1, nc, err);
         if (!c)
-            return finish(f, path, err ? err->status : CORE_ERR_NOMEM, err);
+            return vtk_file_finish(f, path, err ? err->status : CORE_ERR_NOMEM, err);
         mpm_field(s, CELL_FIELDS[k].kind, c);
     }
     /* Nodal mass and velocity from a transfer of the current points with the linear
@@ -147,5 +139,5 @@ core_status mpm_vtk_grid(const mpm_scene *s, const char *path, core_error *err)
     st = vtk_set_time(f, mpm_time(s), mpm_steps_done(s), err);
     if (!st)
         st = vtk_set_active(f, VTK_CELL_DATA, "Scalars", "pressure", err);
-    return finish(f, path, st, err);
+    return vtk_file_finish(f, path, st, err);
 }
