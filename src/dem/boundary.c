@@ -278,6 +278,29 @@ core_status dem_add_springs(dem_scene *s, size_t n, const long *i, const long *j
     return CORE_OK;
 }
 
+/* Appends a tie (particle i held to wall's motion along axis) to the boundary's arrays. */
+static core_status push_tie(dem_boundary *b, long i, int wall, int axis, core_error *err)
+{
+    size_t cap = b->cap_t;
+    core_status st = grow((void **)&b->ti, &cap, b->nt + 1, sizeof *b->ti, err);
+    if (st)
+        return st;
+    int *tw = realloc(b->tw, cap * sizeof *tw);
+    if (tw)
+        b->tw = tw;
+    int *ta = realloc(b->ta, cap * sizeof *ta);
+    if (ta)
+        b->ta = ta;
+    if (!tw || !ta)
+        return core_fail(err, CORE_ERR_NOMEM, "out of memory for the ties");
+    b->cap_t = cap;
+    b->ti[b->nt] = i;
+    b->tw[b->nt] = wall;
+    b->ta[b->nt] = axis;
+    b->nt++;
+    return CORE_OK;
+}
+
 core_status dem_tie_to_wall(dem_scene *s, size_t i, int wall, int axis, core_error *err)
 {
     if (i >= s->n)
@@ -289,23 +312,8 @@ core_status dem_tie_to_wall(dem_scene *s, size_t i, int wall, int axis, core_err
     core_status st = ensure(s, err);
     if (st)
         return st;
-    dem_boundary *b = s->bnd;
-    size_t cap = b->cap_t;
-    if ((st = grow((void **)&b->ti, &cap, b->nt + 1, sizeof *b->ti, err)))
+    if ((st = push_tie(s->bnd, (long)i, wall, axis, err)))
         return st;
-    int *tw = realloc(b->tw, cap * sizeof *tw);
-    if (tw)
-        b->tw = tw;
-    int *ta = realloc(b->ta, cap * sizeof *ta);
-    if (ta)
-        b->ta = ta;
-    if (!tw || !ta)
-        return core_fail(err, CORE_ERR_NOMEM, "out of memory for the ties");
-    b->cap_t = cap;
-    b->ti[b->nt] = (long)i;
-    b->tw[b->nt] = wall;
-    b->ta[b->nt] = axis;
-    b->nt++;
     s->v[axis][i] = s->walls[wall].velocity[axis];
     dem_invalidate(s, 0);
     return CORE_OK;
@@ -683,22 +691,8 @@ core_status dem_boundary_load(dem_scene *s, ckpt_section *sec, core_error *err)
             if (i < 0 || (size_t)i >= s->n || wall < 0 || wall >= s->nwalls || axis < 0 ||
                 axis >= s->dim)
                 return corrupt(sec, "bad tie", err);
-            size_t cap = b->cap_t;
-            if ((st = grow((void **)&b->ti, &cap, b->nt + 1, sizeof *b->ti, err)))
+            if ((st = push_tie(b, (long)i, (int)wall, (int)axis, err)))
                 return st;
-            int *tw = realloc(b->tw, cap * sizeof *tw);
-            if (tw)
-                b->tw = tw;
-            int *ta = realloc(b->ta, cap * sizeof *ta);
-            if (ta)
-                b->ta = ta;
-            if (!tw || !ta)
-                return core_fail(err, CORE_ERR_NOMEM, "out of memory for the ties");
-            b->cap_t = cap;
-            b->ti[b->nt] = (long)i;
-            b->tw[b->nt] = (int)wall;
-            b->ta[b->nt] = (int)axis;
-            b->nt++;
         }
     }
     if (!st)
