@@ -154,6 +154,14 @@ void *bind_check_self(lua_State *L, int arg, const char *tname, const char *call
     return u;
 }
 
+void *bind_check_udata(lua_State *L, int arg, const char *tname, const char *call)
+{
+    void *u = luaL_testudata(L, arg, tname);
+    if (!u) /* numbered as the user counts (a method's self is not #1) */
+        bind_arg_error(L, arg, call, tname);
+    return u;
+}
+
 void bind_check_table(lua_State *L, int arg, const char *call)
 {
     if (lua_type(L, arg) != LUA_TTABLE)

@@ -81,6 +81,9 @@ void bind_arg_vector(lua_State *L, int arg, const char *call, int n, double *out
 /* The userdata of type tname at arg, or an error naming the call that says how to call a method
  * (s:run{...}, not s.run{...}) when arg is a method's self. */
 void *bind_check_self(lua_State *L, int arg, const char *tname, const char *call);
+/* The userdata of type tname at a (non-self) argument, or "bad argument #N to 'call' (tname
+ * expected, got …)". */
+void *bind_check_udata(lua_State *L, int arg, const char *tname, const char *call);
 
 /* Writes a short description of the value at idx: "-0.1", "'xyz'", "nil", "table". */
 void bind_describe(lua_State *L, int idx, char *buf, size_t size);

@@ -26,9 +26,7 @@ static dem_scene *check_scene(lua_State *L, int idx)
 
 struct dem_scene *bind_check_dem_scene(lua_State *L, int idx, const char *call)
 {
-    lscene *u = luaL_testudata(L, idx, SCENE);
-    if (!u) /* numbered as the user counts (a method's self is not #1) */
-        bind_arg_error(L, idx, call, "dem.scene");
+    lscene *u = bind_check_udata(L, idx, SCENE, call);
     if (!u->s)
         luaL_error(L, "%s: the dem.scene was closed", call);
     return u->s;

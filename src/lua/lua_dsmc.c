@@ -895,12 +895,7 @@ void bind_open_dsmc(lua_State *L)
 /* ---- for other bindings (lua_checkpoint_mpm.c) --------------------------------------------- */
 dsmc_scene *bind_check_dsmc_scene(lua_State *L, int idx, const char *call)
 {
-    lscene *u = luaL_testudata(L, idx, SCENE);
-    if (!u) {
-        char got[64];
-        bind_describe(L, idx, got, sizeof got);
-        luaL_error(L, "bad argument #%d to '%s' (dsmc.scene expected, got %s)", idx, call, got);
-    }
+    lscene *u = bind_check_udata(L, idx, SCENE, call);
     if (!u->s)
         luaL_error(L, "%s: the dsmc.scene was closed", call);
     return u->s;

@@ -1034,12 +1034,7 @@ void bind_open_mpm(lua_State *L)
 /* ---- for other bindings (lua_checkpoint_mpm.c) --------------------------------------------- */
 mpm_scene *bind_check_mpm_scene(lua_State *L, int idx, const char *call)
 {
-    lscene *u = luaL_testudata(L, idx, SCENE);
-    if (!u) {
-        char got[64];
-        bind_describe(L, idx, got, sizeof got);
-        luaL_error(L, "bad argument #%d to '%s' (mpm.scene expected, got %s)", idx, call, got);
-    }
+    lscene *u = bind_check_udata(L, idx, SCENE, call);
     if (!u->s)
         luaL_error(L, "%s: the mpm.scene was closed", call);
     return u->s;
