@@ -191,27 +191,8 @@ do
 end
 
 -- ---- bad input ----------------------------------------------------------------------------
-local function slurp(p)
-  local f = assert(io.open(p, "rb"))
-  local s = f:read("a")
-  f:close()
-  return s
-end
-local function spit(p, s)
-  local f = assert(io.open(p, "wb"))
-  f:write(s)
-  f:close()
-end
--- FNV-1a 64 (Lua integers wrap), to forge files a real writer could have produced
-local function fnv(s)
-  local h = -3750763034362895579 -- 0xcbf29ce484222325
-  for k = 1, #s do h = (h ~ s:byte(k)) * 0x100000001b3 end
-  return h
-end
-local function reseal(s)
-  local body = s:sub(1, #s - 8)
-  return body .. string.pack("=j", fnv(body))
-end
+local F = dofile("ckpt_files.lua")
+local slurp, spit, reseal = F.read, F.write, F.reseal
 
 local good = path("good.ckpt")
 do

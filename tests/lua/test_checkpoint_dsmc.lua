@@ -113,27 +113,8 @@ do
 end
 
 -- ---- bad files ------------------------------------------------------------------------------
-local function read(path)
-  local f = assert(io.open(path, "rb"))
-  local s = f:read("a")
-  f:close()
-  return s
-end
-
-local function write(path, s)
-  local f = assert(io.open(path, "wb"))
-  f:write(s)
-  f:close()
-end
-
--- FNV-1a 64 of everything before the last 8 bytes, stored there (the container's checksum).
-local function reseal(s)
-  local h = -3750763034362895579 -- 0xcbf29ce484222325
-  for i = 1, #s - 8 do h = (h ~ s:byte(i)) * 0x100000001b3 end
-  return s:sub(1, #s - 8) .. string.pack("<i8", h)
-end
-
-local function put(s, at, bytes) return s:sub(1, at) .. bytes .. s:sub(at + #bytes + 1) end
+local F = dofile("ckpt_files.lua")
+local read, write, reseal, put = F.read, F.write, F.reseal, F.put
 
 local good, bad = base .. "_good.ckpt", base .. "_bad.ckpt"
 local g = dsmc.scene{ dim = 2, size = { 0.05, 0.05 }, cells = { 4, 4 }, radius = 1e-3,

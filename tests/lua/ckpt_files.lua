@@ -1,0 +1,29 @@
+-- Byte-level helpers the checkpoint tests share: read and write a file whole, and forge files a
+-- real writer could have produced (the container's FNV-1a 64 checksum recomputed over a changed
+-- body, so that a changed field reaches the checks behind the checksum).
+local M = {}
+
+function M.read(path)
+  local f = assert(io.open(path, "rb"))
+  local s = f:read("a")
+  f:close()
+  return s
+end
+
+function M.write(path, s)
+  local f = assert(io.open(path, "wb"))
+  f:write(s)
+  f:close()
+end
+
+-- FNV-1a 64 of everything before the last 8 bytes, stored there (Lua integers wrap).
+function M.reseal(s)
+  local h = -3750763034362895579 -- 0xcbf29ce484222325
+  for i = 1, #s - 8 do h = (h ~ s:byte(i)) * 0x100000001b3 end
+  return s:sub(1, #s - 8) .. string.pack("<i8", h)
+end
+
+-- s with bytes written over it after position at.
+function M.put(s, at, bytes) return s:sub(1, at) .. bytes .. s:sub(at + #bytes + 1) end
+
+return M
