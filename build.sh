@@ -8,10 +8,11 @@ set -euo pipefail
 cd "$(dirname "$0")"
 
 # Debian packages: compiler and build tools, the libraries grainlab links, jq (tests read
-# report JSON with it) and python3-vtk9 (tests open the VTK files with VTK's readers).
+# report JSON with it), python3-vtk9 (tests open the VTK files with VTK's readers) and Open MPI
+# (distributed runs: mpirun -np K grainlab script.lua).
 packages=(build-essential cmake pkg-config liblua5.4-dev libreadline-dev libosmesa6-dev
           libpng-dev libfreetype-dev fonts-dejavu-core libcmocka-dev jq libqhull-dev
-          python3-vtk9)
+          python3-vtk9 libopenmpi-dev openmpi-bin)
 
 install_packages() {
     local missing=()

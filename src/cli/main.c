@@ -13,6 +13,7 @@
 #include <lauxlib.h>
 
 #include "cli/cli.h"
+#include "core/comm.h"
 #include "core/fileio.h"
 #include "core/interrupt.h"
 #include "core/progress.h"
@@ -329,11 +330,8 @@ static int run_script(lua_State *L, const char *script)
     return run_chunk(L, status);
 }
 
-int main(int argc, char **argv)
+static int cli_main(int argc, char **argv)
 {
-    /* Line-buffered even into a pipe, so printed results and progress lines on stderr
-     * interleave in logs the way they happened. */
-    setvbuf(stdout, NULL, _IOLBF, 0);
     cli_args a = {0};
     a.chunks = calloc((size_t)argc, sizeof *a.chunks);
     a.params = calloc((size_t)argc, sizeof *a.params);
@@ -393,5 +391,17 @@ int main(int argc, char **argv)
     lua_close(L);
     free(a.chunks);
     free(a.params);
+    return status;
+}
+
+int main(int argc, char **argv)
+{
+    /* Line-buffered even into a pipe, so printed results and progress lines on stderr
+     * interleave in logs the way they happened. */
+    setvbuf(stdout, NULL, _IOLBF, 0);
+    /* Under mpirun every rank runs the same script (SPMD); without it, no MPI at all. */
+    comm_init(&argc, &argv);
+    int status = cli_main(argc, argv);
+    comm_finalize();
     return status;
 }
