@@ -34,6 +34,12 @@ dem_scene_def dem_default_scene_def(void);
 core_status dem_create(const dem_scene_def *def, dem_scene **out, core_error *err);
 void dem_destroy(dem_scene *s);
 int dem_dim(const dem_scene *s);
+/* Distributed runs (MPI, more than one rank): dem_run decomposes the scene over the ranks; this
+ * gathers it back to every rank, as one rank would hold it (collective: every rank calls it). A
+ * no-op when the scene is not decomposed. Every call below other than dem_run and the scalar
+ * queries (time, steps, walls) needs the whole scene: the bindings call this first. */
+core_status dem_replicate(dem_scene *s, core_error *err);
+int dem_distributed(const dem_scene *s);
 
 /* ---- materials ----------------------------------------------------------------------------- */
 typedef struct dem_material {

@@ -18,6 +18,7 @@ typedef struct dem_wall {
     int material;
     double *hist[4];       /* SPRING law, per particle: see dem_pairs.hist */
     uint32_t *cand;        /* particles within r + skin of the wall at the last list build */
+    double *cand_fn;       /* distributed runs: each candidate's normal force (domain.c) */
     size_t ncand, cap_cand;
     double point_build[3]; /* the wall's point at the last list build (skin test) */
     double fn;             /* normal force the wall exerts on the particles, last evaluation */
@@ -99,6 +100,14 @@ struct dem_scene {
 
     struct dem_boundary *bnd; /* boundary conditions (boundary.c); NULL when none */
 
+    /* Distributed runs (domain.c): NULL on one rank and whenever the scene is replicated. While
+     * decomposed, the arrays above hold this rank's owned particles and its ghosts (copies of
+     * other ranks' particles within a cutoff + skin of its region), sorted by global id, so
+     * that pair lists, force sums and history carry-over follow the one-rank order. */
+    struct dem_domain *dom;
+    uint32_t *gid;         /* global id (the one-rank index) of each local particle */
+    unsigned char *ghost;  /* 1: a copy, integrated here but overwritten by the halo */
+
     /* Energy watch (integrate.c): in a scene without drivers the mechanical energy must not
      * grow; checked every DEM_WATCH_EVERY steps against the lowest energy since the reference,
      * which any change to the scene from outside a step resets (dem_invalidate). */
@@ -107,7 +116,35 @@ struct dem_scene {
     double watch_min, watch_min_t, watch_scale;
 };
 
+/* domain.c: the decomposition over MPI ranks (comm.h). dem_domain_start decomposes a replicated
+ * scene at the start of a run when there is more than one rank; dem_replicate (dem.h) gathers it
+ * back. While decomposed, forces() calls dem_domain_rebuild instead of dem_build_pairs (migration,
+ * ghosts, history, then the list) or dem_domain_halo (ghost positions and velocities) first, and
+ * every rank agrees on each error with dem_domain_agree. */
+typedef struct dem_domain dem_domain;
+core_status dem_domain_start(dem_scene *s, core_error *err);
+core_status dem_domain_rebuild(dem_scene *s, core_error *err);
+void dem_domain_halo(dem_scene *s);
+/* Every rank's wall forces summed in global-id order (the one-rank order). */
+core_status dem_domain_wall_sums(dem_scene *s, core_error *err);
+/* All ranks return the status of the lowest-numbered failing rank, with its message. */
+core_status dem_domain_agree(dem_scene *s, core_status st, core_error *err);
+/* The same, and *flag becomes the or of every rank's *flag (one reduction for both). */
+core_status dem_domain_agree_flag(dem_scene *s, core_status st, int *flag, core_error *err);
+/* The largest squared displacement of an owned particle since the last build. */
+double dem_domain_displacement2(const dem_scene *s);
+void dem_domain_free(dem_scene *s);
+size_t dem_domain_count(const dem_scene *s); /* particles on all ranks */
+/* History of the pairs of local particle i as first index (sorted by the partner's global id),
+ * carried to its new rank by the last rebuild: n entries, partner ids and 4 values each. */
+size_t dem_domain_bundle(const dem_scene *s, size_t i, const uint32_t **gj, const double **h);
+/* The global id (1-based in messages: + 1) of local particle i. */
+static inline size_t dem_gid(const dem_scene *s, size_t i) { return s->gid ? s->gid[i] : i; }
+
 /* neighbor.c */
+void dem_wrap_positions(dem_scene *s);
+/* After p->i, j and n are filled: p->start, jstart and jpair from them. */
+core_status dem_pairs_index(dem_scene *s, core_error *err);
 core_status dem_build_pairs(dem_scene *s, core_error *err);
 void dem_free_pairs(dem_pairs *p);
 void dem_pair_parameters(dem_scene *s, size_t i, size_t j, double *k, double *gamma, double *mu);

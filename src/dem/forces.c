@@ -89,12 +89,15 @@ static inline double regularized(const dem_contact_def *c, const dem_power *pw, 
 size_t dem_compute_forces(dem_scene *s, double dt)
 {
     s->force_evals++;
+    size_t t;
     if (s->dim == 2) {
         pair_forces_2(s, dt);
         gather_2(s);
-        return walls_2(s, dt);
+        t = walls_2(s, dt);
+    } else {
+        pair_forces_3(s, dt);
+        gather_3(s);
+        t = walls_3(s, dt);
     }
-    pair_forces_3(s, dt);
-    gather_3(s);
-    return walls_3(s, dt);
+    return t;
 }

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/comm.h"
 #include "core/interrupt.h"
 #include "dem/dem_internal.h"
 
@@ -20,7 +21,7 @@ dem_run_def dem_default_run_def(void)
 static core_status prepare(dem_scene *s, const dem_run_def *run, core_error *err)
 {
     const int D = s->dim;
-    if (s->nmat == 0 || s->n == 0)
+    if (s->nmat == 0 || dem_domain_count(s) == 0)
         return core_fail(err, CORE_ERR_STATE, "the scene has no particles: add some first");
     if (s->contact.tangential == DEM_TANGENT_SPRING) {
         for (int w = 0; w < s->nwalls; w++) {
@@ -91,10 +92,10 @@ static int driven(const dem_scene *s)
             (wl->servo || wl->velocity[0] != 0 || wl->velocity[1] != 0 || wl->velocity[2] != 0))
             return 1;
     }
-    for (size_t i = 0; i < s->n; i++)
-        if (s->flags[i] & DEM_PRESCRIBED)
-            return 1;
-    return 0;
+    int pres = 0;
+    for (size_t i = 0; i < s->n && !pres; i++)
+        pres = (s->flags[i] & DEM_PRESCRIBED) != 0;
+    return s->dom ? comm_any(pres) : pres;
 }
 
 static core_status energy_watch(dem_scene *s, double dt, core_error *err)
@@ -154,9 +155,10 @@ static size_t check_domain(const dem_scene *s)
         if (s->periodic[d])
             continue;
         const double lo = s->lo[d], hi = s->hi[d];
+        const unsigned char *gh = s->ghost; /* distributed: a ghost's state is its owner's */
 #pragma omp parallel for schedule(static) reduction(min : bad) if (n > 4096)
         for (long i = 0; i < n; i++)
-            if ((s->x[d][i] < lo || s->x[d][i] > hi) && (size_t)i < bad)
+            if ((s->x[d][i] < lo || s->x[d][i] > hi) && (size_t)i < bad && !(gh && gh[i]))
                 bad = (size_t)i;
     }
     return bad;
@@ -191,8 +193,12 @@ static double max_displacement2(const dem_scene *s)
 
 /* Forces at the current state; the list is rebuilt first when a particle moved more than half
  * the skin since the last build, or a wall did. disp2 < 0: not known, measure it. */
+static core_status forces_distributed(dem_scene *s, double dt, core_error *err);
+
 static core_status forces(dem_scene *s, double dt, double disp2, core_error *err)
 {
+    if (s->dom)
+        return forces_distributed(s, dt, err);
     const double lim = 0.25 * s->skin * s->skin;
     if (!s->need_rebuild && s->pairs.start) {
         if (disp2 < 0)
@@ -233,6 +239,52 @@ static core_status forces(dem_scene *s, double dt, double disp2, core_error *err
     return CORE_OK;
 }
 
+/* The same on a decomposed scene: every rank takes the same branch (one rebuild test for all,
+ * one verdict on errors), so that the collective calls match. */
+static int walls_moved(const dem_scene *s, double lim)
+{
+    for (int w = 0; w < s->nwalls; w++) {
+        const dem_wall *wl = &s->walls[w];
+        double d2 = 0;
+        for (int d = 0; d < s->dim; d++)
+            d2 += (wl->point[d] - wl->point_build[d]) * (wl->point[d] - wl->point_build[d]);
+        if (wl->active && d2 > lim)
+            return 1;
+    }
+    return 0;
+}
+
+static core_status forces_distributed(dem_scene *s, double dt, core_error *err)
+{
+    const double lim = 0.25 * s->skin * s->skin;
+    int need = s->need_rebuild || !s->pairs.start || walls_moved(s, lim) ||
+               dem_domain_displacement2(s) > lim;
+    core_status st;
+    if (comm_any(need)) {
+        if ((st = dem_domain_rebuild(s, err))) {
+            if (err) {
+                char msg[sizeof err->msg];
+                snprintf(msg, sizeof msg, "%s", err->msg);
+                core_fail(err, st, "%s (at step %ld, t = %.6g s)", msg, s->steps + 1, s->time);
+            }
+            return st;
+        }
+    } else {
+        dem_domain_halo(s);
+    }
+    size_t t = dem_compute_forces(s, dt);
+    st = dem_domain_wall_sums(s, err);
+    if (!st && t != (size_t)-1)
+        st = unstable(s, dem_gid(s, t), "went through a wall", err);
+    st = dem_domain_agree(s, st, err);
+    if (st) {
+        dem_invalidate(s, 1);
+        return st;
+    }
+    s->forces_ready = 1;
+    return CORE_OK;
+}
+
 static void move_walls(dem_scene *s, double dt)
 {
     for (int w = 0; w < s->nwalls; w++) {
@@ -255,11 +307,12 @@ static size_t check_finite(const dem_scene *s)
     size_t bad = (size_t)-1;
     const long n = (long)s->n;
     const int D = s->dim;
+    const unsigned char *gh = s->ghost;
 #pragma omp parallel for schedule(static) reduction(min : bad) if (n > 4096)
     for (long i = 0; i < n; i++)
         for (int d = 0; d < D; d++)
             if (!isfinite(s->x[d][i]) || !isfinite(s->v[d][i]))
-                if ((size_t)i < bad)
+                if ((size_t)i < bad && !(gh && gh[i]))
                     bad = (size_t)i;
     return bad;
 }
@@ -557,8 +610,15 @@ core_status dem_run(dem_scene *s, const dem_run_def *run, core_error *err)
         (run->tt_m < 1 || run->tt_n < 1 || run->tt_q < 0))
         return core_fail(err, CORE_ERR_ARG, "two timescales needs m >= 1, n >= 1, q >= 0 "
                          "(got %d, %d, %d)", run->tt_m, run->tt_n, run->tt_q);
+    if (comm_size() > 1 && s->bnd)
+        return core_fail(err, CORE_ERR_STATE,
+                         "boundary conditions (pressure tractions, the minimal boundary, springs, "
+                         "ties to walls, prescribed spins) do not yet run distributed "
+                         "(comm_size() > 1): run this scene on one rank");
     core_status st = prepare(s, run, err);
     if (st)
+        return st;
+    if (run->steps > 0 && (st = dem_domain_start(s, err)))
         return st;
     if ((int)run->integrator != s->last_integrator) {
         s->gear_ready = s->prev_ready = s->watch_on = 0;
@@ -567,8 +627,9 @@ core_status dem_run(dem_scene *s, const dem_run_def *run, core_error *err)
     }
     long done = 0;
     const long cycle = run->tt_n + run->tt_q;
+    int intr = 0; /* distributed: every rank's Ctrl-C, agreed at the end of each step */
     while (done < run->steps) {
-        if (interrupt_pending())
+        if (s->dom ? intr : interrupt_pending())
             return core_fail(err, CORE_ERR_INTERRUPTED,
                              "interrupted at step %ld (t = %.6g s); the scene is intact",
                              s->steps, s->time);
@@ -597,6 +658,20 @@ core_status dem_run(dem_scene *s, const dem_run_def *run, core_error *err)
             break;
         default:
             st = step_velocity_verlet(s, h, err);
+        }
+        if (s->dom) { /* the checks on every rank, one verdict, the first failing rank's words */
+            if (!st) {
+                size_t bad = check_finite(s);
+                if (bad != (size_t)-1)
+                    st = unstable(s, dem_gid(s, bad), "has a non-finite position or velocity", err);
+                else if ((bad = check_domain(s)) != (size_t)-1)
+                    st = unstable(s, dem_gid(s, bad),
+                                  "left the domain (a box side without a wall and not periodic)",
+                                  err);
+            }
+            intr = interrupt_pending();
+            st = dem_domain_agree_flag(s, st, &intr, err);
+            s->suspect = 0;
         }
         if (st) {
             dem_invalidate(s, 1);
@@ -637,16 +712,20 @@ core_status dem_timestep_info(const dem_scene *s, double v_imp, dem_timestep *ou
                               core_error *err)
 {
     const int D = s->dim;
-    if (s->n == 0 || s->nmat == 0)
+    if (dem_domain_count(s) == 0 || s->nmat == 0)
         return core_fail(err, CORE_ERR_STATE, "the scene has no particles: add some first");
     if (!(v_imp > 0)) {
         double vmax2 = 0, h = 0, g = 0;
         for (size_t i = 0; i < s->n; i++) {
+            if (s->ghost && s->ghost[i])
+                continue;
             double v2 = 0;
             for (int d = 0; d < D; d++)
                 v2 += s->v[d][i] * s->v[d][i];
             vmax2 = fmax(vmax2, v2);
         }
+        if (s->dom) /* a max: exact, whatever the decomposition */
+            comm_max_double(&vmax2, 1);
         for (int d = 0; d < D; d++) {
             g += s->gravity[d] * s->gravity[d];
             if (s->gravity[d] != 0)
@@ -660,10 +739,29 @@ core_status dem_timestep_info(const dem_scene *s, double v_imp, dem_timestep *ou
     for (int mat = 0; mat < s->nmat; mat++) {
         size_t i = (size_t)-1;
         for (size_t k = 0; k < s->n; k++)
-            if (s->mat[k] == mat && (i == (size_t)-1 || s->r[k] < s->r[i]))
+            if (s->mat[k] == mat && (i == (size_t)-1 || s->r[k] < s->r[i]) &&
+                !(s->ghost && s->ghost[k]))
                 i = k;
-        if (i == (size_t)-1)
+        if (s->dom) {
+            /* One rank's choice, the first smallest particle of the material, across ranks: the
+             * smallest radius, then the smallest id; its owner alone computes the limits. */
+            double rmin = i == (size_t)-1 ? INFINITY : s->r[i];
+            comm_min_double(&rmin, 1);
+            int64_t g = i != (size_t)-1 && s->r[i] == rmin ? (int64_t)dem_gid(s, i) : INT64_MAX;
+            comm_min_i64(&g, 1);
+            if (g == INT64_MAX)
+                continue;
+            if (i != (size_t)-1 && (int64_t)dem_gid(s, i) != g)
+                i = (size_t)-1;
+        }
+        if (i == (size_t)-1) {
+            if (s->dom) { /* take part in the reductions below */
+                double t = INFINITY, b = 0;
+                comm_min_double(&t, 1);
+                comm_max_double(&b, 1);
+            }
             continue;
+        }
         double k, gamma, mu;
         dem_pair_parameters((dem_scene *)s, i, i, &k, &gamma, &mu);
         double m_eff = 0.5 * s->m[i];
@@ -677,6 +775,10 @@ core_status dem_timestep_info(const dem_scene *s, double v_imp, dem_timestep *ou
         double b = gamma / (2 * m_eff);
         if (s->contact.damping == DEM_DAMPING_BRILLIANTOV) /* rate T k d^{1/2} / (2 m_eff) */
             b = gamma * k * sqrt(dmax) / (2 * m_eff);
+        if (s->dom) {
+            comm_min_double(&t, 1);
+            comm_max_double(&b, 1);
+        }
         bmax = fmax(bmax, b);
     }
     out->impact_velocity = v_imp;

@@ -4,6 +4,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "core/comm.h"
 #include "dem/dem_internal.h"
 
 /* Geometry of pair q now: returns the overlap (<= 0 when apart) and fills n (from j to i). */
@@ -40,8 +41,11 @@ void dem_measure_energy(dem_scene *s, dem_energy *e)
 {
     const int D = s->dim;
     memset(e, 0, sizeof *e);
+    /* Distributed (the run's energy watch): each rank its owned particles and their pairs as
+     * first particle, then a sum over ranks, the same on every rank. */
+    const unsigned char *gh = s->ghost;
     for (size_t i = 0; i < s->n; i++) {
-        if (s->flags[i] & DEM_FIXED)
+        if ((s->flags[i] & DEM_FIXED) || (gh && gh[i]))
             continue;
         double v2 = 0, gx = 0;
         for (int d = 0; d < D; d++) {
@@ -62,6 +66,8 @@ void dem_measure_energy(dem_scene *s, dem_energy *e)
         dem_build_pairs(s, NULL);
     const dem_pairs *p = &s->pairs;
     for (size_t q = 0; q < p->n; q++) {
+        if (gh && gh[p->i[q]])
+            continue;
         double n[3], dist;
         double delta = pair_geometry(s, p->i[q], p->j[q], n, &dist);
         if (delta <= 0)
@@ -80,7 +86,7 @@ void dem_measure_energy(dem_scene *s, dem_energy *e)
             continue;
         for (size_t i = 0; i < s->n; i++) {
             double delta = wall_overlap(s, wl, i);
-            if (delta <= 0)
+            if (delta <= 0 || (gh && gh[i]))
                 continue;
             double k, gamma, mu;
             dem_wall_parameters(s, wl, i, &k, &gamma, &mu);
@@ -92,6 +98,11 @@ void dem_measure_energy(dem_scene *s, dem_energy *e)
                 e->elastic += spring_energy(f2, wl->hist[3][i]);
             }
         }
+    }
+    if (s->dom) {
+        double v[4] = {e->kinetic, e->rotational, e->elastic, e->potential};
+        comm_sum_double(v, 4);
+        e->kinetic = v[0], e->rotational = v[1], e->elastic = v[2], e->potential = v[3];
     }
     e->total = e->kinetic + e->rotational + e->elastic + e->potential;
 }

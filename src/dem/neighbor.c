@@ -133,6 +133,9 @@ static core_status reserve_pairs(dem_scene *s, size_t n, core_error *err)
 static core_status setup_cells(dem_scene *s, double cutoff, core_error *err)
 {
     const int D = s->dim;
+    /* Distributed: the global count, so that every rank has the same cells (and the same
+     * verdict on a periodic axis too short). */
+    const size_t count = s->dom ? dem_domain_count(s) : s->n;
     size_t total = 1;
     double size = cutoff;
     for (int pass = 0; pass < 64; pass++) {
@@ -147,7 +150,7 @@ static core_status setup_cells(dem_scene *s, double cutoff, core_error *err)
             s->cell_size[d] = s->len[d] / nc;
             total *= (size_t)nc;
         }
-        if (total <= 2 * s->n + 64)
+        if (total <= 2 * count + 64)
             break;
         size *= 1.25;
     }
@@ -219,6 +222,9 @@ static size_t scan(const dem_scene *s, size_t i, uint32_t *out)
         }
     }
     size_t count = 0;
+    /* Distributed: a pair of two ghosts is no owned particle's business. */
+    const unsigned char *gh = s->ghost;
+    const int gi = gh && gh[i];
     int k[3];
     for (k[2] = lo[2]; k[2] <= hi[2]; k[2]++)
         for (k[1] = lo[1]; k[1] <= hi[1]; k[1]++)
@@ -232,7 +238,7 @@ static size_t scan(const dem_scene *s, size_t i, uint32_t *out)
                 size_t cell = cell_index(s, cc);
                 for (size_t e = s->cell_start[cell]; e < s->cell_start[cell + 1]; e++) {
                     uint32_t j = s->cell_items[e];
-                    if (j <= i)
+                    if (j <= i || (gi && gh[j]))
                         continue;
                     double cut = s->r[i] + s->r[j] + s->skin;
                     if (dist2(s, i, j) < cut * cut) {
@@ -251,15 +257,11 @@ static int cmp_u32(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-core_status dem_build_pairs(dem_scene *s, core_error *err)
+/* Wraps positions on periodic axes into the box (the list is built from wrapped positions). */
+void dem_wrap_positions(dem_scene *s)
 {
-    const int D = s->dim;
     const size_t n = s->n;
-    dem_pairs *p = &s->pairs;
-    s->skin = s->skin_def > 0 ? s->skin_def : 0.2 * s->r_max;
-
-    /* Wrap positions on periodic axes into the box (the list is built from wrapped positions). */
-    for (int d = 0; d < D; d++) {
+    for (int d = 0; d < s->dim; d++) {
         if (!s->periodic[d])
             continue;
         for (size_t i = 0; i < n; i++) {
@@ -274,6 +276,56 @@ core_status dem_build_pairs(dem_scene *s, core_error *err)
             }
         }
     }
+}
+
+/* Incidence as j: pair indices in pair order, per particle. */
+static core_status index_j(dem_scene *s, core_error *err)
+{
+    dem_pairs *p = &s->pairs;
+    const size_t n = s->n, npairs = p->n;
+    core_status st;
+    if ((st = alloc_size(&p->jstart, n + 1, err)) || (st = alloc_u32(&p->jpair, npairs, err)))
+        return st;
+    memset(p->jstart, 0, (n + 1) * sizeof(size_t));
+    for (size_t q = 0; q < npairs; q++)
+        p->jstart[p->j[q] + 1]++;
+    for (size_t i = 0; i < n; i++)
+        p->jstart[i + 1] += p->jstart[i];
+    size_t *fill = malloc((n ? n : 1) * sizeof *fill);
+    if (!fill)
+        return core_fail(err, CORE_ERR_NOMEM, "cannot allocate the incidence list");
+    if (n > 0)
+        memcpy(fill, p->jstart, n * sizeof *fill);
+    for (size_t q = 0; q < npairs; q++)
+        p->jpair[fill[p->j[q]]++] = (uint32_t)q;
+    free(fill);
+    return CORE_OK;
+}
+
+core_status dem_pairs_index(dem_scene *s, core_error *err)
+{
+    dem_pairs *p = &s->pairs;
+    const size_t n = s->n;
+    core_status st = alloc_size(&p->start, n + 1, err);
+    if (st)
+        return st;
+    memset(p->start, 0, (n + 1) * sizeof(size_t));
+    for (size_t q = 0; q < p->n; q++)
+        p->start[p->i[q] + 1]++;
+    for (size_t i = 0; i < n; i++)
+        p->start[i + 1] += p->start[i];
+    p->np = n;
+    return index_j(s, err);
+}
+
+core_status dem_build_pairs(dem_scene *s, core_error *err)
+{
+    const int D = s->dim;
+    const size_t n = s->n;
+    dem_pairs *p = &s->pairs;
+    s->skin = s->skin_def > 0 ? s->skin_def : 0.2 * s->r_max;
+
+    dem_wrap_positions(s);
 
     core_status st = setup_cells(s, 2 * s->r_max + s->skin, err);
     if (st)
@@ -348,12 +400,30 @@ core_status dem_build_pairs(dem_scene *s, core_error *err)
         if (dist2(s, p->i[q], p->j[q]) == 0) {
             core_status bad = core_fail(err, CORE_ERR_ARG, "particles %u and %u are at the same "
                                         "position: the contact normal is undefined",
-                                        p->i[q] + 1, p->j[q] + 1);
+                                        (unsigned)dem_gid(s, p->i[q]) + 1,
+                                        (unsigned)dem_gid(s, p->j[q]) + 1);
             dem_free_pairs(&old);
             s->need_rebuild = 1;
             return bad;
         }
-    if (p->hist[0]) {
+    if (p->hist[0] && s->dom) {
+        /* Distributed: the history came with each first particle (its bundle, domain.c). */
+#pragma omp parallel for schedule(static) if (n > 4096)
+        for (size_t i = 0; i < n; i++) {
+            const uint32_t *gj;
+            const double *h;
+            size_t nb = dem_domain_bundle(s, i, &gj, &h), o = 0;
+            for (size_t q = start[i]; q < start[i + 1]; q++) {
+                const uint32_t g = s->gid[p->j[q]];
+                while (o < nb && gj[o] < g)
+                    o++;
+                int same = o < nb && gj[o] == g;
+                for (int d = 0; d < D; d++)
+                    p->hist[d][q] = same ? h[4 * o + d] : 0;
+                p->hist[3][q] = same ? h[4 * o + 3] : 0;
+            }
+        }
+    } else if (p->hist[0]) {
         size_t old_np = carry ? (old.np < n ? old.np : n) : 0;
 #pragma omp parallel for schedule(static) if (n > 4096)
         for (size_t i = 0; i < n; i++) {
@@ -376,27 +446,9 @@ core_status dem_build_pairs(dem_scene *s, core_error *err)
             memset(p->c[d], 0, (npairs ? npairs : 1) * sizeof(double));
     }
 
-    /* Incidence as j: pair indices in pair order, per particle. */
-    if ((st = alloc_size(&p->jstart, n + 1, err)) || (st = alloc_u32(&p->jpair, npairs, err))) {
+    if ((st = index_j(s, err))) {
         dem_free_pairs(&old);
         return st;
-    }
-    memset(p->jstart, 0, (n + 1) * sizeof(size_t));
-    for (size_t q = 0; q < npairs; q++)
-        p->jstart[p->j[q] + 1]++;
-    for (size_t i = 0; i < n; i++)
-        p->jstart[i + 1] += p->jstart[i];
-    {
-        size_t *fill = malloc((n ? n : 1) * sizeof *fill);
-        if (!fill) {
-            dem_free_pairs(&old);
-            return core_fail(err, CORE_ERR_NOMEM, "cannot allocate the incidence list");
-        }
-        if (n > 0)
-            memcpy(fill, p->jstart, n * sizeof *fill);
-        for (size_t q = 0; q < npairs; q++)
-            p->jpair[fill[p->j[q]]++] = (uint32_t)q;
-        free(fill);
     }
 
     /* Wall candidates: particles that can touch the wall before the next build (within r + skin,
@@ -407,6 +459,8 @@ core_status dem_build_pairs(dem_scene *s, core_error *err)
             continue;
         wl->ncand = 0;
         for (size_t i = 0; i < n; i++) {
+            if (s->ghost && s->ghost[i])
+                continue; /* distributed: walls act on owned particles only */
             double dist = 0;
             for (int d = 0; d < D; d++)
                 dist += (s->x[d][i] - wl->point[d]) * wl->normal[d];
@@ -426,6 +480,14 @@ core_status dem_build_pairs(dem_scene *s, core_error *err)
         }
         for (int d = 0; d < 3; d++)
             wl->point_build[d] = wl->point[d];
+        if (s->dom) {
+            double *c = realloc(wl->cand_fn, (wl->cap_cand ? wl->cap_cand : 1) * sizeof *c);
+            if (!c) {
+                dem_free_pairs(&old);
+                return core_fail(err, CORE_ERR_NOMEM, "cannot allocate wall candidates");
+            }
+            wl->cand_fn = c;
+        }
     }
 
     for (int d = 0; d < D && n > 0; d++) /* an empty scene has no arrays yet (memcpy of NULL is UB) */

@@ -97,6 +97,7 @@ void dem_destroy(dem_scene *s)
 {
     if (!s)
         return;
+    dem_domain_free(s);
     dem_clear_boundary(s);
     for (int d = 0; d < 3; d++) {
         free(s->x[d]), free(s->v[d]), free(s->f[d]), free(s->w[d]), free(s->tq[d]);
@@ -415,7 +416,7 @@ long dem_add_particle(dem_scene *s, const dem_particle_def *p, core_error *err)
     return (long)i;
 }
 
-size_t dem_count(const dem_scene *s) { return s->n; }
+size_t dem_count(const dem_scene *s) { return dem_domain_count(s); }
 const double *dem_positions(const dem_scene *s, int d) { return s->x[d]; }
 const double *dem_velocities(const dem_scene *s, int d) { return s->v[d]; }
 const double *dem_angular_velocities(const dem_scene *s, int d) { return s->w[d]; }

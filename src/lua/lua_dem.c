@@ -16,7 +16,8 @@ typedef struct lscene {
     dem_scene *s;
 } lscene;
 
-static dem_scene *check_scene(lua_State *L, int idx)
+/* The scene as its run left it: decomposed over the ranks after a distributed run (s:run only). */
+static dem_scene *check_scene_local(lua_State *L, int idx)
 {
     lscene *u = luaL_checkudata(L, idx, SCENE);
     if (!u->s)
@@ -24,12 +25,27 @@ static dem_scene *check_scene(lua_State *L, int idx)
     return u->s;
 }
 
+/* Every other call sees the whole scene: after a distributed run it is gathered back to every
+ * rank first (collective: every rank of an SPMD script makes the same calls). */
+static dem_scene *replicated(lua_State *L, dem_scene *s, const char *call)
+{
+    core_error err;
+    if (dem_replicate(s, &err) != CORE_OK)
+        bind_raise(L, call, &err);
+    return s;
+}
+
+static dem_scene *check_scene(lua_State *L, int idx)
+{
+    return replicated(L, check_scene_local(L, idx), "scene");
+}
+
 struct dem_scene *bind_check_dem_scene(lua_State *L, int idx, const char *call)
 {
     lscene *u = bind_check_udata(L, idx, SCENE, call);
     if (!u->s)
         luaL_error(L, "%s: the dem.scene was closed", call);
-    return u->s;
+    return replicated(L, u->s, call);
 }
 
 /* ---- dem.scene{...} ------------------------------------------------------------------------ */
@@ -535,7 +551,7 @@ static const char *const RUN_FIELDS[] = {"steps",      "time",     "dt", "force"
 
 static int l_run(lua_State *L)
 {
-    dem_scene *s = check_scene(L, 1);
+    dem_scene *s = check_scene_local(L, 1); /* a run continues a decomposed scene as it is */
     bind_refuse_running(L, 1, "run", "return false from on_step to stop it");
     bind_check_table(L, 2, "run");
     bind_check_fields(L, 2, "run", RUN_FIELDS);

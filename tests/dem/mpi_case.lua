@@ -1,0 +1,108 @@
+-- One DEM scene for the rank-count comparisons of tests/dem/mpi_compare.sh: run on 1, 2 and 3
+-- ranks, every rank writes what it sees (positions and velocities as %a, energies, wall forces)
+-- to out.<rank>; every file of every rank count must be the same bits.
+--   grainlab tests/dem/mpi_case.lua dim=2 integrator=velocity_verlet spring=1 walls=1
+--            periodic=0 servo=0 gravity=1 n=150 steps=300 out=PREFIX fast=0
+local P = params
+local dim = P.dim or 2
+local n = P.n or 150
+local steps = P.steps or 300
+local rank = tonumber(os.getenv("OMPI_COMM_WORLD_RANK") or "0")
+local per = (P.periodic or 0) == 1
+local L = 0.02
+local box = dim == 2 and { { 0, 0 }, { L, L } } or { { 0, 0, 0 }, { L, L, L } }
+local periodic = dim == 2 and { per, false } or { per, false, per }
+local g = (P.gravity or 1) == 1 and -9.81 or 0
+local grav = dim == 2 and { 0, g } or { 0, g, 0 }
+local s = dem.scene{ dim = dim, box = box, gravity = grav, periodic = periodic,
+                     skin = P.skin }
+local quartz = grainlab.material{ name = "quartz", density = 2650, young = 1e8, poisson = 0.3,
+                                  friction = 0.45, restitution = 0.9 }
+s:contact{ normal = "hertz", damping = "viscous",
+           tangential = (P.spring or 1) == 1 and "spring" or "none" }
+-- a deterministic generator (the same on every rank, without grainlab's streams)
+local seed = 12345
+local function rnd()
+  seed = (seed * 1103515245 + 12345) % 2147483648
+  return seed / 2147483648
+end
+local walls = (P.walls or 1) == 1
+if walls then
+  s:add_wall{ point = dim == 2 and { 0, 0 } or { 0, 0, 0 }, normal = dim == 2 and { 0, 1 } or { 0, 1, 0 } }
+  if not per then
+    s:add_wall{ point = dim == 2 and { 0, 0 } or { 0, 0, 0 }, normal = dim == 2 and { 1, 0 } or { 1, 0, 0 } }
+    s:add_wall{ point = dim == 2 and { L, 0 } or { L, 0, 0 }, normal = dim == 2 and { -1, 0 } or { -1, 0, 0 } }
+    if dim == 3 then
+      s:add_wall{ point = { 0, 0, 0 }, normal = { 0, 0, 1 } }
+      s:add_wall{ point = { 0, 0, L }, normal = { 0, 0, -1 } }
+    end
+  end
+  if (P.servo or 0) == 0 then
+    s:add_wall{ point = dim == 2 and { 0, L } or { 0, L, 0 }, normal = dim == 2 and { 0, -1 } or { 0, -1, 0 } }
+  end
+end
+local top
+if (P.servo or 0) == 1 then
+  top = s:add_wall{ point = dim == 2 and { 0, 0.8 * L } or { 0, 0.8 * L, 0 },
+                    normal = dim == 2 and { 0, -1 } or { 0, -1, 0 } }
+  s:wall_servo(top, { force = 0.05, mass = 1e-3, rate = 50 })
+end
+-- particles on a jittered lattice in the lower part of the box (a pile that fills ~60 %)
+local r0 = dim == 2 and 0.0004 or 0.0007
+local sp = 2.3 * r0
+local per_row = math.floor((L - 2 * r0) / sp)
+local added = 0
+local k = 0
+while added < n do
+  local i, j, l = k % per_row, (k // per_row) % per_row, k // (per_row * per_row)
+  if dim == 2 then j, l = k // per_row, 0 end
+  k = k + 1
+  local x = r0 * 1.1 + i * sp + 0.2 * r0 * rnd()
+  local y = r0 * 1.1 + j * sp + 0.2 * r0 * rnd()
+  local z = r0 * 1.1 + l * sp + 0.2 * r0 * rnd()
+  local v = { (rnd() - 0.5) * 2, (rnd() - 0.5) * 2, (rnd() - 0.5) * 2 }
+  local rad = r0 * (0.8 + 0.2 * rnd())
+  if (P.fast or 0) == 1 and added == 0 then v[1] = 3.0 end -- crosses regions within one interval
+  if dim == 2 then
+    s:add_disk{ pos = { x, y }, radius = rad, material = quartz, vel = { v[1], v[2] } }
+  else
+    s:add_sphere{ pos = { x, y, z }, radius = rad, material = quartz, vel = v }
+  end
+  added = added + 1
+end
+local integ = P.integrator or "velocity_verlet"
+local dt = P.dt or 5e-7
+local chunks = P.chunks or 1
+for c = 1, chunks do
+  if integ == "two_timescales" then
+    s:run{ steps = steps // chunks, dt = dt / 2, integrator = integ, n = 2, q = 2, m = 1 }
+  else
+    s:run{ steps = steps // chunks, dt = dt, integrator = integ }
+  end
+end
+local f = assert(io.open((P.out or "out") .. "." .. rank, "w"))
+local p = s:particles()
+local axes = dim == 2 and { "x", "y" } or { "x", "y", "z" }
+local vax = dim == 2 and { "vx", "vy" } or { "vx", "vy", "vz" }
+local px, py, pz = 0, 0, 0
+for i = 1, #p.x do
+  local line = {}
+  for _, a in ipairs(axes) do line[#line + 1] = string.format("%a", p[a][i]) end
+  for _, a in ipairs(vax) do line[#line + 1] = string.format("%a", p[a][i]) end
+  if p.wz then line[#line + 1] = string.format("%a", p.wz[i]) end
+  f:write(table.concat(line, " "), "\n")
+end
+local e = s:measure("energy")
+f:write(string.format("count %d energy %a %a %a\n", #p.x, e.kinetic, e.elastic, e.total))
+local w = 1
+while walls do
+  local ok, fw = pcall(s.wall_force, s, w)
+  if not ok then break end
+  f:write(string.format("wall %d %a\n", w, fw))
+  w = w + 1
+end
+if top then
+  local wp = s:wall_point(top)
+  f:write(string.format("servo %a\n", wp[2]))
+end
+f:close()
