@@ -831,8 +831,8 @@ core_status dem_domain_rebuild(dem_scene *s, core_error *err)
         size_t own = 0;
         for (size_t i = 0; i < s->n; i++)
             own += !s->ghost[i];
-        fprintf(stderr, "rank %d rebuild %ld: %zu owned %zu ghosts, %d peers, %ld rebalances\n",
-                dm->me, dm->rebuilds, own, s->n - own, dm->npeer, dm->rebalances);
+        fprintf(stderr, "step %ld rank %d rebuild %ld: %zu owned %zu ghosts, %d peers, %ld rebalances\n",
+                s->steps, dm->me, dm->rebuilds, own, s->n - own, dm->npeer, dm->rebalances);
     }
     return dem_domain_agree(s, st, err);
 }

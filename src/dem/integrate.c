@@ -442,11 +442,12 @@ static core_status step_velocity_verlet(dem_scene *s, double dt, core_error *err
 static core_status step_position_verlet(dem_scene *s, double dt, core_error *err)
 {
     const int D = s->dim;
-    const long n = (long)s->n;
+    long n = (long)s->n; /* distributed: a rebuild in forces() changes the local count */
     core_status st;
     if (!s->prev_ready) {
         if ((st = forces(s, dt, -1, err)))
             return st;
+        n = (long)s->n;
         /* backward Taylor step: x(t) - x(t-dt) = v dt - a dt^2 / 2 */
         for (long i = 0; i < n; i++)
             for (int d = 0; d < D; d++)
@@ -462,6 +463,7 @@ static core_status step_position_verlet(dem_scene *s, double dt, core_error *err
     }
     if ((st = forces(s, dt, -1, err)))
         return st;
+    n = (long)s->n;
     const int rot = s->rot;
 #pragma omp parallel for schedule(static) if (n > 4096)
     for (long i = 0; i < n; i++) {
@@ -506,12 +508,13 @@ static void gear_predict(double *g[6], long n)
 static core_status step_gear(dem_scene *s, double dt, core_error *err)
 {
     const int D = s->dim, rot = s->rot;
-    const long n = (long)s->n;
+    long n = (long)s->n; /* distributed: a rebuild in forces() changes the local count */
     const int d0 = D == 2 ? 2 : 0;
     core_status st;
     if (!s->gear_ready) {
         if ((st = forces(s, dt, -1, err)))
             return st;
+        n = (long)s->n;
         for (long i = 0; i < n; i++) {
             for (int d = 0; d < D; d++) {
                 s->gear[0][d][i] = s->x[d][i];
@@ -577,6 +580,7 @@ static core_status step_gear(dem_scene *s, double dt, core_error *err)
     s->time += dt;
     if ((st = forces(s, dt, -1, err)))
         return st;
+    n = (long)s->n;
 #pragma omp parallel for schedule(static) if (n > 4096)
     for (long i = 0; i < n; i++) {
         if (!(s->inv_m[i] > 0))
