@@ -40,6 +40,14 @@ int dem_dim(const dem_scene *s);
  * queries (time, steps, walls) needs the whole scene: the bindings call this first. */
 core_status dem_replicate(dem_scene *s, core_error *err);
 int dem_distributed(const dem_scene *s);
+/* What the decomposition did so far (all zero until a run on more than one rank): list rebuilds
+ * while decomposed, rebalances of the regions, particles that changed rank (summed over ranks),
+ * and the fewest and most particles a rank owned after the last rebuild. The same on every rank. */
+typedef struct dem_domain_stats {
+    int ranks;
+    long rebuilds, rebalances, migrations, owned_min, owned_max;
+} dem_domain_stats;
+void dem_domain_stats_get(const dem_scene *s, dem_domain_stats *out);
 
 /* ---- materials ----------------------------------------------------------------------------- */
 typedef struct dem_material {

@@ -107,6 +107,7 @@ struct dem_scene {
     struct dem_domain *dom;
     uint32_t *gid;         /* global id (the one-rank index) of each local particle */
     unsigned char *ghost;  /* 1: a copy, integrated here but overwritten by the halo */
+    dem_domain_stats dstats; /* kept when the scene is gathered back */
 
     /* Energy watch (integrate.c): in a scene without drivers the mechanical energy must not
      * grow; checked every DEM_WATCH_EVERY steps against the lowest energy since the reference,

@@ -61,8 +61,23 @@ struct dem_domain {
     size_t *hb_start;
     uint32_t *hb_j;
     double *hb_h;
-    long rebuilds, rebalances;
 };
+
+void dem_domain_stats_get(const dem_scene *s, dem_domain_stats *out) { *out = s->dstats; }
+
+/* Fewest and most owned particles over the ranks (one reduction), into the stats. */
+static void owned_range(dem_scene *s, long migrated)
+{
+    int64_t own = 0;
+    for (size_t i = 0; i < s->n; i++)
+        own += !s->ghost[i];
+    int64_t v[3] = {own, -own, migrated};
+    comm_max_i64(v, 2);
+    comm_sum_i64(v + 2, 1);
+    s->dstats.owned_max = (long)v[0];
+    s->dstats.owned_min = (long)-v[1];
+    s->dstats.migrations += (long)v[2];
+}
 
 size_t dem_domain_count(const dem_scene *s) { return s->dom ? s->dom->n_global : s->n; }
 int dem_distributed(const dem_scene *s) { return s->dom != NULL; }
@@ -581,6 +596,10 @@ core_status dem_domain_start(dem_scene *s, core_error *err)
         st = build_halo(s, pos, err);
     free(it), free(idx), free(map), free(gh);
     st = dem_domain_agree(s, st, err);
+    if (!st) {
+        s->dstats.ranks = dm->P;
+        owned_range(s, 0);
+    }
     if (st) /* the scene is lost on this rank: a half-decomposed scene is no scene */
         return st;
     return CORE_OK;
@@ -650,15 +669,14 @@ enum { HDR = 3 * sizeof(uint32_t), BENTRY = sizeof(uint32_t) + 4 * sizeof(double
 static core_status rebalance(dem_scene *s, core_error *err)
 {
     dem_domain *dm = s->dom;
-    int64_t cnt[2] = {0, 0};
-    for (size_t i = 0; i < s->n; i++)
-        cnt[0] += !s->ghost[i];
-    cnt[1] = cnt[0];
-    comm_max_i64(&cnt[0], 1);
+    /* the counts of the last rebuild: the particles have moved by less than a skin since */
     double mean = (double)dm->n_global / dm->P;
-    if (!((double)cnt[0] > DEM_REBALANCE * mean && cnt[0] > 1))
+    if (!((double)s->dstats.owned_max > DEM_REBALANCE * mean && s->dstats.owned_max > 1))
         return CORE_OK;
-    rcb_item *mine = malloc((size_t)(cnt[1] ? cnt[1] : 1) * sizeof *mine);
+    size_t own = 0;
+    for (size_t i = 0; i < s->n; i++)
+        own += !s->ghost[i];
+    rcb_item *mine = malloc((own ? own : 1) * sizeof *mine);
     if (!mine)
         return core_fail(err, CORE_ERR_NOMEM, "cannot allocate the rebalance");
     size_t m = 0;
@@ -676,7 +694,7 @@ static core_status rebalance(dem_scene *s, core_error *err)
     free(mine);
     core_status st = build_regions(s, dm, all, bytes / sizeof(rcb_item), err);
     free(all);
-    dm->rebalances++;
+    s->dstats.rebalances++;
     return st;
 }
 
@@ -706,6 +724,7 @@ core_status dem_domain_rebuild(dem_scene *s, core_error *err)
                                 err);
     }
     size_t *soff = sbytes + P, *fill = sbytes + 2 * P;
+    long migrated = 0;
     static const double zero4[4] = {0, 0, 0, 0};
     for (size_t i = 0; i < s->n; i++) {
         if (s->ghost[i])
@@ -720,6 +739,7 @@ core_status dem_domain_rebuild(dem_scene *s, core_error *err)
         double c[3];
         position(s, s->x, i, c);
         int o = owner_of(dm, c);
+        migrated += o != dm->me;
         for (int r = 0; r < P; r++)
             if (r == o || near_region(s, dm, r, c))
                 sbytes[r] += HDR + rb + nb[i] * BENTRY;
@@ -826,13 +846,14 @@ core_status dem_domain_rebuild(dem_scene *s, core_error *err)
     if (!st)
         st = dem_build_pairs(s, err);
     free_bundles(dm);
-    dm->rebuilds++;
+    s->dstats.rebuilds++;
+    owned_range(s, migrated);
     if (getenv("DEM_DEBUG")) {
         size_t own = 0;
         for (size_t i = 0; i < s->n; i++)
             own += !s->ghost[i];
         fprintf(stderr, "step %ld rank %d rebuild %ld: %zu owned %zu ghosts, %d peers, %ld rebalances\n",
-                s->steps, dm->me, dm->rebuilds, own, s->n - own, dm->npeer, dm->rebalances);
+                s->steps, dm->me, s->dstats.rebuilds, own, s->n - own, dm->npeer, s->dstats.rebalances);
     }
     return dem_domain_agree(s, st, err);
 }

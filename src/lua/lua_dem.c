@@ -1009,6 +1009,20 @@ static int l_info(lua_State *L)
     lua_setfield(L, -2, "tangential");
     lua_pushnumber(L, c->damping_time);
     lua_setfield(L, -2, "damping_time");
+    dem_domain_stats ds;
+    dem_domain_stats_get(s, &ds);
+    if (ds.ranks > 1) { /* after a run on more than one rank */
+        lua_createtable(L, 0, 6);
+        const char *names[6] = {"ranks", "rebuilds", "rebalances", "migrations", "owned_min",
+                                "owned_max"};
+        long vals[6] = {ds.ranks, ds.rebuilds, ds.rebalances, ds.migrations, ds.owned_min,
+                        ds.owned_max};
+        for (int k = 0; k < 6; k++) {
+            lua_pushinteger(L, vals[k]);
+            lua_setfield(L, -2, names[k]);
+        }
+        lua_setfield(L, -2, "distributed");
+    }
     return 1;
 }
 
