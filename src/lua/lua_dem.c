@@ -433,7 +433,7 @@ static int l_remove_wall(lua_State *L)
 
 static int l_wall_velocity(lua_State *L)
 {
-    dem_scene *s = check_scene(L, 1);
+    dem_scene *s = check_scene_local(L, 1); /* walls and dt: the same on every rank */
     double v[3] = {0, 0, 0};
     const int id = wall_arg(L, 2, "wall_velocity");
     bind_arg_vector(L, 3, "wall_velocity", dem_dim(s), v);
@@ -445,7 +445,7 @@ static int l_wall_velocity(lua_State *L)
 
 static int l_wall_force(lua_State *L)
 {
-    dem_scene *s = check_scene(L, 1);
+    dem_scene *s = check_scene_local(L, 1); /* walls and dt: the same on every rank */
     double fn;
     core_error err;
     if (dem_wall_force(s, wall_arg(L, 2, "wall_force"), &fn, &err))
@@ -458,7 +458,7 @@ static const char *const SERVO_FIELDS[] = {"force", "mass", "rate", NULL};
 
 static int l_wall_servo(lua_State *L)
 {
-    dem_scene *s = check_scene(L, 1);
+    dem_scene *s = check_scene_local(L, 1); /* walls and dt: the same on every rank */
     const int id = wall_arg(L, 2, "wall_servo");
     double force = 0, mass = 0, rate = 0;
     if (!lua_isnoneornil(L, 3)) {
@@ -485,7 +485,7 @@ static void push_vector(lua_State *L, const double *v, int n)
 
 static int l_wall_point(lua_State *L)
 {
-    dem_scene *s = check_scene(L, 1);
+    dem_scene *s = check_scene_local(L, 1); /* walls and dt: the same on every rank */
     double p[3];
     core_error err;
     if (dem_wall_point(s, wall_arg(L, 2, "wall_point"), p, &err))
@@ -512,7 +512,7 @@ static const char *const TIMESTEP_FIELDS[] = {"impact_velocity", NULL};
 
 static int l_timestep(lua_State *L)
 {
-    dem_scene *s = check_scene(L, 1);
+    dem_scene *s = check_scene_local(L, 1); /* walls and dt: the same on every rank */
     double v = 0;
     if (!lua_isnoneornil(L, 2)) {
         bind_check_table(L, 2, "timestep");

@@ -1,0 +1,18 @@
+-- Boundary conditions (here springs) do not run distributed yet: under mpirun -np K > 1 the run
+-- must stop with an error that names them on every rank; on one rank the run works.
+local s = dem.scene{ dim = 2, box = { { 0, 0 }, { 0.01, 0.01 } } }
+local m = grainlab.material{ name = "quartz", density = 2650, young = 1e8, poisson = 0.3,
+                             friction = 0.45, restitution = 0.9 }
+s:add_disk{ pos = { 0.004, 0.005 }, radius = 0.0005, material = m }
+s:add_disk{ pos = { 0.0052, 0.005 }, radius = 0.0005, material = m }
+s:springs{ i = { 1 }, j = { 2 }, k = 10 }
+local ranks = tonumber(os.getenv("OMPI_COMM_WORLD_SIZE") or "1")
+local ok, err = pcall(s.run, s, { steps = 10, dt = 1e-7 })
+if ranks == 1 then
+  assert(ok, err)
+else
+  assert(not ok, "a run with springs went ahead on " .. ranks .. " ranks")
+  assert(tostring(err):find("do not yet run distributed", 1, true), err)
+  assert(tostring(err):find("springs", 1, true), err)
+end
+print("ok")
