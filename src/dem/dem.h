@@ -40,6 +40,10 @@ int dem_dim(const dem_scene *s);
  * queries (time, steps, walls) needs the whole scene: the bindings call this first. */
 core_status dem_replicate(dem_scene *s, core_error *err);
 int dem_distributed(const dem_scene *s);
+/* Distributed: the wall forces of the last evaluation, summed over the ranks in the one-rank
+ * order, before dem_wall_force reads them (collective; a no-op when already summed or on one
+ * rank). */
+core_status dem_sync_walls(dem_scene *s, core_error *err);
 /* What the decomposition did so far (all zero until a run on more than one rank): list rebuilds
  * while decomposed, rebalances of the regions, particles that changed rank (summed over ranks),
  * and the fewest and most particles a rank owned after the last rebuild. The same on every rank. */

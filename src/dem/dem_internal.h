@@ -126,8 +126,13 @@ typedef struct dem_domain dem_domain;
 core_status dem_domain_start(dem_scene *s, core_error *err);
 core_status dem_domain_rebuild(dem_scene *s, core_error *err);
 void dem_domain_halo(dem_scene *s);
-/* Every rank's wall forces summed in global-id order (the one-rank order). */
-core_status dem_domain_wall_sums(dem_scene *s, core_error *err);
+/* Every rank's wall forces summed in global-id order (the one-rank order): now when `now`, else
+ * at the next dem_sync_walls or dem_replicate. */
+core_status dem_domain_walls_due(dem_scene *s, int now, core_error *err);
+/* An error of this rank in a force evaluation, kept (the first one) until the end of the step;
+ * dem_domain_deferred returns it (and forgets it). */
+void dem_domain_defer(dem_scene *s, core_status st, const core_error *err);
+core_status dem_domain_deferred(dem_scene *s, core_error *err);
 /* All ranks return the status of the lowest-numbered failing rank, with its message. */
 core_status dem_domain_agree(dem_scene *s, core_status st, core_error *err);
 /* The same, and *flag becomes the or of every rank's *flag (one reduction for both). */

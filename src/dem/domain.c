@@ -61,6 +61,9 @@ struct dem_domain {
     size_t *hb_start;
     uint32_t *hb_j;
     double *hb_h;
+    int walls_pending;                /* wall forces not summed over the ranks yet */
+    core_status deferred;             /* this rank's first error of the step (forces) */
+    core_error deferred_err;
 };
 
 void dem_domain_stats_get(const dem_scene *s, dem_domain_stats *out) { *out = s->dstats; }
@@ -873,7 +876,45 @@ static int cmp_term(const void *pa, const void *pb)
     return (a->gid > b->gid) - (a->gid < b->gid);
 }
 
-core_status dem_domain_wall_sums(dem_scene *s, core_error *err)
+static core_status wall_sums(dem_scene *s, core_error *err);
+
+core_status dem_domain_walls_due(dem_scene *s, int now, core_error *err)
+{
+    s->dom->walls_pending = !now;
+    return now ? wall_sums(s, err) : CORE_OK;
+}
+
+core_status dem_sync_walls(dem_scene *s, core_error *err)
+{
+    if (!s->dom || !s->dom->walls_pending)
+        return CORE_OK;
+    s->dom->walls_pending = 0;
+    return wall_sums(s, err);
+}
+
+void dem_domain_defer(dem_scene *s, core_status st, const core_error *err)
+{
+    dem_domain *dm = s->dom;
+    if (st && !dm->deferred) {
+        dm->deferred = st;
+        if (err)
+            dm->deferred_err = *err;
+        else
+            memset(&dm->deferred_err, 0, sizeof dm->deferred_err), dm->deferred_err.status = st;
+    }
+}
+
+core_status dem_domain_deferred(dem_scene *s, core_error *err)
+{
+    dem_domain *dm = s->dom;
+    core_status st = dm->deferred;
+    if (st && err)
+        *err = dm->deferred_err;
+    dm->deferred = CORE_OK;
+    return st;
+}
+
+static core_status wall_sums(dem_scene *s, core_error *err)
 {
     size_t n = 0;
     for (int w = 0; w < s->nwalls; w++)
@@ -937,6 +978,9 @@ core_status dem_replicate(dem_scene *s, core_error *err)
     dem_domain *dm = s->dom;
     if (!dm)
         return CORE_OK;
+    core_status st0 = dem_sync_walls(s, err);
+    if (st0)
+        return st0;
     parray a[max_arrays(s)];
     int na = particle_arrays(s, a);
     const size_t rb = record_bytes(a, na);

@@ -273,14 +273,17 @@ static core_status forces_distributed(dem_scene *s, double dt, core_error *err)
         dem_domain_halo(s);
     }
     size_t t = dem_compute_forces(s, dt);
-    st = dem_domain_wall_sums(s, err);
+    /* A servo wall moves with the sum of every rank's forces: now. Otherwise the sum waits for
+     * a query (dem_sync_walls) and costs nothing per step. */
+    int servo = 0;
+    for (int w = 0; w < s->nwalls; w++)
+        servo |= s->walls[w].active && s->walls[w].servo;
+    st = dem_domain_walls_due(s, servo, err);
     if (!st && t != (size_t)-1)
         st = unstable(s, dem_gid(s, t), "went through a wall", err);
-    st = dem_domain_agree(s, st, err);
-    if (st) {
-        dem_invalidate(s, 1);
-        return st;
-    }
+    /* A local error waits for the end of the step, where every rank agrees on the first one:
+     * the rest of the step makes the same collective calls on every rank. */
+    dem_domain_defer(s, st, err);
     s->forces_ready = 1;
     return CORE_OK;
 }
@@ -664,6 +667,13 @@ core_status dem_run(dem_scene *s, const dem_run_def *run, core_error *err)
             st = step_velocity_verlet(s, h, err);
         }
         if (s->dom) { /* the checks on every rank, one verdict, the first failing rank's words */
+            core_error derr;
+            core_status d = dem_domain_deferred(s, &derr); /* consumed on every path */
+            if (!st && d) {
+                st = d;
+                if (err)
+                    *err = derr;
+            }
             if (!st) {
                 size_t bad = check_finite(s);
                 if (bad != (size_t)-1)

@@ -446,6 +446,9 @@ static int l_wall_velocity(lua_State *L)
 static int l_wall_force(lua_State *L)
 {
     dem_scene *s = check_scene_local(L, 1); /* walls and dt: the same on every rank */
+    core_error serr;
+    if (dem_sync_walls(s, &serr) != CORE_OK)
+        return bind_raise(L, "wall_force", &serr);
     double fn;
     core_error err;
     if (dem_wall_force(s, wall_arg(L, 2, "wall_force"), &fn, &err))
