@@ -16,3 +16,20 @@ else
   assert(tostring(err):find("springs", 1, true), err)
 end
 print("ok")
+
+-- An instability found by one rank (a particle through a wall, checked by its owner only) stops
+-- every rank at the same step with the one-rank message, without a hang.
+local t = dem.scene{ dim = 2, box = { { 0, 0 }, { 0.02, 0.01 } } }
+t:add_wall{ point = { 0, 0 }, normal = { 0, 1 } }
+t:add_wall{ point = { 0.02, 0 }, normal = { -1, 0 } }
+t:add_wall{ point = { 0, 0 }, normal = { 1, 0 } }
+t:add_wall{ point = { 0, 0.01 }, normal = { 0, -1 } }
+for k = 0, 19 do
+  t:add_disk{ pos = { 0.0007 + k * 0.00095, 0.001 }, radius = 0.0004, material = m,
+              vel = { k == 17 and 400 or 0, 0 } }
+end
+local ok2, err2 = pcall(t.run, t, { steps = 200, dt = 2e-7, force = true })
+assert(not ok2, "the run through the wall went ahead")
+local f = assert(io.open((params.out or "refuse") .. "." .. (os.getenv("OMPI_COMM_WORLD_RANK") or "0"), "w"))
+f:write(tostring(err2), "\n", t:info().steps, "\n")
+f:close()

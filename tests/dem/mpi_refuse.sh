@@ -1,13 +1,22 @@
 #!/bin/bash
 # A scene with a boundary condition (springs) runs on one rank and stops with an error naming it
-# on 2 ranks (tests/dem/mpi_refuse.lua checks the message on every rank).
+# on 2 ranks (tests/dem/mpi_refuse.lua checks the message on every rank); an instability one
+# rank finds stops every rank with the one-rank message at the same step.
 #   mpi_refuse.sh GRAINLAB MPIEXEC
 set -u
 grainlab=$1 mpiexec=$2
 here=$(cd "$(dirname "$0")" && pwd)
 . "$here/mpi_lib.sh"
-err=$(mktemp)
-trap 'rm -f "$err"' EXIT
-"$grainlab" --quiet "$here/mpi_refuse.lua" || { echo "FAIL: one rank"; exit 1; }
-mpi_run "$err" "$mpiexec" 2 "$grainlab" --quiet "$here/mpi_refuse.lua" || { echo "FAIL: 2 ranks"; exit 1; }
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+"$grainlab" --quiet "$here/mpi_refuse.lua" out="$out/np1" || { echo "FAIL: one rank"; exit 1; }
+for np in 2 3; do
+  mpi_run "$out/err$np" "$mpiexec" $np "$grainlab" --quiet "$here/mpi_refuse.lua" out="$out/np$np" ||
+    { echo "FAIL: $np ranks"; exit 1; }
+  for r in $(seq 0 $((np - 1))); do
+    cmp -s "$out/np1.0" "$out/np$np.$r" ||
+      { echo "FAIL: rank $r of $np stopped otherwise:"; diff "$out/np1.0" "$out/np$np.$r"; exit 1; }
+  done
+done
+cat "$out/np1.0"
 echo "OK"
