@@ -50,7 +50,12 @@ core_status dem_sync_walls(dem_scene *s, core_error *err);
 typedef struct dem_domain_stats {
     int ranks;
     long rebuilds, rebalances, migrations, owned_min, owned_max;
+    /* traffic to other ranks summed over the ranks: halo exchanges (every force evaluation
+     * without a rebuild), and rebuilds (migration, ghosts, history), in bytes and messages */
+    double halo_bytes, halo_messages, rebuild_bytes, rebuild_messages;
+    long halos;
 } dem_domain_stats;
+/* Collective when the scene ran on more than one rank (the traffic is summed over the ranks). */
 void dem_domain_stats_get(const dem_scene *s, dem_domain_stats *out);
 
 /* ---- materials ----------------------------------------------------------------------------- */

@@ -66,7 +66,17 @@ struct dem_domain {
     core_error deferred_err;
 };
 
-void dem_domain_stats_get(const dem_scene *s, dem_domain_stats *out) { *out = s->dstats; }
+void dem_domain_stats_get(const dem_scene *s, dem_domain_stats *out)
+{
+    *out = s->dstats;
+    if (out->ranks > 1) {
+        double v[4] = {out->halo_bytes, out->halo_messages, out->rebuild_bytes,
+                       out->rebuild_messages};
+        comm_sum_double(v, 4);
+        out->halo_bytes = v[0], out->halo_messages = v[1];
+        out->rebuild_bytes = v[2], out->rebuild_messages = v[3];
+    }
+}
 
 /* Fewest and most owned particles over the ranks (one reduction), into the stats. */
 static void owned_range(dem_scene *s, long migrated)
@@ -471,6 +481,10 @@ void dem_domain_halo(dem_scene *s)
         rb[k] = (dm->recv_start[k + 1] - dm->recv_start[k]) * W * sizeof(double);
     }
     comm_exchange(np, dm->peer, sp, sb, rp, rb, 0xde3);
+    for (int k = 0; k < np; k++)
+        if (sb[k])
+            s->dstats.halo_bytes += (double)sb[k], s->dstats.halo_messages++;
+    s->dstats.halos++;
     for (size_t e = 0; e < tr; e++) {
         size_t i = dm->recv_idx[e];
         const double *b = dm->rbuf + e * W;
@@ -789,6 +803,9 @@ core_status dem_domain_rebuild(dem_scene *s, core_error *err)
     size_t *rbytes = malloc(2 * (size_t)P * sizeof *rbytes);
     if (!rbytes)
         comm_abort(70);
+    for (int r = 0; r < P; r++)
+        if (r != dm->me && sbytes[r])
+            s->dstats.rebuild_bytes += (double)sbytes[r], s->dstats.rebuild_messages++;
     if (comm_alltoallv(sbuf, sbytes, soff, &recv, rbytes, rbytes + P)) {
         free(sbuf), free(sbytes), free(dest), free(rbytes);
         return dem_domain_agree(s, core_fail(err, CORE_ERR_NOMEM, "cannot allocate the migration"),

@@ -1015,14 +1015,20 @@ static int l_info(lua_State *L)
     dem_domain_stats ds;
     dem_domain_stats_get(s, &ds);
     if (ds.ranks > 1) { /* after a run on more than one rank */
-        lua_createtable(L, 0, 6);
-        const char *names[6] = {"ranks", "rebuilds", "rebalances", "migrations", "owned_min",
-                                "owned_max"};
-        long vals[6] = {ds.ranks, ds.rebuilds, ds.rebalances, ds.migrations, ds.owned_min,
-                        ds.owned_max};
-        for (int k = 0; k < 6; k++) {
+        lua_createtable(L, 0, 11);
+        const char *names[7] = {"ranks",     "rebuilds",  "rebalances", "migrations",
+                                "owned_min", "owned_max", "halos"};
+        long vals[7] = {ds.ranks,     ds.rebuilds,  ds.rebalances, ds.migrations,
+                        ds.owned_min, ds.owned_max, ds.halos};
+        for (int k = 0; k < 7; k++) {
             lua_pushinteger(L, vals[k]);
             lua_setfield(L, -2, names[k]);
+        }
+        const char *tn[4] = {"halo_bytes", "halo_messages", "rebuild_bytes", "rebuild_messages"};
+        double tv[4] = {ds.halo_bytes, ds.halo_messages, ds.rebuild_bytes, ds.rebuild_messages};
+        for (int k = 0; k < 4; k++) {
+            lua_pushnumber(L, tv[k]);
+            lua_setfield(L, -2, tn[k]);
         }
         lua_setfield(L, -2, "distributed");
     }
