@@ -54,6 +54,10 @@ typedef struct dem_domain_stats {
      * without a rebuild), and rebuilds (migration, ghosts, history), in bytes and messages */
     double halo_bytes, halo_messages, rebuild_bytes, rebuild_messages;
     long halos;
+    /* wall-clock seconds in rebuilds (all of it: migration, list) and in the rebalances' own
+     * part (gathering positions, new regions), the slowest rank's */
+    double rebuild_s, rebalance_s;
+    double comm_s; /* inside communication calls during runs (core/comm.h), the slowest rank */
 } dem_domain_stats;
 /* Collective when the scene ran on more than one rank (the traffic is summed over the ranks). */
 void dem_domain_stats_get(const dem_scene *s, dem_domain_stats *out);

@@ -30,6 +30,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/clock.h"
 #include "core/comm.h"
 #include "dem/dem_internal.h"
 
@@ -75,6 +76,9 @@ void dem_domain_stats_get(const dem_scene *s, dem_domain_stats *out)
         comm_sum_double(v, 4);
         out->halo_bytes = v[0], out->halo_messages = v[1];
         out->rebuild_bytes = v[2], out->rebuild_messages = v[3];
+        double t[3] = {out->rebuild_s, out->rebalance_s, out->comm_s};
+        comm_max_double(t, 3);
+        out->rebuild_s = t[0], out->rebalance_s = t[1], out->comm_s = t[2];
     }
 }
 
@@ -720,9 +724,11 @@ core_status dem_domain_rebuild(dem_scene *s, core_error *err)
     dem_domain *dm = s->dom;
     const int P = dm->P;
     core_status st = CORE_OK;
+    const double t0 = clock_wall();
     dem_wrap_positions(s); /* what one rank does first at a build */
     dm->gcut = ghost_cut(s);
     st = rebalance(s, err);
+    s->dstats.rebalance_s += clock_wall() - t0;
     st = dem_domain_agree(s, st, err);
     if (st)
         return st;
@@ -867,6 +873,7 @@ core_status dem_domain_rebuild(dem_scene *s, core_error *err)
         st = dem_build_pairs(s, err);
     free_bundles(dm);
     s->dstats.rebuilds++;
+    s->dstats.rebuild_s += clock_wall() - t0;
     owned_range(s, migrated);
     if (getenv("DEM_DEBUG")) {
         size_t own = 0;

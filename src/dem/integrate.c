@@ -607,7 +607,21 @@ static core_status step_gear(dem_scene *s, double dt, core_error *err)
 }
 
 /* ---- the run loop --------------------------------------------------------------------------- */
+static core_status run_steps(dem_scene *s, const dem_run_def *run, core_error *err);
+
 core_status dem_run(dem_scene *s, const dem_run_def *run, core_error *err)
+{
+    if (comm_size() == 1)
+        return run_steps(s, run, err);
+    comm_stats c0, c1; /* distributed: the time inside communication, for the stats */
+    comm_get_stats(&c0);
+    core_status st = run_steps(s, run, err);
+    comm_get_stats(&c1);
+    s->dstats.comm_s += c1.seconds - c0.seconds;
+    return st;
+}
+
+static core_status run_steps(dem_scene *s, const dem_run_def *run, core_error *err)
 {
     if (run->steps < 0)
         return core_fail(err, CORE_ERR_ARG, "steps must be >= 0, got %ld", run->steps);

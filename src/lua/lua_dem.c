@@ -1024,9 +1024,11 @@ static int l_info(lua_State *L)
             lua_pushinteger(L, vals[k]);
             lua_setfield(L, -2, names[k]);
         }
-        const char *tn[4] = {"halo_bytes", "halo_messages", "rebuild_bytes", "rebuild_messages"};
-        double tv[4] = {ds.halo_bytes, ds.halo_messages, ds.rebuild_bytes, ds.rebuild_messages};
-        for (int k = 0; k < 4; k++) {
+        const char *tn[7] = {"halo_bytes", "halo_messages", "rebuild_bytes", "rebuild_messages",
+                             "rebuild_s",  "rebalance_s",   "comm_s"};
+        double tv[7] = {ds.halo_bytes, ds.halo_messages, ds.rebuild_bytes, ds.rebuild_messages,
+                        ds.rebuild_s,  ds.rebalance_s,   ds.comm_s};
+        for (int k = 0; k < 7; k++) {
             lua_pushnumber(L, tv[k]);
             lua_setfield(L, -2, tn[k]);
         }
