@@ -62,7 +62,8 @@ while added < n do
   local x = r0 * 1.1 + i * sp + 0.2 * r0 * rnd()
   local y = r0 * 1.1 + j * sp * (P.spread or 1) + 0.2 * r0 * rnd()
   local z = r0 * 1.1 + l * sp + 0.2 * r0 * rnd()
-  local v = { (rnd() - 0.5) * 2, (rnd() - 0.5) * 2, (rnd() - 0.5) * 2 }
+  local vs = P.vscale or 1
+  local v = { (rnd() - 0.5) * 2 * vs, (rnd() - 0.5) * 2 * vs, (rnd() - 0.5) * 2 * vs }
   local rad = r0 * (0.8 + 0.2 * rnd())
   v[1] = v[1] + (P.drift or 0) -- a pile moving along a periodic axis: the load shifts
   if dim == 2 then
@@ -101,7 +102,7 @@ for c = 1, chunks do
   if integ == "two_timescales" then
     s:run{ steps = steps // chunks, dt = dt / 2, integrator = integ, n = 2, q = 2, m = 1 }
   else
-    s:run{ steps = steps // chunks, dt = dt, integrator = integ }
+    s:run{ steps = steps // chunks, dt = dt, integrator = integ, force = (P.force or 0) == 1 }
   end
 end
 if (P.check_momentum or 0) == 1 then -- no walls, no gravity: contacts conserve momentum
