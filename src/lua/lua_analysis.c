@@ -912,7 +912,7 @@ static core_status delaunay_attach(dem_boundary_def *def, double alpha, int late
     return CORE_OK;
 }
 
-/* count particle ids in [0, n) into a new array (NULL when count is 0). */
+/* Reads a count and that many particle ids in [0, n) into a new array (NULL when none). */
 static core_status get_longs(ckpt_section *sec, size_t n, const char *what, long **out,
                              size_t *count, core_error *err)
 {
