@@ -7,7 +7,8 @@
  *   that needs the whole scene.
  * - The regions are a recursive coordinate bisection by particle count (rcb below): cuts on the
  *   longest axis of each box, placed so that the counts split as the rank counts do. Rebalanced
- *   at a list rebuild when max/mean owned particles exceeds DEM_REBALANCE.
+ *   at a list rebuild when the work lost to the imbalance since the last rebuild exceeds what a
+ *   rebalance costs (see DEM_REBALANCE_COST).
  * - A rank holds its owned particles (position inside its region at the last rebuild) and ghosts:
  *   every particle within 2 r_max + skin of the region (min image on periodic axes; a ghost keeps
  *   its coordinates, the pair kernel's min image does the rest). Local arrays are sorted by global
@@ -34,10 +35,24 @@
 #include "core/comm.h"
 #include "dem/dem_internal.h"
 
-/* Rebalance when the most loaded rank owns more than this times the mean. Each rebalance is an
- * all-gather of the positions (D doubles + an id per particle) and a full migration; see the
- * report in docs/dem.md for the measurement behind the value. */
-#define DEM_REBALANCE 1.10
+/* When to rebalance. A step takes as long as its busiest rank: an imbalance b = max/mean owned
+ * costs (b - 1) steps of work per step. A rebalance (all-gather of the positions, new regions,
+ * the migration of the particles that change rank) was measured at 2-4 steps of work (3000
+ * disks on 2 ranks: 5 ms for the gather and the cut, 16 ms for the rebuild with migration, 4.9 ms
+ * per step). So rebalance when the work lost over the last rebuild interval, (b - 1) x steps,
+ * exceeds DEM_REBALANCE_COST steps, and not for b under DEM_REBALANCE_MIN (the cuts themselves
+ * are only as good as a particle or two). A dense pile, rebuilt every few hundred steps,
+ * rebalances from b ~ 1.02; a fast flow rebuilt every 20 steps waits until b ~ 1.2. The variable
+ * GRAINLAB_DEM_REBALANCE = b replaces the rule by a fixed threshold (for measurements). */
+#define DEM_REBALANCE_COST 4.0
+#define DEM_REBALANCE_MIN 1.02
+
+static double rebalance_threshold(void)
+{
+    const char *e = getenv("GRAINLAB_DEM_REBALANCE");
+    double v = e ? strtod(e, NULL) : 0;
+    return v >= 1 ? v : 0;
+}
 
 typedef struct rcb_node {
     int axis, rank; /* rank >= 0: a leaf */
@@ -48,7 +63,9 @@ typedef struct rcb_node {
 struct dem_domain {
     int P, me;
     size_t n_global;
-    double gcut; /* ghost distance: 2 r_max + skin, with a rounding margin */
+    double gcut;       /* ghost distance: 2 r_max + skin, with a rounding margin */
+    double threshold;  /* > 0: rebalance above this max/mean owned (else the cost rule) */
+    long last_rebuild; /* s->steps at the last rebuild or decomposition */
     rcb_node *node;
     int nnode;
     double (*box)[2][3]; /* region of each rank: [r][0] lo, [r][1] hi */
@@ -62,8 +79,8 @@ struct dem_domain {
     size_t *hb_start;
     uint32_t *hb_j;
     double *hb_h;
-    int walls_pending;                /* wall forces not summed over the ranks yet */
-    core_status deferred;             /* this rank's first error of the step (forces) */
+    int walls_pending;    /* wall forces not summed over the ranks yet */
+    core_status deferred; /* this rank's first error of the step (forces) */
     core_error deferred_err;
 };
 
@@ -513,6 +530,8 @@ core_status dem_domain_start(dem_scene *s, core_error *err)
     dm->me = comm_rank();
     dm->n_global = s->n;
     dm->gcut = ghost_cut(s);
+    dm->threshold = rebalance_threshold();
+    dm->last_rebuild = s->steps;
     s->dom = dm;
     const size_t n = s->n;
     /* Decide on the positions the current list was built from (x_build), so that the list
@@ -692,7 +711,11 @@ static core_status rebalance(dem_scene *s, core_error *err)
     dem_domain *dm = s->dom;
     /* the counts of the last rebuild: the particles have moved by less than a skin since */
     double mean = (double)dm->n_global / dm->P;
-    if (!((double)s->dstats.owned_max > DEM_REBALANCE * mean && s->dstats.owned_max > 1))
+    const double b = s->dstats.owned_max / (mean > 0 ? mean : 1);
+    const long interval = s->steps - dm->last_rebuild;
+    int go = dm->threshold > 0 ? b > dm->threshold
+                               : b > DEM_REBALANCE_MIN && (b - 1) * interval > DEM_REBALANCE_COST;
+    if (!go || s->dstats.owned_max <= 1)
         return CORE_OK;
     size_t own = 0;
     for (size_t i = 0; i < s->n; i++)
@@ -872,16 +895,10 @@ core_status dem_domain_rebuild(dem_scene *s, core_error *err)
     if (!st)
         st = dem_build_pairs(s, err);
     free_bundles(dm);
+    dm->last_rebuild = s->steps;
     s->dstats.rebuilds++;
     s->dstats.rebuild_s += clock_wall() - t0;
     owned_range(s, migrated);
-    if (getenv("DEM_DEBUG")) {
-        size_t own = 0;
-        for (size_t i = 0; i < s->n; i++)
-            own += !s->ghost[i];
-        fprintf(stderr, "step %ld rank %d rebuild %ld: %zu owned %zu ghosts, %d peers, %ld rebalances\n",
-                s->steps, dm->me, s->dstats.rebuilds, own, s->n - own, dm->npeer, s->dstats.rebalances);
-    }
     return dem_domain_agree(s, st, err);
 }
 

@@ -398,10 +398,11 @@ core_status dem_build_pairs(dem_scene *s, core_error *err)
     }
     for (size_t q = 0; q < npairs; q++) /* the contact normal of two coincident centres is undefined */
         if (dist2(s, p->i[q], p->j[q]) == 0) {
-            core_status bad = core_fail(err, CORE_ERR_ARG, "particles %u and %u are at the same "
-                                        "position: the contact normal is undefined",
-                                        (unsigned)dem_gid(s, p->i[q]) + 1,
-                                        (unsigned)dem_gid(s, p->j[q]) + 1);
+            core_status bad =
+                core_fail(err, CORE_ERR_ARG,
+                          "particles %u and %u are at the same "
+                          "position: the contact normal is undefined",
+                          (unsigned)dem_gid(s, p->i[q]) + 1, (unsigned)dem_gid(s, p->j[q]) + 1);
             dem_free_pairs(&old);
             s->need_rebuild = 1;
             return bad;

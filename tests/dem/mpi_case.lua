@@ -152,7 +152,9 @@ local info = s:info()
 if info.distributed then -- how the ranks shared the work (not compared: one rank has none)
   local d = info.distributed
   local g = assert(io.open((P.out or "out") .. ".stats." .. rank, "w"))
-  g:write(string.format("ranks %d rebuilds %d rebalances %d migrations %d owned_min %d owned_max %d\n",
-                        d.ranks, d.rebuilds, d.rebalances, d.migrations, d.owned_min, d.owned_max))
+  g:write(string.format("ranks %d rebuilds %d rebalances %d migrations %d owned_min %d owned_max %d" ..
+                        " rebuild_ms %.3f rebalance_ms %.3f comm_ms %.3f halos %d\n",
+                        d.ranks, d.rebuilds, d.rebalances, d.migrations, d.owned_min, d.owned_max,
+                        1000 * d.rebuild_s, 1000 * d.rebalance_s, 1000 * d.comm_s, d.halos))
   g:close()
 end
