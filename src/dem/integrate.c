@@ -782,31 +782,27 @@ core_status dem_timestep_info(const dem_scene *s, double v_imp, dem_timestep *ou
             if (i != (size_t)-1 && (int64_t)dem_gid(s, i) != g)
                 i = (size_t)-1;
         }
-        if (i == (size_t)-1) {
-            if (s->dom) { /* take part in the reductions below */
-                double t = INFINITY, b = 0;
-                comm_min_double(&t, 1);
-                comm_max_double(&b, 1);
-            }
-            continue;
+        double t = INFINITY, b = 0; /* distributed: on the ranks without the particle */
+        if (i != (size_t)-1) {
+            double k, gamma, mu;
+            dem_pair_parameters((dem_scene *)s, i, i, &k, &gamma, &mu);
+            double m_eff = 0.5 * s->m[i];
+            double beta = s->contact.normal == DEM_NORMAL_LINEAR  ? 1
+                          : s->contact.normal == DEM_NORMAL_POWER ? s->contact.beta
+                                                                  : 1.5;
+            double dmax = pow((beta + 1) * m_eff * v_imp * v_imp / (2 * k), 1 / (beta + 1));
+            t = 2 * dmax / v_imp * contact_integral(beta + 1);
+            if (beta == 1)
+                t = DEM_PI * sqrt(m_eff / k); /* independent of speed */
+            b = gamma / (2 * m_eff);
+            if (s->contact.damping == DEM_DAMPING_BRILLIANTOV) /* rate T k d^{1/2} / (2 m_eff) */
+                b = gamma * k * sqrt(dmax) / (2 * m_eff);
         }
-        double k, gamma, mu;
-        dem_pair_parameters((dem_scene *)s, i, i, &k, &gamma, &mu);
-        double m_eff = 0.5 * s->m[i];
-        double beta = s->contact.normal == DEM_NORMAL_LINEAR ? 1
-                      : s->contact.normal == DEM_NORMAL_POWER ? s->contact.beta : 1.5;
-        double dmax = pow((beta + 1) * m_eff * v_imp * v_imp / (2 * k), 1 / (beta + 1));
-        double t = 2 * dmax / v_imp * contact_integral(beta + 1);
-        if (beta == 1)
-            t = DEM_PI * sqrt(m_eff / k); /* independent of speed */
-        tc = fmin(tc, t);
-        double b = gamma / (2 * m_eff);
-        if (s->contact.damping == DEM_DAMPING_BRILLIANTOV) /* rate T k d^{1/2} / (2 m_eff) */
-            b = gamma * k * sqrt(dmax) / (2 * m_eff);
-        if (s->dom) {
+        if (s->dom) { /* one rank computed them: min and max are its values, exactly */
             comm_min_double(&t, 1);
             comm_max_double(&b, 1);
         }
+        tc = fmin(tc, t);
         bmax = fmax(bmax, b);
     }
     out->impact_velocity = v_imp;

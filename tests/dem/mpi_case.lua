@@ -2,7 +2,7 @@
 -- ranks, every rank writes what it sees (positions and velocities as %a, energies, wall forces)
 -- to out.<rank>; every file of every rank count must be the same bits.
 --   grainlab tests/dem/mpi_case.lua dim=2 integrator=velocity_verlet spring=1 walls=1
---            periodic=0 servo=0 gravity=1 n=150 steps=300 out=PREFIX fast=0
+--            periodic=0 servo=0 gravity=1 n=150 steps=300 out=PREFIX fast=0 dt=5e-7|auto chunks=1
 local P = params
 local dim = P.dim or 2
 local n = P.n or 150
