@@ -3,9 +3,11 @@
  * cells (collisions); every cell and every wall hit draws from its own random stream, so the
  * result does not depend on the number of threads. */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "core/clock.h"
+#include "core/comm.h"
 #include "core/interrupt.h"
 #include "dsmc/dsmc_internal.h"
 
@@ -28,10 +30,13 @@ dsmc_run_def dsmc_default_run_def(void)
  * number: first a serial partition into DSMC_SORT_BLOCKS fixed ranges of cells (only the few
  * particles that crossed a range boundary move), then every range is sorted by cell on its own,
  * ranges in parallel. Measured on the 10^6-particle benchmark: the single serial sort took 60% of
- * a step (perf), and bound two threads to 1.3x at best. */
-#define DSMC_SORT_BLOCKS 64
+ * a step (perf), and bound two threads to 1.3x at best.
+ * Then each cell is put in identity order (order_cell): the flag sort is unstable and its result
+ * depends on the order it starts from, which differs with the decomposition over ranks; the
+ * collisions index the particles of a cell, so that order must not. */
 
-static void swap_particles(dsmc_scene *s, size_t i, size_t j)
+static inline __attribute__((always_inline)) void swap_particles(dsmc_scene *s, size_t i,
+                                                                  size_t j)
 {
     for (int k = 0; k < s->D; k++) {
         double t = s->x[k][i];
@@ -44,6 +49,9 @@ static void swap_particles(dsmc_scene *s, size_t i, size_t j)
     uint32_t c = s->cell[i];
     s->cell[i] = s->cell[j];
     s->cell[j] = c;
+    c = s->id[i];
+    s->id[i] = s->id[j];
+    s->id[j] = c;
 }
 
 /* Sorts particles [lo, hi) by key(cell) into buckets [0, nb), key(c) = (c - c0) >> shift (the
@@ -90,7 +98,7 @@ static void flag_sort(dsmc_scene *s, size_t lo, size_t hi, size_t *start, size_t
 
 /* Cells per sort range: a power of two (a shift, not a division, per particle) giving at most
  * DSMC_SORT_BLOCKS ranges. */
-static int block_shift(size_t nc)
+int dsmc_sort_shift(size_t nc)
 {
     int sh = 0;
     while ((nc + ((size_t)1 << sh) - 1) >> sh > DSMC_SORT_BLOCKS)
@@ -98,10 +106,71 @@ static int block_shift(size_t nc)
     return sh;
 }
 
-static void sort_counted(dsmc_scene *s, const size_t *bcount)
+static int cmp_u64(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* Puts the particles [a, a + N) of one cell in identity order. The flag sort keeps a cell's
+ * particles in order only where its bucket did not shift, so after a step most cells are
+ * scrambled: sort (identity, slot) keys in a small buffer, then permute each array through a
+ * buffer. Measured (callgrind, cooling benchmark, 20 per cell): 1.5x fewer instructions than an
+ * insertion sort moving whole particles, and 1.2x fewer than ranks by counting (N^2 compares). */
+static void order_cell(dsmc_scene *s, size_t a, size_t N)
+{
+    uint32_t *id = s->id + a;
+    size_t i = 1;
+    while (i < N && id[i - 1] < id[i])
+        i++;
+    if (i >= N)
+        return;
+    enum { SMALL = 64 };
+    uint64_t kbuf[SMALL];
+    double tbuf[SMALL];
+    uint64_t *key = kbuf;
+    double *tmp = tbuf;
+    if (N > SMALL) {
+        key = malloc(N * sizeof *key);
+        tmp = malloc(N * sizeof *tmp);
+        if (!key || !tmp) { /* out of memory: the cell stays as it is */
+            free(key);
+            free(tmp);
+            return;
+        }
+    }
+    for (size_t k = 0; k < N; k++)
+        key[k] = (uint64_t)id[k] << 32 | (uint64_t)k;
+    if (N > SMALL) {
+        qsort(key, N, sizeof *key, cmp_u64);
+    } else {
+        for (size_t k = 1; k < N; k++) {
+            uint64_t x = key[k];
+            size_t j = k;
+            for (; j > 0 && key[j - 1] > x; j--)
+                key[j] = key[j - 1];
+            key[j] = x;
+        }
+    }
+    const int D = s->D;
+    for (int q = 0; q < 2 * D; q++) {
+        double *A = (q < D ? s->x[q] : s->v[q - D]) + a;
+        for (size_t k = 0; k < N; k++)
+            tmp[k] = A[key[k] & 0xffffffffu];
+        memcpy(A, tmp, N * sizeof *tmp);
+    }
+    for (size_t k = 0; k < N; k++)
+        id[k] = (uint32_t)(key[k] >> 32);
+    if (N > SMALL) {
+        free(key);
+        free(tmp);
+    }
+}
+
+void dsmc_sort_counted(dsmc_scene *s, const size_t *bcount)
 {
     size_t nc = s->ncells;
-    int sh = block_shift(nc);
+    int sh = dsmc_sort_shift(nc);
     size_t width = (size_t)1 << sh, nb = (nc + width - 1) >> sh;
     size_t bstart[DSMC_SORT_BLOCKS + 1], bnext[DSMC_SORT_BLOCKS];
     flag_sort(s, 0, s->n, bstart, bnext, nb, 0, sh, bcount);
@@ -113,11 +182,16 @@ static void sort_counted(dsmc_scene *s, const size_t *bcount)
         size_t c0 = (size_t)b * width, c1 = c0 + width < nc ? c0 + width : nc;
         flag_sort(s, bstart[b], bstart[b + 1], start + c0, next + c0, c1 - c0, (uint32_t)c0, 0,
                   NULL);
+        for (size_t c = c0; c < c1; c++) {
+            size_t e = c + 1 < c1 ? start[c + 1] : bstart[b + 1];
+            if (e - start[c] > 1)
+                order_cell(s, start[c], e - start[c]);
+        }
     }
     start[nc] = s->n;
 }
 
-void dsmc_sort(dsmc_scene *s) { sort_counted(s, NULL); }
+void dsmc_sort(dsmc_scene *s) { dsmc_sort_counted(s, NULL); }
 
 /* ---- free flight ------------------------------------------------------------------------------ */
 typedef struct wall_state {
@@ -169,7 +243,7 @@ typedef struct flight_consts {
 
 /* Walls for one particle that is outside the walls on a non-periodic axis (the slow path). */
 static __attribute__((noinline)) long walls_one(const dsmc_scene *s, const flight_consts *fc,
-                                                int D, long i, double x[3], double v[3])
+                                                int D, uint64_t id, double x[3], double v[3])
 {
     long hits = 0;
     for (int k = 0; k < D; k++) {
@@ -183,7 +257,7 @@ static __attribute__((noinline)) long walls_one(const dsmc_scene *s, const fligh
                 break;
             rng r = {{0, 0, 0, 0}};
             if (s->walls[side].kind == DSMC_WALL_DIFFUSE)
-                dsmc_stream(&r, fc->seed, STREAM_WALL, fc->step, (uint64_t)i * 8 + (uint64_t)bounce);
+                dsmc_stream(&r, fc->seed, STREAM_WALL, fc->step, id * 8 + (uint64_t)bounce);
             reflect(s, side, &ws[side], fc->dt, x, v, &r);
             hits++;
         }
@@ -243,7 +317,7 @@ flight_dim(dsmc_scene *s, const flight_consts *fc, size_t bcount[DSMC_SORT_BLOCK
             }
         }
         if (any_wall && out)
-            hits += walls_one(s, fc, D, i, x, v);
+            hits += walls_one(s, fc, D, s->id[i], x, v);
         size_t c = 0;
         double chk = 0;
         for (int k = D - 1; k >= 0; k--) {
@@ -282,7 +356,7 @@ static flight_totals flight(dsmc_scene *s, double dt, size_t bcount[DSMC_SORT_BL
         if (fc.ws[side].active)
             dsmc_wall_motion(s, side, s->t + dt, &fc.ws[side].pos, &fc.ws[side].vel);
     }
-    fc.sh = block_shift(s->ncells);
+    fc.sh = dsmc_sort_shift(s->ncells);
     fc.seed = s->def.seed;
     fc.step = (uint64_t)s->steps;
     return s->D == 2 ? flight_dim(s, &fc, bcount, 2) : flight_dim(s, &fc, bcount, 3);
@@ -346,7 +420,7 @@ static inline void collide_3d(double *vi, double *vj, const double gv[3], double
 static collide_totals collide(dsmc_scene *s, double dt)
 {
     const int D = s->D;
-    const long nc = (long)s->ncells;
+    const long c_lo = (long)s->cell_lo, nc = (long)s->cell_hi;
     const size_t *start = s->start;
     double *rem = s->remainder;
     double *V[3] = {s->v[0], s->v[1], s->v[2]};
@@ -358,7 +432,7 @@ static collide_totals collide(dsmc_scene *s, double dt)
     long attempts = 0, collisions = 0, raised = 0, overpacked = 0;
 #pragma omp parallel for schedule(dynamic, 64) \
     reduction(+ : attempts, collisions, raised, overpacked) if (s->n >= DSMC_PARALLEL_MIN)
-    for (long c = 0; c < nc; c++) {
+    for (long c = c_lo; c < nc; c++) {
         size_t a = start[c], N = start[c + 1] - a;
         if (N < 2)
             continue;
@@ -459,12 +533,28 @@ core_status dsmc_run(dsmc_scene *s, const dsmc_run_def *run, long *done, core_er
         return core_fail(err, CORE_ERR_ARG, "dt must be positive, got %g", run->dt);
     if (run->steps < 0)
         return core_fail(err, CORE_ERR_ARG, "steps must be >= 0, got %ld", run->steps);
-    double c0 = clock_cpu(), w0 = clock_wall();
+    /* several ranks: every decision below (stop, rebalance) is taken by all of them together */
+    const bool multi = comm_size() > 1;
     core_status st = CORE_OK;
+    if (multi && (st = dsmc_domain_split(s, err)))
+        return st;
+    double c0 = clock_cpu(), w0 = clock_wall();
+    /* this rank's counts for the run, added to the statistics at the end (summed over ranks) */
+    int64_t cnt[6] = {0, 0, 0, 0, 0, 0}; /* moves, wall hits, attempts, collisions, raised, over */
+    long nsteps = 0;
+    double tsum = 0;
     while (*done < run->steps) {
         if (run->time_end >= 0 && s->t >= run->time_end * (1 - 1e-14))
             break;
-        if (interrupt_pending()) {
+        int intr = interrupt_pending();
+        if (multi) {
+            int64_t q[2] = {intr, (int64_t)s->n};
+            comm_max_i64(q, 2);
+            intr = q[0] != 0;
+            if (!intr && (st = dsmc_domain_balance(s, q[1], err)))
+                break;
+        }
+        if (intr) {
             st = core_fail(err, CORE_ERR_INTERRUPTED,
                            "interrupted at step %ld (t = %.6g s); the scene is intact", s->steps,
                            s->t);
@@ -475,29 +565,45 @@ core_status dsmc_run(dsmc_scene *s, const dsmc_run_def *run, long *done, core_er
             dt = run->time_end - s->t;
         size_t bcount[DSMC_SORT_BLOCKS];
         flight_totals ft = flight(s, dt, bcount);
-        if (ft.bad) {
+        if (multi ? comm_any(ft.bad) : ft.bad) {
             st = core_fail(err, CORE_ERR_UNSTABLE,
                            "step %ld (t = %.6g s): a particle's position or velocity is not "
                            "finite", s->steps, s->t);
             break;
         }
-        sort_counted(s, bcount);
+        if (multi && (st = dsmc_domain_migrate(s, bcount, err)))
+            break;
+        dsmc_sort_counted(s, bcount);
         collide_totals ct = collide(s, dt);
         s->t += dt;
         s->steps++;
         ++*done;
-        s->stats.steps++;
-        s->stats.particle_moves += (double)s->n;
-        s->stats.wall_hits += (double)ft.wall_hits;
-        s->stats.attempts += (double)ct.attempts;
-        s->stats.collisions += (double)ct.collisions;
-        s->stats.vmax_raised += (double)ct.raised;
-        s->stats.cells_overpacked += (double)ct.overpacked;
-        s->stats.time += dt;
-        s->total_collisions += (double)ct.collisions;
+        nsteps++;
+        tsum += dt;
+        cnt[0] += (int64_t)s->n;
+        cnt[1] += ft.wall_hits;
+        cnt[2] += ct.attempts;
+        cnt[3] += ct.collisions;
+        cnt[4] += ct.raised;
+        cnt[5] += ct.overpacked;
     }
-    s->stats.cpu_s += clock_cpu() - c0;
-    s->stats.wall_s += clock_wall() - w0;
+    double cpu = clock_cpu() - c0, wall = clock_wall() - w0;
+    if (s->distributed) {
+        comm_sum_i64(cnt, 6);
+        comm_sum_double(&cpu, 1); /* the CPU of all ranks; the wall time of the slowest */
+        comm_max_double(&wall, 1);
+    }
+    s->stats.steps += nsteps;
+    s->stats.particle_moves += (double)cnt[0];
+    s->stats.wall_hits += (double)cnt[1];
+    s->stats.attempts += (double)cnt[2];
+    s->stats.collisions += (double)cnt[3];
+    s->stats.vmax_raised += (double)cnt[4];
+    s->stats.cells_overpacked += (double)cnt[5];
+    s->stats.time += tsum;
+    s->total_collisions += (double)cnt[3];
+    s->stats.cpu_s += cpu;
+    s->stats.wall_s += wall;
     return st;
 }
 
