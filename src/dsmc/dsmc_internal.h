@@ -61,8 +61,11 @@ void dsmc_stream(rng *r, uint64_t seed, uint64_t purpose, uint64_t step, uint64_
 /* Sorts the particles in place by cell index, each cell by identity, and fills start[]
  * (ncells + 1 offsets). */
 void dsmc_sort(dsmc_scene *s);
-/* The same with the particles per sort range already counted (dsmc_sort_shift ranges). */
+/* The sort of a step: by cell only (the particles per sort range already counted, over
+ * dsmc_sort_shift ranges; NULL: counted here); within a cell the order is the layout's. */
 void dsmc_sort_counted(dsmc_scene *s, const size_t *bcount);
+/* Puts every cell of this rank in identity order (after dsmc_sort_counted). */
+void dsmc_order_cells(dsmc_scene *s);
 #define DSMC_SORT_BLOCKS 64
 int dsmc_sort_shift(size_t ncells);
 

@@ -31,9 +31,12 @@ dsmc_run_def dsmc_default_run_def(void)
  * particles that crossed a range boundary move), then every range is sorted by cell on its own,
  * ranges in parallel. Measured on the 10^6-particle benchmark: the single serial sort took 60% of
  * a step (perf), and bound two threads to 1.3x at best.
- * Then each cell is put in identity order (order_cell): the flag sort is unstable and its result
- * depends on the order it starts from, which differs with the decomposition over ranks; the
- * collisions index the particles of a cell, so that order must not. */
+ * Within a cell the order is left as the flag sort makes it, which depends on the order it
+ * started from, and so on the decomposition over ranks: the collisions index each cell's
+ * particles in identity order through a small permutation (cell_perm) instead, and the arrays
+ * are put in that order only between runs (dsmc_order_cells), for everything that reads them.
+ * (Measured by callgrind on the cooling benchmark: ordering the arrays every step cost +33% of
+ * the instructions of a step; the permutation costs about a third of that.) */
 
 static inline __attribute__((always_inline)) void swap_particles(dsmc_scene *s, size_t i,
                                                                   size_t j)
@@ -112,38 +115,15 @@ static int cmp_u64(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-/* Puts the particles [a, a + N) of one cell in identity order. The flag sort keeps a cell's
- * particles in order only where its bucket did not shift, so after a step most cells are
- * scrambled: sort (identity, slot) keys in a small buffer, then permute each array through a
- * buffer. Measured (callgrind, cooling benchmark, 20 per cell): 1.5x fewer instructions than an
- * insertion sort moving whole particles, and 1.2x fewer than ranks by counting (N^2 compares). */
-static void order_cell(dsmc_scene *s, size_t a, size_t N)
+/* The identity order of a cell's N particles: P[k] = the slot (from the cell's first) of the
+ * k-th smallest identity. key: N scratch entries. */
+static void cell_perm(const uint32_t *id, size_t N, uint64_t *key, uint32_t *P)
 {
-    uint32_t *id = s->id + a;
-    size_t i = 1;
-    while (i < N && id[i - 1] < id[i])
-        i++;
-    if (i >= N)
-        return;
-    enum { SMALL = 64 };
-    uint64_t kbuf[SMALL];
-    double tbuf[SMALL];
-    uint64_t *key = kbuf;
-    double *tmp = tbuf;
-    if (N > SMALL) {
-        key = malloc(N * sizeof *key);
-        tmp = malloc(N * sizeof *tmp);
-        if (!key || !tmp) { /* out of memory: the cell stays as it is */
-            free(key);
-            free(tmp);
-            return;
-        }
-    }
     for (size_t k = 0; k < N; k++)
         key[k] = (uint64_t)id[k] << 32 | (uint64_t)k;
-    if (N > SMALL) {
+    if (N > 64) {
         qsort(key, N, sizeof *key, cmp_u64);
-    } else {
+    } else { /* identities are unique: no ties */
         for (size_t k = 1; k < N; k++) {
             uint64_t x = key[k];
             size_t j = k;
@@ -152,19 +132,80 @@ static void order_cell(dsmc_scene *s, size_t a, size_t N)
             key[j] = x;
         }
     }
+    for (size_t k = 0; k < N; k++)
+        P[k] = (uint32_t)key[k];
+}
+
+/* Puts the particles [a, a + N) of one cell in identity order, through a buffer (an insertion
+ * sort moving whole particles when out of memory). */
+static void order_cell(dsmc_scene *s, size_t a, size_t N)
+{
+    uint32_t *id = s->id + a;
+    size_t i = 1;
+    while (i < N && id[i - 1] < id[i])
+        i++;
+    if (i >= N)
+        return;
     const int D = s->D;
+    double *X[3] = {s->x[0] + a, s->x[1] + a, D == 3 ? s->x[2] + a : NULL};
+    double *V[3] = {s->v[0] + a, s->v[1] + a, D == 3 ? s->v[2] + a : NULL};
+    enum { SMALL = 64 };
+    uint64_t kbuf[SMALL];
+    double tbuf[SMALL];
+    uint32_t pbuf[SMALL];
+    uint64_t *key = kbuf;
+    double *tmp = tbuf;
+    uint32_t *P = pbuf;
+    void *heap = NULL;
+    if (N > SMALL) {
+        heap = malloc(N * (sizeof *key + sizeof *tmp + sizeof *P));
+        if (!heap) {
+            for (; i < N; i++) {
+                uint32_t ki = id[i];
+                double x[3], v[3];
+                for (int k = 0; k < D; k++) {
+                    x[k] = X[k][i];
+                    v[k] = V[k][i];
+                }
+                size_t j = i;
+                for (; j > 0 && id[j - 1] > ki; j--) {
+                    for (int k = 0; k < D; k++) {
+                        X[k][j] = X[k][j - 1];
+                        V[k][j] = V[k][j - 1];
+                    }
+                    id[j] = id[j - 1];
+                }
+                for (int k = 0; k < D; k++) {
+                    X[k][j] = x[k];
+                    V[k][j] = v[k];
+                }
+                id[j] = ki;
+            }
+            return;
+        }
+        key = heap;
+        tmp = (double *)(key + N);
+        P = (uint32_t *)(tmp + N);
+    }
+    cell_perm(id, N, key, P);
     for (int q = 0; q < 2 * D; q++) {
-        double *A = (q < D ? s->x[q] : s->v[q - D]) + a;
+        double *A = q < D ? X[q] : V[q - D];
         for (size_t k = 0; k < N; k++)
-            tmp[k] = A[key[k] & 0xffffffffu];
+            tmp[k] = A[P[k]];
         memcpy(A, tmp, N * sizeof *tmp);
     }
     for (size_t k = 0; k < N; k++)
         id[k] = (uint32_t)(key[k] >> 32);
-    if (N > SMALL) {
-        free(key);
-        free(tmp);
-    }
+    free(heap);
+}
+
+void dsmc_order_cells(dsmc_scene *s)
+{
+    const long c0 = (long)s->cell_lo, c1 = (long)s->cell_hi;
+#pragma omp parallel for schedule(dynamic, 256) if (s->n >= DSMC_PARALLEL_MIN)
+    for (long c = c0; c < c1; c++)
+        if (s->start[c + 1] - s->start[c] > 1)
+            order_cell(s, s->start[c], s->start[c + 1] - s->start[c]);
 }
 
 void dsmc_sort_counted(dsmc_scene *s, const size_t *bcount)
@@ -182,16 +223,15 @@ void dsmc_sort_counted(dsmc_scene *s, const size_t *bcount)
         size_t c0 = (size_t)b * width, c1 = c0 + width < nc ? c0 + width : nc;
         flag_sort(s, bstart[b], bstart[b + 1], start + c0, next + c0, c1 - c0, (uint32_t)c0, 0,
                   NULL);
-        for (size_t c = c0; c < c1; c++) {
-            size_t e = c + 1 < c1 ? start[c + 1] : bstart[b + 1];
-            if (e - start[c] > 1)
-                order_cell(s, start[c], e - start[c]);
-        }
     }
     start[nc] = s->n;
 }
 
-void dsmc_sort(dsmc_scene *s) { dsmc_sort_counted(s, NULL); }
+void dsmc_sort(dsmc_scene *s)
+{
+    dsmc_sort_counted(s, NULL);
+    dsmc_order_cells(s);
+}
 
 /* ---- free flight ------------------------------------------------------------------------------ */
 typedef struct wall_state {
@@ -436,14 +476,30 @@ static collide_totals collide(dsmc_scene *s, double dt)
         size_t a = start[c], N = start[c + 1] - a;
         if (N < 2)
             continue;
+        /* The cell's particles in identity order: P[k] is the k-th (offset from a). Out of
+         * memory for a large cell: the arrays themselves are put in order, P = NULL. */
+        uint64_t kbuf[64];
+        uint32_t pbuf[64], *P = pbuf;
+        uint64_t *key = kbuf;
+        void *heap = NULL;
+        if (N > 64) {
+            heap = malloc(N * (sizeof *key + sizeof *P));
+            key = heap;
+            P = heap ? (uint32_t *)(key + N) : NULL;
+            if (!heap)
+                order_cell(s, a, N);
+        }
+        if (P)
+            cell_perm(s->id + a, N, key, P);
         /* v_max: twice the largest speed about the cell's mean velocity bounds every pair's
-         * relative speed at the start of the step; raised when a collision exceeds it. */
+         * relative speed at the start of the step; raised when a collision exceeds it. The
+         * mean sums in identity order, so its bits do not depend on the layout. */
         double u[3] = {0, 0, 0};
         for (int k = 0; k < D; k++) {
             const double *vk = V[k] + a;
             double sum = 0;
             for (size_t i = 0; i < N; i++)
-                sum += vk[i];
+                sum += vk[P ? P[i] : i];
             u[k] = sum / (double)N;
         }
         double m2 = 0;
@@ -456,8 +512,10 @@ static collide_totals collide(dsmc_scene *s, double dt)
             m2 = q > m2 ? q : m2;
         }
         double vmax = 2 * sqrt(m2);
-        if (vmax == 0)
+        if (vmax == 0) {
+            free(heap);
             continue;
+        }
         double Nd = (double)N, Veff = Vc, chi = 1;
         if (excl == DSMC_EXCLUDED_FREE_VOLUME) {
             Veff = Vc - Nd * vb / rcp;
@@ -478,15 +536,19 @@ static collide_totals collide(dsmc_scene *s, double dt)
         double Mi = floor(M);
         rem[c] = M - Mi;
         long m = (long)Mi;
-        if (m == 0)
+        if (m == 0) {
+            free(heap);
             continue;
+        }
         rng r;
         dsmc_stream(&r, seed, STREAM_COLLIDE, step, (uint64_t)c);
         attempts += m;
         for (long t = 0; t < m; t++) {
-            size_t i = a + rng_below(&r, N), j = a + rng_below(&r, N - 1);
+            size_t i = rng_below(&r, N), j = rng_below(&r, N - 1);
             if (j >= i)
                 j++;
+            i = a + (P ? P[i] : i);
+            j = a + (P ? P[j] : j);
             double gv[3] = {0, 0, 0}, g2 = 0;
             for (int k = 0; k < D; k++) {
                 gv[k] = V[k][i] - V[k][j];
@@ -521,6 +583,7 @@ static collide_totals collide(dsmc_scene *s, double dt)
                 }
             }
         }
+        free(heap);
     }
     return (collide_totals){attempts, collisions, raised, overpacked};
 }
@@ -587,6 +650,8 @@ core_status dsmc_run(dsmc_scene *s, const dsmc_run_def *run, long *done, core_er
         cnt[4] += ct.raised;
         cnt[5] += ct.overpacked;
     }
+    /* between runs the arrays are in cell then identity order, for everything that reads them */
+    dsmc_order_cells(s);
     double cpu = clock_cpu() - c0, wall = clock_wall() - w0;
     if (s->distributed) {
         comm_sum_i64(cnt, 6);
