@@ -281,7 +281,8 @@ static core_status read_ids(reader *rd, dsmc_scene *s)
     TRY(ckpt_section_done(&rd->sec, rd->err));
     if (!(sorted = malloc((s->n ? s->n : 1) * sizeof *sorted)))
         TRY(core_fail(rd->err, CORE_ERR_NOMEM, "out of memory for %zu particles", s->n));
-    memcpy(sorted, s->id, s->n * sizeof *sorted);
+    if (s->n)
+        memcpy(sorted, s->id, s->n * sizeof *sorted);
     qsort(sorted, s->n, sizeof *sorted, cmp_u32);
     for (size_t i = 0; i < s->n; i++)
         if (sorted[i] >= next || (i > 0 && sorted[i] == sorted[i - 1]))
