@@ -350,6 +350,12 @@ core_status dsmc_gather(dsmc_scene *s, core_error *err)
 
 bool dsmc_is_distributed(const dsmc_scene *s) { return s->distributed; }
 
+int dsmc_ranks(const dsmc_scene *s)
+{
+    (void)s;
+    return comm_size();
+}
+
 core_status dsmc_block_sum(const dsmc_scene *s, const double *local, size_t nper, double *out,
                            core_error *err)
 {

@@ -130,6 +130,8 @@ void dsmc_wall_motion(const dsmc_scene *s, int side, double t, double *pos, doub
  * rank (a no-op when it is there already). */
 core_status dsmc_gather(dsmc_scene *s, core_error *err);
 bool dsmc_is_distributed(const dsmc_scene *s);
+/* The ranks the scene's runs are spread over (comm_size(); 1 without mpirun). */
+int dsmc_ranks(const dsmc_scene *s);
 
 /* ---- running --------------------------------------------------------------------------------- */
 /* The paper's validity conditions for a step tau, with the particle-weighted mean density
@@ -178,7 +180,10 @@ typedef struct dsmc_stats {
     double vmax_raised;      /* candidates whose |g| exceeded the cell's v_max */
     double cells_overpacked; /* cell-steps whose free volume fell below 1% of the cell */
     double time;             /* simulated, s */
-    double cpu_s, wall_s;    /* spent in dsmc_run */
+    double cpu_s, wall_s;    /* spent in dsmc_run: CPU of all ranks, wall of the slowest */
+    /* A distributed run's traffic (core/comm.h counters, during dsmc_run): bytes and messages
+     * sent, summed over ranks, and the wall time inside communication of the slowest rank. */
+    double comm_bytes, comm_messages, comm_s;
 } dsmc_stats;
 
 /* Counters since the last dsmc_reset_stats (or creation). */

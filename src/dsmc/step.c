@@ -602,10 +602,13 @@ core_status dsmc_run(dsmc_scene *s, const dsmc_run_def *run, long *done, core_er
     if (multi && (st = dsmc_domain_split(s, err)))
         return st;
     double c0 = clock_cpu(), w0 = clock_wall();
+    comm_stats cs0;
+    comm_get_stats(&cs0);
     /* this rank's counts for the run, added to the statistics at the end (summed over ranks) */
     int64_t cnt[6] = {0, 0, 0, 0, 0, 0}; /* moves, wall hits, attempts, collisions, raised, over */
     long nsteps = 0;
     double tsum = 0;
+    bool sorted = true;
     while (*done < run->steps) {
         if (run->time_end >= 0 && s->t >= run->time_end * (1 - 1e-14))
             break;
@@ -628,6 +631,7 @@ core_status dsmc_run(dsmc_scene *s, const dsmc_run_def *run, long *done, core_er
             dt = run->time_end - s->t;
         size_t bcount[DSMC_SORT_BLOCKS];
         flight_totals ft = flight(s, dt, bcount);
+        sorted = false;
         if (multi ? comm_any(ft.bad) : ft.bad) {
             st = core_fail(err, CORE_ERR_UNSTABLE,
                            "step %ld (t = %.6g s): a particle's position or velocity is not "
@@ -637,6 +641,7 @@ core_status dsmc_run(dsmc_scene *s, const dsmc_run_def *run, long *done, core_er
         if (multi && (st = dsmc_domain_migrate(s, bcount, err)))
             break;
         dsmc_sort_counted(s, bcount);
+        sorted = true;
         collide_totals ct = collide(s, dt);
         s->t += dt;
         s->steps++;
@@ -650,14 +655,25 @@ core_status dsmc_run(dsmc_scene *s, const dsmc_run_def *run, long *done, core_er
         cnt[4] += ct.raised;
         cnt[5] += ct.overpacked;
     }
-    /* between runs the arrays are in cell then identity order, for everything that reads them */
-    dsmc_order_cells(s);
+    /* between runs the arrays are in cell then identity order, for everything that reads them
+     * (unless a step stopped between its flight and its sort: non-finite, or out of memory) */
+    if (sorted)
+        dsmc_order_cells(s);
     double cpu = clock_cpu() - c0, wall = clock_wall() - w0;
+    comm_stats cs1;
+    comm_get_stats(&cs1);
+    double traffic[2] = {cs1.bytes - cs0.bytes, cs1.messages - cs0.messages};
+    double comm_s = cs1.seconds - cs0.seconds;
     if (s->distributed) {
         comm_sum_i64(cnt, 6);
         comm_sum_double(&cpu, 1); /* the CPU of all ranks; the wall time of the slowest */
         comm_max_double(&wall, 1);
+        comm_sum_double(traffic, 2);
+        comm_max_double(&comm_s, 1);
     }
+    s->stats.comm_bytes += traffic[0];
+    s->stats.comm_messages += traffic[1];
+    s->stats.comm_s += comm_s;
     s->stats.steps += nsteps;
     s->stats.particle_moves += (double)cnt[0];
     s->stats.wall_hits += (double)cnt[1];

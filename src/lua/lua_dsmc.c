@@ -551,7 +551,13 @@ static void measure_stats(lua_State *L, dsmc_scene *s)
     set_number(L, "collision_frequency", 2 * st.collisions / (N * st.time));
     set_number(L, "collision_frequency_theory", dsmc_collision_frequency(s));
     set_number(L, "total_collisions", dsmc_total_collisions(s));
-    (void)steps;
+    /* a distributed run's traffic (0 on one rank): totals over ranks, and per step per rank */
+    set_number(L, "comm_bytes", st.comm_bytes);
+    set_number(L, "comm_messages", st.comm_messages);
+    set_number(L, "comm_s", st.comm_s);
+    set_number(L, "ranks", (double)dsmc_ranks(s));
+    set_number(L, "comm_bytes_per_step_per_rank", st.comm_bytes / (steps * dsmc_ranks(s)));
+    set_number(L, "comm_messages_per_step_per_rank", st.comm_messages / (steps * dsmc_ranks(s)));
 }
 
 static const char *const HISTOGRAM_FIELDS[] = {"bins", "range", "quantity", NULL};
@@ -860,8 +866,10 @@ void bind_open_dsmc(lua_State *L)
          "range 5 sqrt(T/m)). stats (SPARTA's vocabulary, since s:reset_stats()): steps, "
          "particle_moves, particle_moves_per_cpu_s, attempts, collisions (= accepted), "
          "attempts_per_particle_per_step, collisions_per_particle_per_step, acceptance, "
-         "wall_hits, vmax_raised, collision_frequency (measured: 2 collisions / (N t)) and "
-         "collision_frequency_theory. profile {axis = dim, bins = cells}: position, count, "
+         "wall_hits, vmax_raised, collision_frequency (measured: 2 collisions / (N t)), "
+         "collision_frequency_theory; under mpirun ranks, comm_bytes, comm_messages (sent, all "
+         "ranks), comm_s (the slowest rank's), comm_bytes_per_step_per_rank and "
+         "comm_messages_per_step_per_rank. profile {axis = dim, bins = cells}: position, count, "
          "density, packing, temperature per layer. validity {dt = 0}: the paper's conditions "
          "with their numbers."},
         {"particles", l_particles, "s:particles()",
