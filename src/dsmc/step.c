@@ -617,8 +617,10 @@ core_status dsmc_run(dsmc_scene *s, const dsmc_run_def *run, long *done, core_er
             int64_t q[2] = {intr, (int64_t)s->n};
             comm_max_i64(q, 2);
             intr = q[0] != 0;
-            if (!intr && (st = dsmc_domain_balance(s, q[1], err)))
+            if (!intr && (st = dsmc_domain_balance(s, q[1], err))) {
+                sorted = false; /* out of memory, maybe in the middle of a migration */
                 break;
+            }
         }
         if (intr) {
             st = core_fail(err, CORE_ERR_INTERRUPTED,
