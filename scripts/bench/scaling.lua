@@ -46,6 +46,7 @@ local function dsmc_scaling()
       comm_bytes_per_step_per_rank = st.comm_bytes_per_step_per_rank,
       comm_messages_per_step_per_rank = st.comm_messages_per_step_per_rank,
       comm_s_per_step = st.comm_s / steps,
+      imbalance = st.imbalance,
       collisions_per_particle_per_step = st.collisions_per_particle_per_step,
       bytes_per_particle_this_rank = info.particle_bytes / n * st.ranks,
       temperature_bits = string.format("%a", T),
@@ -64,9 +65,10 @@ end
 if rank == 0 then
   local m = result.metrics
   print(string.format("scaling %s: %d ranks x %s threads: %.4g particle-steps/s (%.2f ms/step), " ..
-                      "%.0f bytes and %.1f messages per step per rank, %.3f ms/step in comm, T %s",
+                      "%.0f bytes and %.1f messages per step per rank, %.3f ms/step in comm, " ..
+                      "imbalance %.4f, T %s",
                       result.params.engine, result.params.ranks, tostring(result.params.threads),
                       m.particle_steps_per_s, m.step_ms, m.comm_bytes_per_step_per_rank,
                       m.comm_messages_per_step_per_rank, 1000 * m.comm_s_per_step,
-                      m.temperature_bits))
+                      m.imbalance, m.temperature_bits))
 end

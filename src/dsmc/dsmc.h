@@ -184,6 +184,7 @@ typedef struct dsmc_stats {
     /* A distributed run's traffic (core/comm.h counters, during dsmc_run): bytes and messages
      * sent, summed over ranks, and the wall time inside communication of the slowest rank. */
     double comm_bytes, comm_messages, comm_s;
+    double imbalance; /* particles on the busiest rank over the mean, at the end of the last run */
 } dsmc_stats;
 
 /* Counters since the last dsmc_reset_stats (or creation). */

@@ -217,13 +217,20 @@ void dsmc_sort_counted(dsmc_scene *s, const size_t *bcount)
     flag_sort(s, 0, s->n, bstart, bnext, nb, 0, sh, bcount);
     bstart[nb] = s->n;
     size_t *start = s->start, *next = s->next;
-    const long nbl = (long)nb;
+    /* Only this rank's cells [cell_lo, cell_hi) hold particles (all of them on one rank): the
+     * offsets of other ranks' cells are left alone, so the cost of a rank's sort goes with its
+     * share of the grid, not with the whole grid. */
+    const size_t lo = s->cell_lo, hi = s->cell_hi;
+    const long b0 = hi > lo ? (long)(lo >> sh) : 0, b1 = hi > lo ? (long)((hi - 1) >> sh) + 1 : 0;
 #pragma omp parallel for schedule(dynamic, 1) if (s->n >= DSMC_PARALLEL_MIN)
-    for (long b = 0; b < nbl; b++) {
+    for (long b = b0; b < b1; b++) {
         size_t c0 = (size_t)b * width, c1 = c0 + width < nc ? c0 + width : nc;
+        c0 = c0 > lo ? c0 : lo;
+        c1 = c1 < hi ? c1 : hi;
         flag_sort(s, bstart[b], bstart[b + 1], start + c0, next + c0, c1 - c0, (uint32_t)c0, 0,
                   NULL);
     }
+    start[hi] = s->n;
     start[nc] = s->n;
 }
 
@@ -664,18 +671,21 @@ core_status dsmc_run(dsmc_scene *s, const dsmc_run_def *run, long *done, core_er
     double cpu = clock_cpu() - c0, wall = clock_wall() - w0;
     comm_stats cs1;
     comm_get_stats(&cs1);
-    double traffic[2] = {cs1.bytes - cs0.bytes, cs1.messages - cs0.messages};
-    double comm_s = cs1.seconds - cs0.seconds;
+    /* summed: CPU of all ranks, bytes and messages they sent; the slowest: wall time, time in
+     * communication, particles held (the imbalance) */
+    double sum[3] = {cpu, cs1.bytes - cs0.bytes, cs1.messages - cs0.messages};
+    double most[3] = {wall, cs1.seconds - cs0.seconds, (double)s->n};
     if (s->distributed) {
         comm_sum_i64(cnt, 6);
-        comm_sum_double(&cpu, 1); /* the CPU of all ranks; the wall time of the slowest */
-        comm_max_double(&wall, 1);
-        comm_sum_double(traffic, 2);
-        comm_max_double(&comm_s, 1);
+        comm_sum_double(sum, 3);
+        comm_max_double(most, 3);
     }
-    s->stats.comm_bytes += traffic[0];
-    s->stats.comm_messages += traffic[1];
-    s->stats.comm_s += comm_s;
+    cpu = sum[0];
+    wall = most[0];
+    s->stats.comm_bytes += sum[1];
+    s->stats.comm_messages += sum[2];
+    s->stats.comm_s += most[1];
+    s->stats.imbalance = dsmc_count(s) ? most[2] * comm_size() / (double)dsmc_count(s) : 1;
     s->stats.steps += nsteps;
     s->stats.particle_moves += (double)cnt[0];
     s->stats.wall_hits += (double)cnt[1];

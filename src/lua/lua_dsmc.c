@@ -556,6 +556,7 @@ static void measure_stats(lua_State *L, dsmc_scene *s)
     set_number(L, "comm_messages", st.comm_messages);
     set_number(L, "comm_s", st.comm_s);
     set_number(L, "ranks", (double)dsmc_ranks(s));
+    set_number(L, "imbalance", st.imbalance);
     set_number(L, "comm_bytes_per_step_per_rank", st.comm_bytes / (steps * dsmc_ranks(s)));
     set_number(L, "comm_messages_per_step_per_rank", st.comm_messages / (steps * dsmc_ranks(s)));
 }
@@ -869,7 +870,8 @@ void bind_open_dsmc(lua_State *L)
          "wall_hits, vmax_raised, collision_frequency (measured: 2 collisions / (N t)), "
          "collision_frequency_theory; under mpirun ranks, comm_bytes, comm_messages (sent, all "
          "ranks), comm_s (the slowest rank's), comm_bytes_per_step_per_rank and "
-         "comm_messages_per_step_per_rank. profile {axis = dim, bins = cells}: position, count, "
+         "comm_messages_per_step_per_rank, imbalance (the busiest rank's particles over the mean, "
+         "at the end of the last run). profile {axis = dim, bins = cells}: position, count, "
          "density, packing, temperature per layer. validity {dt = 0}: the paper's conditions "
          "with their numbers."},
         {"particles", l_particles, "s:particles()",
