@@ -912,7 +912,9 @@ void bind_open_dsmc(lua_State *L)
          "1]. excluded_volume: the paper's free volume V_c - V_b/nu_rcp in Eq. 1 (default; chi "
          "= 1/(1 - nu/nu_rcp)), the Enskog chi(nu) of the cell, or none (chi = 1). "
          "packing_limit nu_rcp: 0.82 (2D), 0.64 (3D). Results depend on the seed, not on the "
-         "number of threads."},
+         "number of threads, nor on the number of MPI ranks (under mpirun the first run "
+         "splits the grid between the ranks; queries that need every particle gather it "
+         "back)."},
         {NULL, NULL, NULL, NULL}};
     lua_newtable(L);
     bind_register(L, -1, fns);
