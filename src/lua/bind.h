@@ -60,8 +60,8 @@ int bind_field_vector(lua_State *L, int arg, const char *call, const char *field
 int bind_field_boolean(lua_State *L, int arg, const char *call, const char *field, int def);
 /* Reads a box {{lower corner}, {upper corner}} of dim finite numbers each into lo, hi (required),
  * the upper corner above the lower one on every axis. */
-void bind_field_box(lua_State *L, int arg, const char *call, const char *field, int dim,
-                    double *lo, double *hi);
+void bind_field_box(lua_State *L, int arg, const char *call, const char *field, int dim, double *lo,
+                    double *hi);
 
 /* Raises "bad field 'F' in argument #N to 'call' (EXPECTED expected, got VALUE)" for the value
  * on top of the stack. */
@@ -100,8 +100,8 @@ typedef struct bind_run {
     core_status (*advance)(void *ctx, long n, struct progress *p, long *done, core_error *err);
     void *ctx;
     int kernel_progress;
-    double dt;         /* the run's fixed time step, checked at its start (0: chosen every step) */
-    int forced;        /* force = true: dt was accepted beyond the stability limit */
+    double dt;  /* the run's fixed time step, checked at its start (0: chosen every step) */
+    int forced; /* force = true: dt was accepted beyond the stability limit */
 } bind_run;
 
 /* Reads `every`, `on_step` and `progress` from the options table at arg and advances in chunks
@@ -172,6 +172,9 @@ void bind_new_type(lua_State *L, const char *tname, const bind_fn *methods, cons
  * threads, rng, progress, write_file) and help.c (doc, doc_of). */
 void bind_open_core(lua_State *L, int idx);
 void bind_open_help(lua_State *L, int idx);
+/* grainlab.mpi onto the table at idx (lua_mpi.c); on ranks > 0 also turns the Lua functions that
+ * write files (io.open for writing, io.output, os.remove, os.rename) into no-ops. */
+void bind_open_mpi(lua_State *L, int idx);
 
 /* Registers the global `dem` module (lua_dem.c). */
 void bind_open_dem(lua_State *L);

@@ -38,6 +38,7 @@ static int open_grainlab(lua_State *L)
     int g = lua_gettop(L);
     bind_open_core(L, g);
     bind_open_help(L, g);
+    bind_open_mpi(L, g);
     lua_createtable(L, 0, 2);
     if (opt->report_path) {
         lua_pushstring(L, opt->report_path);
@@ -58,7 +59,7 @@ static int open_grainlab(lua_State *L)
     bind_open_dsmc(L);
     bind_open_checkpoint_mpm(L);
     bind_open_render(L);
-    bind_open_vtk(L); /* after the engines: adds write_vtk to their scene types */
+    bind_open_vtk(L);    /* after the engines: adds write_vtk to their scene types */
     bind_open_lammps(L); /* LAMMPS files for dem (lua_lammps.c) */
 
     /* The Lua-side library completes the table: report, check, help. */
