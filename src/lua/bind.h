@@ -60,8 +60,8 @@ int bind_field_vector(lua_State *L, int arg, const char *call, const char *field
 int bind_field_boolean(lua_State *L, int arg, const char *call, const char *field, int def);
 /* Reads a box {{lower corner}, {upper corner}} of dim finite numbers each into lo, hi (required),
  * the upper corner above the lower one on every axis. */
-void bind_field_box(lua_State *L, int arg, const char *call, const char *field, int dim, double *lo,
-                    double *hi);
+void bind_field_box(lua_State *L, int arg, const char *call, const char *field, int dim,
+                    double *lo, double *hi);
 
 /* Raises "bad field 'F' in argument #N to 'call' (EXPECTED expected, got VALUE)" for the value
  * on top of the stack. */
@@ -100,8 +100,8 @@ typedef struct bind_run {
     core_status (*advance)(void *ctx, long n, struct progress *p, long *done, core_error *err);
     void *ctx;
     int kernel_progress;
-    double dt;  /* the run's fixed time step, checked at its start (0: chosen every step) */
-    int forced; /* force = true: dt was accepted beyond the stability limit */
+    double dt;         /* the run's fixed time step, checked at its start (0: chosen every step) */
+    int forced;        /* force = true: dt was accepted beyond the stability limit */
 } bind_run;
 
 /* Reads `every`, `on_step` and `progress` from the options table at arg and advances in chunks

@@ -59,7 +59,7 @@ static int open_grainlab(lua_State *L)
     bind_open_dsmc(L);
     bind_open_checkpoint_mpm(L);
     bind_open_render(L);
-    bind_open_vtk(L);    /* after the engines: adds write_vtk to their scene types */
+    bind_open_vtk(L); /* after the engines: adds write_vtk to their scene types */
     bind_open_lammps(L); /* LAMMPS files for dem (lua_lammps.c) */
 
     /* The Lua-side library completes the table: report, check, help. */
