@@ -15,10 +15,8 @@
 
 #include "core/clock.h"
 
-static int comm_on; /* MPI_Init was called */
 static int comm_r, comm_n = 1;
 static comm_stats stats;
-static int depth; /* comm calls in progress: only the outermost one counts in the stats */
 
 /* Bytes per MPI call (counts are int), and the largest total a v-collective moves with int
  * counts and displacements; tests lower both to take the large-message paths with small data. */
@@ -73,6 +71,9 @@ void comm_get_stats(comm_stats *out) { *out = stats; }
 void comm_reset_stats(void) { memset(&stats, 0, sizeof stats); }
 
 #ifdef GRAINLAB_HAVE_MPI
+
+static int comm_on; /* MPI_Init was called */
+static int depth;   /* comm calls in progress: only the outermost one counts in the stats */
 
 /* Launched by mpirun (Open MPI sets OMPI_COMM_WORLD_SIZE; PMIx- and PMI-based launchers set
  * PMIX_RANK or PMI_RANK). A plain run does not start MPI's runtime at all. */
