@@ -173,6 +173,11 @@ compare springs 0 velocity 100
 lammps_input "$ETA" viscoelastic "thermo $STEPS
 run $STEPS" > "$OUT/in.time"
 load() { uptime | sed 's/.*load average: //; s/,.*//'; }
+# CPU time the hypervisor gave to other guests ("steal", /proc/stat) during a run, as a percentage
+# of the machine's CPU time: on a virtual machine a quiet load average can hide a host that runs
+# this guest's 2 cores at half speed, and then the 2-core figures mean little.
+cpustat() { awk '/^cpu / { print $2 + $3 + $4 + $5 + $6 + $7 + $8 + $9, $9 }' /proc/stat; }
+steal() { echo "$1 $2" | awk '{ d = $3 - $1; printf "%.0f", d > 0 ? 100 * ($4 - $2) / d : 0 }'; }
 run_gl() { OMP_NUM_THREADS=$1 "$GL" "$OUT/grainlab_side.lua" mode=time threads="$1" steps="$STEPS" data="$DATA" | awk '/^RATE/'; }
 run_lmp() {
   if [ "$1" = 1 ]; then "$LMP" -in "$OUT/in.time" -log "$OUT/log.time" -screen none
@@ -185,20 +190,23 @@ run_lmp() {
 for cores in 1 2; do
   r=1
   while [ "$r" -le "$REPS" ]; do
-    l=$(load); echo "grainlab $cores $(run_gl "$cores") LOAD $l" | tee -a "$OUT/times.txt"
-    l=$(load); echo "lammps $cores $(run_lmp "$cores") LOAD $l" | tee -a "$OUT/times.txt"
+    l=$(load); c0=$(cpustat); t=$(run_gl "$cores"); c1=$(cpustat)
+    echo "grainlab $cores $t LOAD $l STEAL $(steal "$c0" "$c1")" | tee -a "$OUT/times.txt"
+    l=$(load); c0=$(cpustat); t=$(run_lmp "$cores"); c1=$(cpustat)
+    echo "lammps $cores $t LOAD $l STEAL $(steal "$c0" "$c1")" | tee -a "$OUT/times.txt"
     r=$((r + 1))
   done
 done
 # the medians, as a Markdown table
 echo
-echo "| cores | grainlab particle-steps/s | contacts/particle (start → end) | LAMMPS particle-steps/s | contacts/particle (start → end) | grainlab / LAMMPS | load (1 min) per run |"
-echo "|---:|---:|---:|---:|---:|---:|---|"
+echo "| cores | grainlab particle-steps/s | contacts/particle (start → end) | LAMMPS particle-steps/s | contacts/particle (start → end) | grainlab / LAMMPS | load (1 min) per run | steal % per run |"
+echo "|---:|---:|---:|---:|---:|---:|---|---|"
 for cores in 1 2; do
   g=$(awk -v c="$cores" '$1 == "grainlab" && $2 == c { print $4 }' "$OUT/times.txt" | sort -g | awk '{ a[NR] = $1 } END { print a[int((NR + 1) / 2)] }')
   l=$(awk -v c="$cores" '$1 == "lammps" && $2 == c { print $4 }' "$OUT/times.txt" | sort -g | awk '{ a[NR] = $1 } END { print a[int((NR + 1) / 2)] }')
   zg=$(awk -v c="$cores" '$1 == "grainlab" && $2 == c { z = $10 " → " $8 } END { print z }' "$OUT/times.txt")
   zl=$(awk -v c="$cores" '$1 == "lammps" && $2 == c { z = $10 " → " $8 } END { print z }' "$OUT/times.txt")
   ld=$(awk -v c="$cores" '$2 == c { printf "%s%s", s, $12; s = " " }' "$OUT/times.txt")
-  echo "| $cores | $g | $zg | $l | $zl | $(awk -v a="$g" -v b="$l" 'BEGIN { printf "%.2f", a / b }') | $ld |"
+  st=$(awk -v c="$cores" '$2 == c { printf "%s%s", s, $14; s = " " }' "$OUT/times.txt")
+  echo "| $cores | $g | $zg | $l | $zl | $(awk -v a="$g" -v b="$l" 'BEGIN { printf "%.2f", a / b }') | $ld | $st |"
 done

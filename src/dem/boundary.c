@@ -531,18 +531,19 @@ size_t dem_boundary_edges(const dem_scene *s, const long **a, const long **bb,
 }
 
 /* ---- checkpoints (called by checkpoint.c) ---------------------------------------------------- *
- * Everything but the update callback: a boundary rebuilt by a caller's update (the Delaunay mode
- * of the Lua binding) cannot be restored from a file, and is refused. The nodes and their g_a
- * are a function of the edges (dem_set_boundary_edges rebuilds them in the same order). */
+ * Everything but the update callback itself: of a boundary rebuilt by a caller's update (the
+ * Delaunay mode of the Lua binding) the section 'boundary_update' holds the update's kind and
+ * what its save_ctx writes; the loader's restorer of that kind re-attaches it. The nodes and
+ * their g_a are a function of the edges (dem_set_boundary_edges rebuilds them in that order). */
 core_status dem_boundary_save(const dem_scene *s, ckpt_writer *w, core_error *err)
 {
     const dem_boundary *b = s->bnd;
-    if (b->has_def && b->def.update)
+    const int update = b->has_def && b->def.update;
+    if (update && (!b->def.kind || !b->def.save_ctx || strlen(b->def.kind) > CKPT_TAG_MAX))
         return core_fail(err, CORE_ERR_STATE,
-                         "the scene's boundary edges are rebuilt by a Delaunay triangulation "
-                         "every %ld steps (s:boundary{ mode = 'delaunay' }), which checkpoints "
-                         "do not store yet; fixed edges, the minimal-boundary penalty, springs, "
-                         "ties and spins are stored",
+                         "the scene's boundary edges are rebuilt every %ld steps by an update "
+                         "callback without a kind and save_ctx (dem_boundary_def), which a "
+                         "checkpoint cannot restore",
                          b->def.every);
     core_status st = ckpt_section_begin(w, "boundary", CKPT_REQUIRED, err);
     if (st)
@@ -591,6 +592,13 @@ core_status dem_boundary_save(const dem_scene *s, ckpt_writer *w, core_error *er
     ckpt_put_f64(w, b->pres_max);
     ckpt_put_f64(w, b->stiffness);
     ckpt_put_f64s(w, b->eint, 4);
+    if ((st = ckpt_section_end(w, err)) || !update)
+        return st;
+    /* required: a grainlab without it would continue with edges that are never rebuilt */
+    if ((st = ckpt_section_begin(w, "boundary_update", CKPT_REQUIRED, err)))
+        return st;
+    ckpt_put_str(w, b->def.kind);
+    b->def.save_ctx(b->def.ctx, w);
     return ckpt_section_end(w, err);
 }
 
@@ -733,5 +741,36 @@ core_status dem_boundary_load(dem_scene *s, ckpt_section *sec, core_error *err)
         return st;
     b->last_update = (long)last_update;
     b->updates = (long)updates;
+    return ckpt_section_done(sec, err);
+}
+
+core_status dem_boundary_load_update(dem_scene *s, ckpt_section *sec,
+                                     const dem_boundary_restorer *restorer, core_error *err)
+{
+    char kind[CKPT_TAG_MAX + 1];
+    core_status st = ckpt_get_str(sec, kind, sizeof kind, err);
+    if (st)
+        return st;
+    for (const char *c = kind; *c; c++)
+        if (!((*c >= 'a' && *c <= 'z') || (*c >= '0' && *c <= '9') || *c == '_'))
+            return corrupt(sec, "bad update kind", err);
+    dem_boundary *b = s->bnd;
+    if (!b || !b->has_def || b->def.update)
+        return corrupt(sec, "an update without a boundary definition", err);
+    if (!restorer || strcmp(restorer->kind, kind) != 0)
+        return core_fail(err, CORE_ERR_STATE,
+                         "'%s': the scene's boundary edges are rebuilt every %ld steps by a '%s' "
+                         "update, which this loader cannot re-attach",
+                         ckpt_reader_path(sec->r), b->def.every, kind);
+    /* Only the update's fields change: dem_set_boundary would also reset the integral term and
+     * the step of the last update, which are loaded already. */
+    dem_boundary_def d = b->def;
+    if ((st = restorer->restore(sec, s, &d, err)))
+        return st;
+    b->def.update = d.update;
+    b->def.ctx = d.ctx;
+    b->def.free_ctx = d.free_ctx;
+    b->def.kind = d.kind;
+    b->def.save_ctx = d.save_ctx;
     return ckpt_section_done(sec, err);
 }

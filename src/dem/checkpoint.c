@@ -451,7 +451,8 @@ static const char *inconsistent(const dem_scene *s, int gear_ready, int prev_rea
     return NULL;
 }
 
-static void read_all(reader *r, ckpt_reader *ck, dem_scene **out)
+static void read_all(reader *r, ckpt_reader *ck, const dem_boundary_restorer *restorer,
+                     dem_scene **out)
 {
     dem_scene_def def = dem_default_scene_def();
     open_section(r, ck, "scene");
@@ -642,6 +643,11 @@ static void read_all(reader *r, ckpt_reader *ck, dem_scene **out)
         if (!r->st)
             r->st = dem_boundary_load(s, &r->sec, r->err);
     }
+    if (!r->st && ckpt_has(ck, "boundary_update")) {
+        open_section(r, ck, "boundary_update");
+        if (!r->st)
+            r->st = dem_boundary_load_update(s, &r->sec, restorer, r->err);
+    }
     const char *wrong = r->st ? NULL : inconsistent(s, gear_ready, prev_ready, need_rebuild);
     if (wrong)
         r->st = core_fail(r->err, CORE_ERR_IO, "'%s' is corrupt (inconsistent state: %s)",
@@ -657,6 +663,12 @@ static void read_all(reader *r, ckpt_reader *ck, dem_scene **out)
 
 core_status dem_load(const char *path, dem_scene **out, core_error *err)
 {
+    return dem_load_with(path, NULL, out, err);
+}
+
+core_status dem_load_with(const char *path, const dem_boundary_restorer *restorer, dem_scene **out,
+                          core_error *err)
+{
     *out = NULL;
     ckpt_reader *ck;
     core_status st = ckpt_reader_open(&ck, path, "dem", err);
@@ -664,7 +676,7 @@ core_status dem_load(const char *path, dem_scene **out, core_error *err)
         return st;
     reader r = {.err = err, .st = CORE_OK};
     dem_scene *s = NULL;
-    read_all(&r, ck, &s);
+    read_all(&r, ck, restorer, &s);
     ckpt_reader_close(ck);
     if (r.st) { /* nothing half-loaded reaches the caller */
         dem_destroy(s);

@@ -260,6 +260,8 @@ core_status dem_brilliantov_time(double e, double m_eff, double K, double v, dou
 core_status dem_pair_damping(const dem_scene *s, size_t i, size_t j, int wall, double *out,
                              core_error *err);
 
+struct ckpt_writer; /* core/checkpoint.h */
+struct ckpt_section;
 /* ---- boundary conditions of the biaxial laboratory (Padbidri Ch. 3) ----------------------- *
  * 2D only. A pressure boundary is a list of directed edges a -> b between particles, outward
  * normal (dy, -dx)/L: every force evaluation, each loaded edge pushes both its particles inward
@@ -287,6 +289,12 @@ typedef struct dem_boundary_def {
      * error is driven back too (a proportional-integral penalty; with an explicit step, K is
      * limited, and the rate penalty alone then lags under load); 0: the rate only (Eq. 3.4). */
     double tau;
+    /* Checkpoints: a function pointer cannot go into a file, so the installer of `update` names
+     * it (`kind`, at most 15 characters, e.g. "delaunay") and writes what ctx holds with
+     * save_ctx (core/checkpoint.h put functions); dem_load_with hands that back to the caller's
+     * dem_boundary_restorer of the same kind. An update without a kind cannot be saved. */
+    const char *kind;
+    void (*save_ctx)(const void *ctx, struct ckpt_writer *w);
 } dem_boundary_def;
 
 dem_boundary_def dem_default_boundary_def(void); /* no pressure, every 250, no penalty */
@@ -420,10 +428,24 @@ const dem_material *dem_material_get(const dem_scene *s, int index); /* NULL if 
  * The whole state a run continues from, laid out by particle id (core/checkpoint.h container,
  * engine kind "dem"): run N + M steps, or N, save, load (in another process, with another thread
  * count), M: the same bits. Boundary conditions are stored (edges, pressure, the minimal-boundary
- * penalty and its integral, springs, ties, spins) except an update callback: a boundary rebuilt
- * by one is refused. version: the grainlab version recorded in the file. */
+ * penalty and its integral, springs, ties, spins, the step of the last update) and an update
+ * callback's kind and ctx (dem_boundary_def.kind, save_ctx), never the callback itself; an update
+ * without a kind is refused. version: the grainlab version recorded in the file. */
 core_status dem_save(const dem_scene *s, const char *path, const char *version, core_error *err);
-/* A new scene from a file; on any error nothing is returned (*out = NULL). */
+
+/* Re-attaches a saved boundary update on load: `restore` reads what save_ctx wrote (sec is
+ * positioned there and must be read to the end of it) and sets def->update, ctx, free_ctx, kind
+ * and save_ctx; the rest of *def is the loaded definition. On failure it frees what it made. */
+typedef struct dem_boundary_restorer {
+    const char *kind;
+    core_status (*restore)(struct ckpt_section *sec, const dem_scene *s, dem_boundary_def *def,
+                           core_error *err);
+} dem_boundary_restorer;
+/* A new scene from a file; on any error nothing is returned (*out = NULL). A file whose boundary
+ * is rebuilt by an update of another kind than restorer's (or restorer NULL) is refused. */
+core_status dem_load_with(const char *path, const dem_boundary_restorer *restorer, dem_scene **out,
+                          core_error *err);
+/* dem_load_with without a restorer. */
 core_status dem_load(const char *path, dem_scene **out, core_error *err);
 
 #endif

@@ -134,11 +134,13 @@ core_status dem_alloc_array(double **a, size_t n, core_error *err);
 typedef struct dem_boundary dem_boundary;
 core_status dem_boundary_apply(dem_scene *s, double dt, core_error *err);
 core_status dem_boundary_due(dem_scene *s, core_error *err);
-/* Checkpoints (checkpoint.c): the boundary's section; the save refuses a boundary rebuilt by an
- * update callback (it cannot be restored from a file). */
+/* Checkpoints (checkpoint.c): the boundary's section and, for a boundary rebuilt by an update
+ * callback, the update's (its kind and ctx; the save refuses an update without a kind). */
 struct ckpt_writer;
 struct ckpt_section;
 core_status dem_boundary_save(const dem_scene *s, struct ckpt_writer *w, core_error *err);
 core_status dem_boundary_load(dem_scene *s, struct ckpt_section *sec, core_error *err);
+core_status dem_boundary_load_update(dem_scene *s, struct ckpt_section *sec,
+                                     const dem_boundary_restorer *restorer, core_error *err);
 
 #endif

@@ -193,6 +193,8 @@ void bind_open_dsmc(lua_State *L);
 /* Registers the global `analysis` module and the boundary-condition methods of dem.scene
  * (lua_analysis.c); after bind_open_dem. */
 void bind_open_analysis(lua_State *L);
+/* dem.load's restorer of the Delaunay boundary update s:boundary installs (lua_analysis.c). */
+const struct dem_boundary_restorer *bind_dem_boundary_restorer(void);
 /* s:save and dem.load (lua_checkpoint.c); after bind_open_dem. */
 void bind_open_checkpoint(lua_State *L);
 

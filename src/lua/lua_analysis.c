@@ -1,11 +1,13 @@
 /* The Lua module `analysis` (Delaunay-cell continuum over src/analysis) and the boundary-
  * condition methods of dem.scene (over src/dem/boundary.c). This file is also the small layer
  * that couples the two: the Delaunay boundary update handed to the DEM as a callback. */
+#include <inttypes.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "analysis/analysis.h"
+#include "core/checkpoint.h"
 #include "core/clock.h"
 #include "dem/dem.h"
 #include "lua/bind.h"
@@ -853,6 +855,128 @@ static core_status delaunay_update(void *ctxp, dem_scene *s, core_error *err)
     return st;
 }
 
+/* ---- the Delaunay update in checkpoints ---- *
+ * s:save stores the update's parameters and the previous loop (the band of the next update is
+ * taken along it) in the 'boundary_update' section; dem.load reads them back and attaches the
+ * same update as s:boundary does (delaunay_attach), so that the rebuilds continue at the same
+ * steps with the same edges. The callback pointer is never written. */
+static const char DELAUNAY_KIND[] = "delaunay";
+
+static void put_longs(ckpt_writer *w, const long *v, size_t n)
+{
+    ckpt_put_u64(w, n);
+    for (size_t k = 0; k < n; k++)
+        ckpt_put_i64(w, v[k]);
+}
+
+static void delaunay_save(const void *ctxp, ckpt_writer *w)
+{
+    const delaunay_ctx *c = ctxp;
+    ckpt_put_f64(w, c->alpha);
+    ckpt_put_u32(w, (uint32_t)c->lateral);
+    ckpt_put_u32(w, (uint32_t)c->band);
+    put_longs(w, c->ids, c->ids ? c->nids : 0);
+    put_longs(w, c->loop, c->nloop);
+}
+
+/* The one installation of the Delaunay update on def, for s:boundary and dem.load: a new context
+ * with copies of ids (NULL: all particles) and of the previous loop (NULL: none yet). */
+static core_status delaunay_attach(dem_boundary_def *def, double alpha, int lateral, int band,
+                                   const long *ids, size_t nids, const long *loop, size_t nloop,
+                                   core_error *err)
+{
+    delaunay_ctx *c = calloc(1, sizeof *c);
+    if (c) {
+        c->ids = ids ? malloc((nids ? nids : 1) * sizeof *c->ids) : NULL;
+        c->loop = nloop ? malloc(nloop * sizeof *c->loop) : NULL;
+    }
+    if (!c || (ids && !c->ids) || (nloop && !c->loop)) {
+        free_delaunay_ctx(c);
+        return core_fail(err, CORE_ERR_NOMEM, "out of memory for the Delaunay boundary");
+    }
+    c->alpha = alpha;
+    c->lateral = lateral;
+    c->band = band;
+    if (ids) {
+        memcpy(c->ids, ids, nids * sizeof *ids);
+        c->nids = nids;
+    }
+    if (nloop)
+        memcpy(c->loop, loop, nloop * sizeof *loop);
+    c->nloop = nloop;
+    def->update = delaunay_update;
+    def->ctx = c;
+    def->free_ctx = free_delaunay_ctx;
+    def->kind = DELAUNAY_KIND;
+    def->save_ctx = delaunay_save;
+    return CORE_OK;
+}
+
+/* Reads a count and that many particle ids in [0, n) into a new array (NULL when none). */
+static core_status get_longs(ckpt_section *sec, size_t n, const char *what, long **out,
+                             size_t *count, core_error *err)
+{
+    *out = NULL;
+    *count = 0;
+    uint64_t c = 0;
+    core_status st = ckpt_get_u64(sec, &c, err);
+    if (st)
+        return st;
+    if (c > (sec->size - sec->pos) / 8) /* before it sizes an allocation */
+        return core_fail(err, CORE_ERR_IO,
+                         "'%s' is a corrupt dem checkpoint: %" PRIu64 " entries of %s",
+                         ckpt_reader_path(sec->r), c, what);
+    if (c == 0)
+        return CORE_OK;
+    *count = (size_t)c;
+    long *v = malloc(*count * sizeof *v);
+    if (!v)
+        return core_fail(err, CORE_ERR_NOMEM, "out of memory loading a checkpoint");
+    for (size_t k = 0; k < *count && !st; k++)
+        st = ckpt_get_int_in(sec, 0, (long)n - 1, what, &v[k], err);
+    if (st)
+        free(v);
+    else
+        *out = v;
+    return st;
+}
+
+static core_status delaunay_restore(ckpt_section *sec, const dem_scene *s, dem_boundary_def *def,
+                                    core_error *err)
+{
+    const char *bad = "'%s' is a corrupt dem checkpoint: the Delaunay boundary's %s";
+    const char *path = ckpt_reader_path(sec->r);
+    double alpha = 0;
+    uint32_t flag[2] = {0, 0}; /* sides = 'lateral', band */
+    long *ids = NULL, *loop = NULL;
+    size_t nids = 0, nloop = 0;
+    core_status st = ckpt_get_finite(sec, "the Delaunay boundary's alpha", &alpha, err);
+    if (!st && !(alpha >= 0))
+        st = core_fail(err, CORE_ERR_IO, bad, path, "alpha is negative");
+    for (int k = 0; k < 2 && !st; k++)
+        if (!(st = ckpt_get_u32(sec, &flag[k], err)) && flag[k] > 1)
+            st = core_fail(err, CORE_ERR_IO, bad, path,
+                           k ? "band flag is not 0 or 1" : "sides flag is not 0 or 1");
+    const size_t n = dem_count(s);
+    if (!st)
+        st = get_longs(sec, n, "a Delaunay boundary particle id", &ids, &nids, err);
+    if (!st && nids > 0 && nids < 3)
+        st = core_fail(err, CORE_ERR_IO, bad, path, "ids are fewer than 3");
+    if (!st)
+        st = get_longs(sec, n, "a Delaunay boundary loop id", &loop, &nloop, err);
+    if (!st)
+        st = delaunay_attach(def, alpha, (int)flag[0], (int)flag[1], ids, nids, loop, nloop, err);
+    free(ids);
+    free(loop);
+    return st;
+}
+
+const dem_boundary_restorer *bind_dem_boundary_restorer(void)
+{
+    static const dem_boundary_restorer r = {DELAUNAY_KIND, delaunay_restore};
+    return &r;
+}
+
 /* Field `key` of the table at tab as a 2x2 matrix {{xx, xy}, {yx, yy}} of finite numbers;
  * errors name field `label` of argument arg (mbc is a table inside argument #1). */
 static void read_matrix(lua_State *L, int tab, const char *key, int arg, const char *call,
@@ -1104,30 +1228,14 @@ static int l_boundary(lua_State *L)
             snprintf(got, sizeof got, "%d ids", (int)nids);
             return field_fail(L, 2, call, "ids", "array of at least 3 particle ids", got);
         }
-        delaunay_ctx *c = calloc(1, sizeof *c);
-        if (!c)
-            return luaL_error(L, "%s: out of memory", call);
-        c->alpha = alpha;
-        c->lateral = lateral;
-        c->band = band;
-        if (ids) {
-            c->nids = nids;
-            c->ids = malloc((nids ? nids : 1) * sizeof *c->ids);
-            if (!c->ids) {
-                free(c);
-                return luaL_error(L, "%s: out of memory", call);
-            }
-            memcpy(c->ids, ids, nids * sizeof *ids);
-        }
-        def.update = delaunay_update;
-        def.ctx = c;
-        def.free_ctx = free_delaunay_ctx;
         core_error err;
+        if (delaunay_attach(&def, alpha, lateral, band, ids, nids, NULL, 0, &err))
+            return bind_raise(L, call, &err);
         /* Build the edges first (a failed triangulation leaves the scene as it was). */
         double penalty = def.penalty;
         def.penalty = 0;
         if (dem_set_boundary(s, &def, &err)) {
-            free_delaunay_ctx(c);
+            free_delaunay_ctx(def.ctx);
             return bind_raise(L, call, &err);
         }
         if (dem_update_boundary(s, &err)) {

@@ -23,7 +23,7 @@ static int l_dem_load(lua_State *L)
     const char *path = bind_arg_path(L, 1, "load");
     struct dem_scene **slot = bind_new_dem_scene(L);
     core_error err;
-    if (dem_load(path, slot, &err) != CORE_OK)
+    if (dem_load_with(path, bind_dem_boundary_restorer(), slot, &err) != CORE_OK)
         return bind_raise(L, "load", &err);
     return 1;
 }
@@ -36,8 +36,10 @@ void bind_open_checkpoint(lua_State *L)
          "history, walls and servos, the contact law, the integrator's state, time and counters), "
          "by particle id. dem.load(path) in this or another process, with any number of threads, "
          "continues with the same bits. Written whole (temporary file + rename). Boundary "
-         "conditions (fixed edges, pressure, MBC, springs, ties, spins) are saved; a boundary "
-         "rebuilt by Delaunay triangulation (mode = 'delaunay') is refused."},
+         "conditions are saved (fixed edges, pressure, MBC with its integral term, springs, "
+         "ties, spins), also a boundary rebuilt by Delaunay triangulation (mode = 'delaunay'): "
+         "its parameters, current edges and schedule, so the rebuilds continue at the same "
+         "steps with the same edges."},
         {NULL, NULL, NULL, NULL}};
     luaL_getmetatable(L, "dem.scene");
     lua_getfield(L, -1, "__index");

@@ -3,7 +3,8 @@
 # process that loads the file (with 2 threads where the first had 1; these scenes are below the
 # 4096 particles at which threads start: test_checkpoint_dem.lua covers that): every position, velocity,
 # angular velocity and angle printed with %a must agree, for 2D and 3D and each integrator; the
-# same for a file saved from on_step; a bad file stops the script with a clear message.
+# same for a file saved from on_step and for Delaunay boundaries rebuilt during the run; a bad
+# file stops the script with a clear message.
 # usage: test_checkpoint.sh path/to/grainlab   (run from tests/cli)
 set -u
 G=$1
@@ -35,6 +36,21 @@ f="$tmp/bnd.ckpt"
 "$G" --quiet ckpt_dem.lua mode=save $c file="$f" || bad "boundary save"
 "$G" --quiet ckpt_dem.lua mode=load $c file="$f" >"$tmp/load" || bad "boundary load"
 cmp -s "$tmp/full" "$tmp/load" && ok || bad "boundary: N + M differs from N, save, load in a new process, M"
+
+# a Delaunay boundary rebuilt every `every` steps (each variant of ckpt_dem_case.lua: pressure, MBC
+# with its integral, lateral sides, ids): the rebuilds after the load, in the new process, give the
+# same edges at the same steps (the dump ends with the edges and the count of rebuilds)
+for k in 1 2 3 4; do
+  f="$tmp/delaunay$k.ckpt"
+  "$G" --quiet ckpt_dem.lua mode=full delaunay=$k >"$tmp/full" || bad "Delaunay $k full run"
+  "$G" --quiet ckpt_dem.lua mode=save delaunay=$k file="$f" || bad "Delaunay $k save"
+  "$G" --quiet --threads 2 ckpt_dem.lua mode=load delaunay=$k file="$f" >"$tmp/load" || bad "Delaunay $k load"
+  grep -q "^boundary .* [1-9][0-9]* updates" "$tmp/load" && ok || bad "Delaunay $k: no edges in the dump"
+  if cmp -s "$tmp/full" "$tmp/load"; then ok; else
+    bad "Delaunay $k: N + M differs from N, save, load in a new process, M"
+    diff "$tmp/full" "$tmp/load" | head -4
+  fi
+done
 
 # saved from on_step, continued in a new process
 f="$tmp/onstep.ckpt"

@@ -85,6 +85,46 @@ function M.build_boundary()
   return s
 end
 
+-- The 2D scene with a Delaunay boundary (s:boundary{ mode = 'delaunay' }), whose edges are rebuilt
+-- every `every` steps: one variant per combination the binding offers, each with an integrator
+-- and the N and M of its round trip, chosen so that rebuilds after step N give other edges than
+-- those saved (the tests check that they do).
+local ids42 = {}
+for k = 1, 42 do ids42[k] = k end -- all but the top row
+M.delaunay = {
+  { name = "pressure", integ = "two_timescales", n = 500, m = 500,
+    def = { every = 50, alpha = 1.2, pressure = 20, depth = 0.002 } },
+  { name = "pressure + MBC strain rate with integral", integ = "gear", n = 500, m = 500,
+    def = { every = 50, alpha = 1.2, pressure = 20, depth = 0.002,
+            mbc = { strain_rate = { { -1, 0 }, { 0, 1 } }, rate = 1, kappa = 1, dt = M.dt[2],
+                    tau = 50 * M.dt[2] } } },
+  { name = "lateral sides, no band, MBC gradient", integ = "position_verlet", n = 600, m = 400,
+    def = { every = 100, sides = "lateral", band = false, pressure = 20, depth = 0.002,
+            mbc = { gradient = { { -1, 0.5 }, { 0, 1 } }, rate = 1, kappa = 1, dt = M.dt[2],
+                    tau = 20 * M.dt[2] } } },
+  { name = "ids, MBC with K and a mask", integ = "velocity_verlet", n = 700, m = 500,
+    def = { every = 60, ids = ids42, pressure = 20, depth = 0.002,
+            mbc = { strain_rate = { { 0, 0 }, { 0, 0 } }, mask = { { 1, 0 }, { 0, 0 } }, K = 1e-9,
+                    tau = 30 * M.dt[2] } } },
+}
+
+function M.build_delaunay(k)
+  local s = M.build(2)
+  local def = { mode = "delaunay" }
+  for key, v in pairs(M.delaunay[k].def) do def[key] = v end
+  s:boundary(def)
+  return s
+end
+
+-- The boundary edges and their counters, for comparing rebuilds.
+function M.dump_edges(s)
+  local e, bi = s:boundary_edges(), s:boundary_info()
+  local out = { string.format("boundary %d edges, %d loaded, %d updates", bi.edges, bi.loaded,
+                              bi.updates) }
+  for k = 1, #e.a do out[#out + 1] = string.format("%d>%d%s", e.a[k], e.b[k], e.loaded[k] and "" or "-") end
+  return table.concat(out, " ")
+end
+
 function M.run(s, integrator, steps, every, on_step)
   local dt = M.dt[s:info().dim] / (integrator == "two_timescales" and 2 or 1)
   return s:run{ steps = steps, dt = dt, integrator = integrator, m = 2, n = 2,
