@@ -12,6 +12,8 @@ static volatile sig_atomic_t terminating = 0;
 static char where[160];
 
 void interrupt_request(void) { requested = 1; }
+bool interrupt_pending_here(void) { return requested != 0; }
+
 bool interrupt_pending(void)
 {
     if (comm_size() == 1)
