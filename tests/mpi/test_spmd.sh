@@ -52,6 +52,12 @@ one=$(cd "$tmp" && mkdir -p plain && cd plain && "$G" --quiet "$here/spmd_output
 three=$(printf '%s\n' "$out" | grep -v -e '^printed once' -e wall -e '^  ranks ')
 [ "$one" = "$three" ] && ok || bad "plain and 3-rank stdout differ: $one // $three"
 
+# GRAINLAB_MPI_OUTPUT=all: every rank prints (debugging)
+export GRAINLAB_MPI_OUTPUT=all
+run 3 -e 'print("hello from", grainlab.mpi.rank())'
+expect_rc 0 output-all; count "hello from" 3 output-all; count "hello from	2" 1 output-all
+unset GRAINLAB_MPI_OUTPUT
+
 # --- errors ---
 # the same error on every rank: said once, status 1, no MPI_ABORT
 run 3 -e 'local x = nil; x.field = 1'
