@@ -301,19 +301,20 @@ static double error_wait(void)
  * plain run, others tagged with their rank). A rank that failed while the others run on (an
  * error on that rank only) cannot be waited for: after error_wait() it prints its message and
  * ends the whole run. */
-static int spmd_finish(int status)
+static int spmd_finish(int status, double wait)
 {
     int P = comm_size(), me = comm_rank();
     if (P == 1)
         return status;
     int64_t mine[2] = {status, spmd_error ? (int64_t)digest(spmd_error) : 0};
     int64_t *all = malloc(2 * (size_t)P * sizeof *all);
-    double wait = status ? error_wait() : -1;
     if (!all || comm_agree(mine, all, wait) != 0) {
+        if (spmd_error)
+            dprintf(rank_stderr, "grainlab: rank %d: %s\n", me, spmd_error);
         dprintf(rank_stderr,
-                "grainlab: rank %d: %s\ngrainlab: rank %d failed alone (the other ranks did not "
-                "reach the end within %g s): ending the run\n",
-                me, spmd_error ? spmd_error : "failed", me, wait);
+                "grainlab: rank %d %s alone (the other ranks did not reach the end within %g s): "
+                "ending the run\n",
+                me, spmd_error ? "failed" : "ended", wait);
         comm_abort(status ? status : 1);
     }
     int agreed = 0, first = spmd_error != NULL;
@@ -330,6 +331,21 @@ static int spmd_finish(int status)
     free(spmd_error);
     spmd_error = NULL;
     return agreed;
+}
+
+/* os.exit in a distributed run: the ranks agree on the status as at the end of a script, then
+ * MPI is ended properly (a bare exit() is reported by mpirun as a crash); a rank that calls it
+ * alone, with the others running on, ends the run after error_wait(). */
+static int l_spmd_exit(lua_State *L)
+{
+    int status = lua_isboolean(L, 1) ? (lua_toboolean(L, 1) ? EXIT_SUCCESS : EXIT_FAILURE)
+                                     : (int)luaL_optinteger(L, 1, EXIT_SUCCESS);
+    fflush(stdout);
+    status = spmd_finish(status, error_wait());
+    if (lua_toboolean(L, 2))
+        lua_close(L);
+    comm_finalize();
+    exit(status);
 }
 
 void cli_print_error(lua_State *L)
@@ -470,6 +486,12 @@ static int cli_main(int argc, char **argv)
     }
     catch_sigterm(L);
     set_params(L, &a, argv[0]);
+    if (comm_size() > 1) {
+        lua_getglobal(L, "os");
+        lua_pushcfunction(L, l_spmd_exit);
+        lua_setfield(L, -2, "exit");
+        lua_pop(L, 1);
+    }
 
     for (int i = 0; i < a.nchunks && status == 0; i++)
         status = run_chunk(
@@ -485,7 +507,7 @@ static int cli_main(int argc, char **argv)
     if (a.interactive && !interrupt_terminating()) /* also after an error: state to inspect */
         repl_run(L);
     if (interrupt_terminating()) {
-        status = spmd_finish(terminated());
+        status = spmd_finish(terminated(), error_wait());
         lua_close(L);
         free(a.chunks);
         free(a.params);
@@ -497,7 +519,7 @@ static int cli_main(int argc, char **argv)
         fprintf(stderr, "grainlab: %d report check%s failed\n", failed, failed == 1 ? "" : "s");
         status = 1;
     }
-    status = spmd_finish(status);
+    status = spmd_finish(status, status ? error_wait() : -1);
     lua_close(L);
     free(a.chunks);
     free(a.params);

@@ -76,6 +76,14 @@ count "grainlab: rank 1: only on rank one" 1 lone-error; count "rank 1 failed al
 run 3 -e 'if grainlab.mpi.rank() == 2 then error("late on rank two", 0) end'
 expect_rc 1 lone-error-at-end; count "grainlab: rank 2: late on rank two" 1 lone-error-at-end
 lacks MPI_ABORT lone-error-at-end
+# os.exit on every rank: MPI ended properly, the status kept; on one rank alone: no hang
+run 2 -e 'print("bye") os.exit(true)'
+expect_rc 0 os.exit-true; count bye 1 os.exit-true; lacks "exiting improperly" os.exit-true
+run 3 -e 'os.exit(3, true)'
+expect_rc 3 os.exit-3; lacks "exiting improperly" os.exit-3
+run 3 -e 'if grainlab.mpi.rank() == 1 then os.exit(0) end grainlab.mpi.barrier()'
+[ "$rc" -ne 0 ] && [ "$rc" -ne 124 ] && ok || bad "lone os.exit: nonzero status, no timeout"
+count "grainlab: rank 1 ended alone" 1 lone-os.exit
 unset GRAINLAB_MPI_ERROR_WAIT
 # a failed report check: once
 run 2 -e 'grainlab.report{ scenario = "f", checks = { { name = "c", value = 2, limit = 1 } } }'
