@@ -63,6 +63,9 @@ unset GRAINLAB_MPI_OUTPUT
 run 3 -e 'local x = nil; x.field = 1'
 expect_rc 1 same-error; count "attempt to index a nil value (local 'x')" 1 same-error; lacks MPI_ABORT same-error
 lacks "rank 1" same-error
+# bcast refused on the root: every rank raises the root's message (no rank waits for data)
+run 3 -e 'grainlab.mpi.bcast(grainlab.mpi.rank() == 0 and print or 1)'
+expect_rc 1 bcast-refused; count "bad argument #1 to 'bcast'" 1 bcast-refused; lacks "rank 1" bcast-refused
 # different errors: each said once, by its rank
 run 3 -e 'error("error of rank " .. grainlab.mpi.rank(), 0)'
 expect_rc 1 rank-errors; count "grainlab: error of rank 0" 1 rank-errors
