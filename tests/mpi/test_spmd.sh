@@ -2,9 +2,11 @@
 # SPMD scripts under mpirun, as a user runs them: output and files once, errors once, a lone
 # failing rank ending the run without a hang, SIGTERM stopping every rank at the same step,
 # and the refusals (MPM, the REPL).
-# usage: test_spmd.sh path/to/grainlab path/to/mpirun   (run from tests/mpi)
+# usage: test_spmd.sh path/to/grainlab path/to/mpirun [SECTION]   (run from tests/mpi)
+#   SECTION: output, errors, refusals or sigterm (default: all of them)
 set -u
-G=$(realpath "$1") M=${2:-}
+G=$(realpath "$1") M=${2:-} section=${3:-all}
+want() { [ "$section" = all ] || [ "$section" = "$1" ]; }
 if [ -z "$M" ] || [ ! -x "$M" ] || ! "$G" -e 'os.exit(grainlab.mpi.available and 0 or 1)'; then
   echo "skipped: grainlab was built without MPI, or mpirun is missing"; exit 77
 fi
@@ -31,6 +33,7 @@ count() {
 }
 lacks() { case "$out$err" in *"$1"*) bad "$2: unexpected '$1'" ;; *) ok ;; esac; }
 
+if want output; then
 # --- output and files once (3 ranks) ---
 run 3 --report r.json "$here/spmd_output.lua"
 expect_rc 0 output
@@ -58,6 +61,9 @@ run 3 -e 'print("hello from", grainlab.mpi.rank())'
 expect_rc 0 output-all; count "hello from" 3 output-all; count "hello from	2" 1 output-all
 unset GRAINLAB_MPI_OUTPUT
 
+fi
+
+if want errors; then
 # --- errors ---
 # the same error on every rank: said once, status 1, no MPI_ABORT
 run 3 -e 'local x = nil; x.field = 1'
@@ -92,6 +98,9 @@ unset GRAINLAB_MPI_ERROR_WAIT
 run 2 -e 'grainlab.report{ scenario = "f", checks = { { name = "c", value = 2, limit = 1 } } }'
 expect_rc 1 report-check; count "1 report check failed" 1 report-check
 
+fi
+
+if want refusals; then
 # --- refusals ---
 run 2 -e 'local m = mpm.scene{ cells = { 4, 4 }, size = { 1, 1 } }'
 expect_rc 1 mpm; count "mpm.scene: MPM does not run distributed yet (this run has 2 ranks under mpirun); run MPM scripts without mpirun" 1 mpm
@@ -100,6 +109,9 @@ expect_rc 2 repl; count "under mpirun, give the script as a file" 1 repl
 run 2 -
 expect_rc 2 stdin-script; count "under mpirun, give the script as a file" 1 stdin-script
 
+fi
+
+if want sigterm; then
 # --- SIGTERM to one rank only: every rank stops at the same step, said once, status 143 ---
 rm -rf "$tmp/run"; mkdir -p "$tmp/run"
 (cd "$tmp/run" && exec timeout 60 "$M" --oversubscribe -np 3 "$G" --quiet "$here/long_run.lua" >"$tmp/out" 2>"$tmp/err") &
@@ -113,6 +125,8 @@ wait "$launcher"; rc=$?; out=$(cat "$tmp/out"); err=$(cat "$tmp/err")
 expect_rc 143 sigterm; count "grainlab: terminated (SIGTERM) at step" 1 sigterm
 lacks MPI_ABORT sigterm
 [ -z "$(ls "$tmp/run" | grep tmp)" ] && ok || bad "sigterm: temporaries left"
+
+fi
 
 echo "test_spmd: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]
