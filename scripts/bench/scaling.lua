@@ -3,8 +3,7 @@
 --   mpirun -np K grainlab scripts/bench/scaling.lua engine=dsmc threads=1 ...
 -- Each invocation measures one configuration (K ranks x threads); run it for 1 rank x 1 thread,
 -- 2 ranks x 1 thread and 1 rank x 2 threads, alternating, and compare particle_steps_per_s.
--- Only rank 0 reports (OMPI_COMM_WORLD_RANK), until grainlab.mpi writes once by itself.
-local rank = tonumber(os.getenv("OMPI_COMM_WORLD_RANK") or "0")
+-- (Under mpirun only rank 0's output appears: docs/mpi.md.)
 local engine = params.engine or "dsmc"
 
 -- ---- DSMC: Herrmann Fig. 2's gas -------------------------------------------------------------
@@ -62,7 +61,7 @@ else
         tostring(engine))
 end
 
-if rank == 0 then
+do
   local m = result.metrics
   print(string.format("scaling %s: %d ranks x %s threads: %.4g particle-steps/s (%.2f ms/step), " ..
                       "%.0f bytes and %.1f messages per step per rank, %.3f ms/step in comm, " ..
