@@ -4,7 +4,9 @@
 #define _POSIX_C_SOURCE 200809L
 #include <ctype.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <signal.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -28,6 +30,9 @@ static const char *USAGE =
     "  grainlab FILE.lua a=1 b=x   run a script; the pairs arrive in the global table `params`\n"
     "                              (numbers converted, true/false as booleans, text as strings);\n"
     "                              FILE '-' reads the script from standard input\n"
+    "  mpirun -np K grainlab FILE.lua\n"
+    "                              run distributed: every rank runs the script (SPMD), output\n"
+    "                              is written once, by rank 0 (docs/mpi.md)\n"
     "\n"
     "options:\n"
     "  -i               enter the REPL after running the script and -e chunks\n"
@@ -159,7 +164,10 @@ static void on_sigint(int sig)
 {
     signal(sig, on_second_sigint);
     interrupt_request();
-    lua_sethook(running_L, stop_hook, LUA_MASKCALL | LUA_MASKRET | LUA_MASKCOUNT, 1);
+    /* Distributed, the ranks stop together where the engines agree (between steps): a hook would
+     * raise in each rank's Lua at a different place, and leave the others waiting. */
+    if (comm_size() == 1)
+        lua_sethook(running_L, stop_hook, LUA_MASKCALL | LUA_MASKRET | LUA_MASKCOUNT, 1);
 }
 
 /* SIGTERM (a batch scheduler's time limit) stops the run between steps like Ctrl-C, then ends the
@@ -180,7 +188,7 @@ static void on_sigterm(int sig)
         _exit(128 + sig);
     }
     interrupt_terminate(sig);
-    if (running_L)
+    if (running_L && comm_size() == 1) /* distributed: see on_sigint */
         lua_sethook(running_L, stop_hook, LUA_MASKCALL | LUA_MASKRET | LUA_MASKCOUNT, 1);
 }
 
@@ -243,9 +251,113 @@ int cli_docall(lua_State *L, int narg, int nres)
     return status;
 }
 
+/* ---- distributed runs: output once, errors once ----------------------------------------------
+ * Ranks other than 0 write their standard output and error to the null device (every rank runs
+ * the same script, so rank 0 says it all), keeping the real stderr for messages of their own. */
+static int rank_stderr = STDERR_FILENO;
+static char *spmd_error; /* the first error of a distributed run, printed after the agreement */
+
+/* The sanitizers' reports (a crash, a leak) must not vanish with a rank's stderr. */
+void __sanitizer_set_report_fd(void *fd) __attribute__((weak));
+
+static void quiet_other_ranks(void)
+{
+    const char *all = getenv("GRAINLAB_MPI_OUTPUT"); /* "all": debugging, every rank speaks */
+    if (comm_rank() == 0 || (all && strcmp(all, "all") == 0))
+        return;
+    fflush(stdout);
+    fflush(stderr);
+    int keep = dup(STDERR_FILENO), null = open("/dev/null", O_WRONLY);
+    if (keep < 0 || null < 0)
+        return;
+    rank_stderr = keep;
+    dup2(null, STDOUT_FILENO);
+    dup2(null, STDERR_FILENO);
+    close(null);
+    if (__sanitizer_set_report_fd)
+        __sanitizer_set_report_fd((void *)(intptr_t)keep);
+}
+
+static uint64_t digest(const char *s)
+{
+    uint64_t h = 1469598103934665603u; /* FNV-1a */
+    for (; *s; s++)
+        h = (h ^ (unsigned char)*s) * 1099511628211u;
+    return h ? h : 1;
+}
+
+/* Seconds a failed rank waits for the others to reach the end of the script too (the same
+ * error on every rank: one message, a clean exit) before it ends the run alone. */
+static double error_wait(void)
+{
+    const char *env = getenv("GRAINLAB_MPI_ERROR_WAIT");
+    char *end;
+    double d = env && *env ? strtod(env, &end) : 5.0;
+    return env && *env && (*end || !(d >= 0)) ? 5.0 : d;
+}
+
+/* The end of a distributed run: the ranks agree on the exit status (the highest), and each
+ * distinct error message is printed once, by the lowest rank that raised it (rank 0's as in a
+ * plain run, others tagged with their rank). A rank that failed while the others run on (an
+ * error on that rank only) cannot be waited for: after error_wait() it prints its message and
+ * ends the whole run. */
+static int spmd_finish(int status, double wait)
+{
+    int P = comm_size(), me = comm_rank();
+    if (P == 1)
+        return status;
+    int64_t mine[2] = {status, spmd_error ? (int64_t)digest(spmd_error) : 0};
+    int64_t *all = malloc(2 * (size_t)P * sizeof *all);
+    if (!all || comm_agree(mine, all, wait) != 0) {
+        if (spmd_error)
+            dprintf(rank_stderr, "grainlab: rank %d: %s\n", me, spmd_error);
+        dprintf(rank_stderr,
+                "grainlab: rank %d %s alone (the other ranks did not reach the end within %g s): "
+                "ending the run\n",
+                me, spmd_error ? "failed" : "ended", wait);
+        comm_abort(status ? status : 1);
+    }
+    int agreed = 0, first = spmd_error != NULL;
+    for (int r = 0; r < P; r++) {
+        agreed = all[2 * r] > agreed ? (int)all[2 * r] : agreed;
+        if (r < me && all[2 * r] && all[2 * r + 1] == mine[1])
+            first = 0;
+    }
+    if (first && me == 0)
+        fprintf(stderr, "grainlab: %s\n", spmd_error);
+    else if (first)
+        dprintf(rank_stderr, "grainlab: rank %d: %s\n", me, spmd_error);
+    free(all);
+    free(spmd_error);
+    spmd_error = NULL;
+    return agreed;
+}
+
+/* os.exit in a distributed run: the ranks agree on the status as at the end of a script, then
+ * MPI is ended properly (a bare exit() is reported by mpirun as a crash); a rank that calls it
+ * alone, with the others running on, ends the run after error_wait(). */
+static int l_spmd_exit(lua_State *L)
+{
+    int status = lua_isboolean(L, 1) ? (lua_toboolean(L, 1) ? EXIT_SUCCESS : EXIT_FAILURE)
+                                     : (int)luaL_optinteger(L, 1, EXIT_SUCCESS);
+    fflush(stdout);
+    status = spmd_finish(status, error_wait());
+    if (lua_toboolean(L, 2))
+        lua_close(L);
+    comm_finalize();
+    exit(status);
+}
+
 void cli_print_error(lua_State *L)
 {
     if (interrupt_terminating()) { /* main says it once, with where the work stopped */
+        lua_pop(L, 1);
+        return;
+    }
+    if (comm_size() > 1) { /* said once, at the end (spmd_finish) */
+        const char *msg = lua_tostring(L, -1);
+        if (!spmd_error)
+            spmd_error = strdup(msg ? msg : "(error object is not a string)");
         lua_pop(L, 1);
         return;
     }
@@ -350,6 +462,16 @@ static int cli_main(int argc, char **argv)
         free(a.params);
         return status;
     }
+    /* stdin reaches rank 0 only, and a prompt is one person's: SPMD runs scripts from files. */
+    if (comm_size() > 1 && (a.interactive || (!a.script && a.nchunks == 0) ||
+                            (a.script && strcmp(a.script, "-") == 0))) {
+        fprintf(stderr, "grainlab: under mpirun, give the script as a file (the REPL, -i and "
+                        "scripts on standard input do not run distributed: standard input reaches "
+                        "rank 0 only); run without mpirun for an interactive session\n");
+        free(a.chunks);
+        free(a.params);
+        return 2;
+    }
     if (a.quiet)
         progress_set_default_style(PROGRESS_QUIET);
     if (a.threads)
@@ -357,14 +479,23 @@ static int cli_main(int argc, char **argv)
 
     bind_options opt = {.report_path = a.report, .quiet = a.quiet};
     lua_State *L = bind_newstate(&opt);
-    if (!L)
+    if (!L) {
+        if (comm_size() > 1) /* the other ranks would wait for this one */
+            comm_abort(1);
         return 1;
+    }
     catch_sigterm(L);
     set_params(L, &a, argv[0]);
+    if (comm_size() > 1) {
+        lua_getglobal(L, "os");
+        lua_pushcfunction(L, l_spmd_exit);
+        lua_setfield(L, -2, "exit");
+        lua_pop(L, 1);
+    }
 
     for (int i = 0; i < a.nchunks && status == 0; i++)
-        status = run_chunk(L, luaL_loadbufferx(L, a.chunks[i], strlen(a.chunks[i]),
-                                               "=(command line)", "t"));
+        status = run_chunk(
+            L, luaL_loadbufferx(L, a.chunks[i], strlen(a.chunks[i]), "=(command line)", "t"));
     if (status == 0 && a.script)
         status = run_script(L, a.script);
     else if (status == 0 && a.nchunks == 0 && !a.interactive) {
@@ -376,7 +507,7 @@ static int cli_main(int argc, char **argv)
     if (a.interactive && !interrupt_terminating()) /* also after an error: state to inspect */
         repl_run(L);
     if (interrupt_terminating()) {
-        status = terminated();
+        status = spmd_finish(terminated(), error_wait());
         lua_close(L);
         free(a.chunks);
         free(a.params);
@@ -388,6 +519,7 @@ static int cli_main(int argc, char **argv)
         fprintf(stderr, "grainlab: %d report check%s failed\n", failed, failed == 1 ? "" : "s");
         status = 1;
     }
+    status = spmd_finish(status, status ? error_wait() : -1);
     lua_close(L);
     free(a.chunks);
     free(a.params);
@@ -401,6 +533,7 @@ int main(int argc, char **argv)
     setvbuf(stdout, NULL, _IOLBF, 0);
     /* Under mpirun every rank runs the same script (SPMD); without it, no MPI at all. */
     comm_init(&argc, &argv);
+    quiet_other_ranks();
     int status = cli_main(argc, argv);
     comm_finalize();
     return status;

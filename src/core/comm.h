@@ -20,6 +20,14 @@ void comm_finalize(void);
 /* Ends every rank of the run with exit code `code` (exit() on one rank). */
 void comm_abort(int code) __attribute__((noreturn));
 
+/* End-of-run agreement among all ranks, on a channel of its own that never matches the data
+ * collectives above: every rank contributes two numbers (the CLI: its exit status and a digest
+ * of its error message) and gets all ranks' pairs in rank order (all: 2 * comm_size()). Returns
+ * 0, or -1 when not every rank joined within timeout_s seconds (< 0: wait for ever), which
+ * means another rank is still running or blocked elsewhere: the caller then ends the run with
+ * comm_abort. */
+int comm_agree(const int64_t mine[2], int64_t *all, double timeout_s);
+
 int comm_rank(void);
 int comm_size(void);
 /* Whether this build can run distributed at all (compiled with MPI). */
@@ -52,14 +60,18 @@ int comm_allgatherv(const void *buf, size_t bytes, void **out, size_t *out_bytes
  * gets what each rank sent it, concatenated in rank order, in a new malloc'd buffer (*recv,
  * recv_bytes[r] from rank r, recv_off[r] its offset). Collective. Returns 0, or -1 when out of
  * memory (all ranks agree). */
-int comm_alltoallv(const void *send, const size_t *send_bytes, const size_t *send_off,
-                   void **recv, size_t *recv_bytes, size_t *recv_off);
+int comm_alltoallv(const void *send, const size_t *send_bytes, const size_t *send_off, void **recv,
+                   size_t *recv_bytes, size_t *recv_off);
 
 /* Point-to-point exchange with a known set of peers (a halo whose sizes both sides know):
  * sends send_bytes[k] bytes from send[k] to peers[k] and receives recv_bytes[k] bytes from
  * peers[k] into recv[k], for k < npeers, all at once. Not collective over all ranks: only the
  * peers named take part, and both sides must name each other with matching sizes. tag keeps
- * separate exchanges apart. */
+ * separate exchanges apart. A peer named more than once (both neighbours of a ring of two, or
+ * this rank itself across a periodic seam) is matched in the order of k on both sides: the
+ * first message sent to it fills the first buffer it receives into, and so on; order the
+ * peers (or use one tag per direction) so that this pairs the right buffers. A peer may be this
+ * rank itself, also in a run without MPI (the message is copied). */
 void comm_exchange(int npeers, const int *peers, const void *const *send, const size_t *send_bytes,
                    void *const *recv, const size_t *recv_bytes, int tag);
 
@@ -72,5 +84,14 @@ typedef struct comm_stats {
 } comm_stats;
 void comm_get_stats(comm_stats *out);
 void comm_reset_stats(void);
+/* What is counted, per call made by the caller (comm's own internal calls are not counted
+ * again): one call; bytes: reductions n values of their type, bcast (bytes * (size - 1)) on the
+ * root and 0 elsewhere, alltoallv and allgatherv the bytes this rank sends to other ranks,
+ * comm_exchange the bytes sent to peers; messages: size - 1 for reductions and barrier, bcast
+ * as its bytes, and one per peer or other rank with a non-empty block. */
+
+/* Tests: the largest message (bytes) sent in one MPI call and moved by one v-collective, so
+ * that the chunked and point-to-point paths for huge data run with small data (0: defaults). */
+void comm_set_message_limit(size_t bytes);
 
 #endif

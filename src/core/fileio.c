@@ -8,6 +8,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "core/comm.h"
+
 /* The temporary files being written now, so that a process ended by a signal can remove them
  * (an unfinished file is never renamed into place, and must not stay beside the outputs). */
 enum { MAX_LIVE = 64 };
@@ -62,6 +64,15 @@ core_status atomic_open(atomic_file *f, const char *path, core_error *err)
     int fd = mkstemp(f->tmp);
     if (fd < 0)
         return core_fail(err, CORE_ERR_IO, "cannot write '%s': %s", path, strerror(errno));
+    f->sink = comm_rank() > 0;
+    if (f->sink) { /* rank 0 writes the file: here the check above, then nothing */
+        close(fd);
+        unlink(f->tmp);
+        f->fp = fopen("/dev/null", "wb");
+        if (!f->fp)
+            return core_fail(err, CORE_ERR_IO, "cannot write '%s': %s", path, strerror(errno));
+        return CORE_OK;
+    }
     f->fp = fdopen(fd, "wb");
     if (!f->fp) {
         int e = errno;
@@ -77,6 +88,16 @@ core_status atomic_commit(atomic_file *f, core_error *err)
 {
     if (!f->fp)
         return core_fail(err, CORE_ERR_STATE, "file '%s' is not open", f->path);
+    if (f->sink) {
+        struct stat st;
+        int bad = ferror(f->fp) || fflush(f->fp) != 0, e = errno;
+        fclose(f->fp);
+        f->fp = NULL;
+        if (!bad && stat(f->path, &st) == 0 && S_ISDIR(st.st_mode)) /* rename(2) would fail */
+            bad = 1, e = EISDIR;
+        return bad ? core_fail(err, CORE_ERR_IO, "cannot write '%s': %s", f->path, strerror(e))
+                   : CORE_OK;
+    }
     /* mkstemp creates 0600; give the file the permissions an ordinary fopen would. */
     mode_t mask = umask(0);
     umask(mask);
@@ -101,7 +122,10 @@ core_status atomic_commit(atomic_file *f, core_error *err)
 
 void atomic_abort(atomic_file *f)
 {
-    if (f->fp) {
+    if (f->fp && f->sink) {
+        fclose(f->fp);
+        f->fp = NULL;
+    } else if (f->fp) {
         fclose(f->fp);
         f->fp = NULL;
         untrack(f->tmp);

@@ -1,5 +1,9 @@
 /* Output files are written whole: data goes to a temporary file beside the target, which is
- * renamed over it only when complete, so a failed or interrupted write never leaves half a file. */
+ * renamed over it only when complete, so a failed or interrupted write never leaves half a file.
+ * In a distributed run only rank 0 writes: on the other ranks the same calls make the same
+ * checks (the directory takes a new file, the target is not a directory) and succeed or fail as
+ * rank 0's do, but the data goes to the null device. Not collective: a write made by one rank
+ * only is fine. */
 #ifndef GRAINLAB_CORE_FILEIO_H
 #define GRAINLAB_CORE_FILEIO_H
 
@@ -9,6 +13,7 @@
 
 typedef struct atomic_file {
     FILE *fp;        /* write here */
+    int sink;        /* a rank other than 0: fp is the null device */
     char path[4096]; /* final name */
     char tmp[4096 + 32];
 } atomic_file;

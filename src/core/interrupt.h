@@ -9,7 +9,13 @@
 
 /* Async-signal-safe. interrupt_clear() does nothing once the process is terminating. */
 void interrupt_request(void);
+/* Whether a stop was requested. In a distributed run (comm_size() > 1) this is a collective
+ * call, the ranks' flags or-ed (not async-signal-safe then): engines call it at the same points
+ * on every rank, between steps, so that all ranks stop at the same step. */
 bool interrupt_pending(void);
+/* This process's own flag, never collective (async-signal-safe): for code that may run on some
+ * ranks only, such as an error path. */
+bool interrupt_pending_here(void);
 void interrupt_clear(void);
 
 /* Async-signal-safe: sets the interrupt flag and records that the process must end with `sig`. */

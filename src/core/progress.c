@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include "core/clock.h"
+#include "core/comm.h"
 
 static progress_style default_style = PROGRESS_AUTO;
 static const double BAR_INTERVAL_S = 0.1;
@@ -56,7 +57,9 @@ void progress_begin_on(progress *p, FILE *out, progress_style style, const char 
 
 void progress_begin(progress *p, const char *label, double total, const char *unit)
 {
-    progress_begin_on(p, stderr, default_style, label, total, unit);
+    /* A distributed run reports once, from rank 0 (every rank runs the same steps). */
+    progress_style style = comm_rank() > 0 ? PROGRESS_QUIET : default_style;
+    progress_begin_on(p, stderr, style, label, total, unit);
 }
 
 static int terminal_width(FILE *out)

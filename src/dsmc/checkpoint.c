@@ -8,10 +8,12 @@
  * The random numbers need no saved generator state: every cell's collisions and every diffuse
  * wall hit draw from a stream seeded by (seed, purpose, step, index) (dsmc_stream), so the seed
  * and the step count reproduce them. The array order is state: particles have no identity beyond
- * their slot, the in-place counting sort of the next step starts from this order, and a wall hit's
- * stream is indexed by the slot. Between steps the array is sorted by cell; the reader checks that
- * and re-adds the particles in that order (the sort of dsmc_add then moves none), so the cell
- * offsets are rebuilt exactly. Nothing depends on the thread count. */
+ * their slot and identity (section dsmc.ids: the identity orders each cell's particles and keys a
+ * wall hit's stream). Between steps the array is sorted by cell, then identity; the reader checks
+ * the cells and re-adds the particles in that order (the sort of dsmc_add then moves none), so the
+ * cell offsets are rebuilt exactly. Nothing depends on the thread count or on the number of ranks
+ * (a distributed scene is gathered before it is saved). A file without dsmc.ids (written before
+ * identities existed) numbers the particles in file order. */
 #include <limits.h>
 #include <math.h>
 #include <stdlib.h>
@@ -85,6 +87,12 @@ core_status dsmc_save(const dsmc_scene *s, const char *path, const char *version
     ckpt_put_f64s(w, s->remainder, s->ncells);
     TRY(ckpt_section_end(w, err));
 
+    /* before the particles, which stay the last section (tests forge values at its end) */
+    TRY(ckpt_section_begin(w, "dsmc.ids", CKPT_REQUIRED, err));
+    ckpt_put_u64(w, s->next_id);
+    ckpt_put_u32s(w, s->id, s->n);
+    TRY(ckpt_section_end(w, err));
+
     TRY(ckpt_section_begin(w, "dsmc.particles", CKPT_REQUIRED, err));
     ckpt_put_u64(w, (uint64_t)s->n);
     for (int k = 0; k < s->D; k++) {
@@ -92,6 +100,7 @@ core_status dsmc_save(const dsmc_scene *s, const char *path, const char *version
         ckpt_put_f64s(w, s->v[k], s->n);
     }
     TRY(ckpt_section_end(w, err));
+
 
     st = ckpt_writer_commit(w, err);
     w = NULL;
@@ -254,6 +263,37 @@ done:
     return st;
 }
 
+static int cmp_u32(const void *a, const void *b)
+{
+    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    return (x > y) - (x < y);
+}
+
+static core_status read_ids(reader *rd, dsmc_scene *s)
+{
+    core_status st;
+    uint64_t next;
+    uint32_t *sorted = NULL;
+    TRY(ckpt_get_u64(&rd->sec, &next, rd->err));
+    if (next < s->n || next > 4294967296ULL)
+        TRY(corrupt(rd, "the next identity is out of range"));
+    TRY(ckpt_get_u32s(&rd->sec, s->id, s->n, rd->err));
+    TRY(ckpt_section_done(&rd->sec, rd->err));
+    if (!(sorted = malloc((s->n ? s->n : 1) * sizeof *sorted)))
+        TRY(core_fail(rd->err, CORE_ERR_NOMEM, "out of memory for %zu particles", s->n));
+    if (s->n)
+        memcpy(sorted, s->id, s->n * sizeof *sorted);
+    qsort(sorted, s->n, sizeof *sorted, cmp_u32);
+    for (size_t i = 0; i < s->n; i++)
+        if (sorted[i] >= next || (i > 0 && sorted[i] == sorted[i - 1]))
+            TRY(corrupt(rd, "particle identities repeat or exceed the next identity"));
+    s->next_id = next;
+    dsmc_sort(s); /* each cell in identity order, as it was saved */
+done:
+    free(sorted);
+    return st;
+}
+
 static core_status read_scene(ckpt_reader *r, reader *rd, dsmc_scene **out)
 {
     core_status st;
@@ -266,6 +306,10 @@ static core_status read_scene(ckpt_reader *r, reader *rd, dsmc_scene **out)
     TRY(read_walls(rd, s));
     TRY(ckpt_find(r, "dsmc.particles", &rd->sec, rd->err));
     TRY(read_particles(rd, s));
+    if (ckpt_has(r, "dsmc.ids")) {
+        TRY(ckpt_find(r, "dsmc.ids", &rd->sec, rd->err));
+        TRY(read_ids(rd, s));
+    }
     /* after the particles: dsmc_add leaves the remainders and the clock alone, but read them
      * last all the same so that nothing can overwrite them */
     TRY(ckpt_find(r, "dsmc.cells", &rd->sec, rd->err));

@@ -4,8 +4,9 @@
  * cell M_c = N_c (N_c - 1) sigma v_max tau / (2 V_c) candidate pairs (Eq. 1), each accepted with
  * probability |v_i - v_j| / v_max and collided with a random impact parameter and restitution e.
  *
- * Per particle the scene stores its position, its velocity and its cell index, nothing more (the
- * paper's "low memory demand"); everything else is per cell.
+ * Per particle the scene stores its position, its velocity, its cell index and a 4-byte identity
+ * (the order of addition; it orders each cell, see dsmc_internal.h), nothing more (the paper's
+ * "low memory demand": 40 bytes in 2D, 56 in 3D); everything else is per cell.
  *
  * Usage: fill a dsmc_scene_def from dsmc_default_scene_def(), create the scene, add particles
  * (dsmc_fill or dsmc_add), set walls, then dsmc_run. Every call that can fail returns a
@@ -57,8 +58,8 @@ double dsmc_particle_volume(const dsmc_scene *s); /* pi R^2 (2D), 4/3 pi R^3 (3D
 double dsmc_volume(const dsmc_scene *s);          /* box area (2D) or volume (3D) */
 size_t dsmc_cell_count(const dsmc_scene *s);
 void dsmc_cell_size(const dsmc_scene *s, double h[3]);
-/* Bytes allocated for the particle arrays (position, velocity, cell index) and for the per-cell
- * arrays (carried remainder, sort offsets). */
+/* Bytes allocated for the particle arrays (position, velocity, cell index, identity) on this
+ * rank and for the per-cell arrays (carried remainder, sort offsets). */
 void dsmc_memory(const dsmc_scene *s, size_t *particle_bytes, size_t *cell_bytes);
 /* Largest number of particles the box holds at the packing limit: nu_rcp V / V_particle. */
 size_t dsmc_capacity(const dsmc_scene *s);
@@ -82,11 +83,12 @@ core_status dsmc_fill(dsmc_scene *s, const dsmc_fill_def *f, core_error *err);
 /* Adds n particles from arrays (z, vz ignored in 2D; z may be NULL then). */
 core_status dsmc_add(dsmc_scene *s, size_t n, const double *x, const double *y, const double *z,
                      const double *vx, const double *vy, const double *vz, core_error *err);
-size_t dsmc_count(const dsmc_scene *s);
+size_t dsmc_count(const dsmc_scene *s); /* all particles, on every rank */
 
 typedef struct dsmc_particles {
     const double *x[3], *v[3]; /* x[2], v[2] NULL in 2D */
     const uint32_t *cell;      /* cell index after the last sort */
+    const uint32_t *id;        /* identity: the order of addition, from 0 */
 } dsmc_particles;
 void dsmc_get_particles(const dsmc_scene *s, dsmc_particles *p);
 
@@ -116,6 +118,20 @@ core_status dsmc_set_wall(dsmc_scene *s, int side, const dsmc_wall_def *w, core_
 const dsmc_wall_def *dsmc_wall(const dsmc_scene *s, int side);
 /* Where the wall of `side` is at time t and its normal velocity (along +axis). */
 void dsmc_wall_motion(const dsmc_scene *s, int side, double t, double *pos, double *vel);
+
+/* ---- distributed runs (dsmc/domain.c) -------------------------------------------------------
+ * Under mpirun every rank builds the same scene; dsmc_run on more than one rank then keeps on
+ * each rank only the particles of its cells (contiguous ranges of the cell index, balanced by
+ * particle count) and migrates them between ranks as they move. The results are the same bits
+ * on any number of ranks. dsmc_run, dsmc_gather, dsmc_measure_moments, dsmc_check_validity and
+ * dsmc_collision_frequency are collective then (every rank calls them, in the same order);
+ * everything else that reads particles (dsmc_get_particles, the fields, profiles and histograms,
+ * VTK, checkpoints) needs the whole scene: call dsmc_gather first, which puts it back on every
+ * rank (a no-op when it is there already). */
+core_status dsmc_gather(dsmc_scene *s, core_error *err);
+bool dsmc_is_distributed(const dsmc_scene *s);
+/* The ranks the scene's runs are spread over (comm_size(); 1 without mpirun). */
+int dsmc_ranks(const dsmc_scene *s);
 
 /* ---- running --------------------------------------------------------------------------------- */
 /* The paper's validity conditions for a step tau, with the particle-weighted mean density
@@ -164,7 +180,11 @@ typedef struct dsmc_stats {
     double vmax_raised;      /* candidates whose |g| exceeded the cell's v_max */
     double cells_overpacked; /* cell-steps whose free volume fell below 1% of the cell */
     double time;             /* simulated, s */
-    double cpu_s, wall_s;    /* spent in dsmc_run */
+    double cpu_s, wall_s;    /* spent in dsmc_run: CPU of all ranks, wall of the slowest */
+    /* A distributed run's traffic (core/comm.h counters, during dsmc_run): bytes and messages
+     * sent, summed over ranks, and the wall time inside communication of the slowest rank. */
+    double comm_bytes, comm_messages, comm_s;
+    double imbalance; /* particles on the busiest rank over the mean, at the end of the last run */
 } dsmc_stats;
 
 /* Counters since the last dsmc_reset_stats (or creation). */

@@ -15,15 +15,36 @@ struct dsmc_scene {
     double cell_volume;
     size_t ncells;
 
-    /* Per particle: position, velocity, cell index. Nothing else. */
+    /* Per particle: position, velocity, cell index and identity (the order of addition). The
+     * identity gives the particles of a cell an order that does not depend on where they sit in
+     * the arrays (between steps every cell is sorted by it; its random pair choices index that
+     * order) and keys a wall hit's stream: so the result is the same whatever the array layout,
+     * thread count or decomposition over ranks. */
     size_t n, cap;
     double *x[3], *v[3];
-    uint32_t *cell;
+    uint32_t *cell, *id;
+    uint64_t next_id; /* the identity of the next particle added */
 
     /* Per cell: the fractional candidate remainder carried between steps (Eq. 1), and the
      * transient start offsets of the sorted particles (ncells + 1) and insertion cursors. */
     double *remainder;
     size_t *start, *next;
+
+    /* Blocks of 2^blk_shift consecutive cells (nblk of them): the unit in which the grid is
+     * cut between ranks and in which sums over particles are taken (per block in cell order,
+     * then blocks in order), so a sum has the same bits on any number of ranks. */
+    int blk_shift;
+    size_t nblk;
+
+    /* A distributed run (domain.c): this rank holds only the particles of blocks
+     * [blk_lo, blk_hi) (its cells [cell_lo, cell_hi)); n_global particles in all. The remainders
+     * of other ranks' cells are stale here until dsmc_gather. Not distributed: the whole scene,
+     * replicated on every rank, cell range the whole grid. */
+    bool distributed;
+    size_t blk_lo, blk_hi, cell_lo, cell_hi, n_global;
+    size_t *cuts;           /* comm_size() + 1 block offsets: rank r owns [cuts[r], cuts[r + 1]) */
+    long last_balance;      /* step of the last cut */
+    double balance_best;    /* the imbalance (max / mean particles) that cut reached */
 
     dsmc_wall_def walls[6];
     double t;
@@ -37,8 +58,35 @@ struct dsmc_scene {
  * whatever the thread that handles it. */
 void dsmc_stream(rng *r, uint64_t seed, uint64_t purpose, uint64_t step, uint64_t index);
 
-/* Sorts the particles in place by cell index and fills start[] (ncells + 1 offsets). */
+/* Sorts the particles in place by cell index, each cell by identity, and fills start[]
+ * (ncells + 1 offsets). */
 void dsmc_sort(dsmc_scene *s);
+/* The sort of a step: by cell only (the particles per sort range already counted, over
+ * dsmc_sort_shift ranges; NULL: counted here); within a cell the order is the layout's. */
+void dsmc_sort_counted(dsmc_scene *s, const size_t *bcount);
+/* Puts every cell of this rank in identity order (after dsmc_sort_counted). */
+void dsmc_order_cells(dsmc_scene *s);
+#define DSMC_SORT_BLOCKS 64
+int dsmc_sort_shift(size_t ncells);
+
+/* Grows the particle arrays to hold n (scene.c); dsmc_resize sets their capacity to cap >= n
+ * (returns 0, or -1 when out of memory, the arrays as they were). */
+core_status dsmc_reserve(dsmc_scene *s, size_t n, core_error *err);
+int dsmc_resize(dsmc_scene *s, size_t cap);
+
+/* ---- domain.c: the distributed run ----
+ * Every call is collective when comm_size() > 1 and does nothing on one rank unless said. */
+/* Cuts the replicated scene by blocks of cells, balanced by particle count; keeps this rank's. */
+core_status dsmc_domain_split(dsmc_scene *s, core_error *err);
+/* After a flight: particles whose cell another rank owns go there (bcount, the particles per
+ * sort range, follows the leavers and the arrivals). */
+core_status dsmc_domain_migrate(dsmc_scene *s, size_t *bcount, core_error *err);
+/* Between steps: cuts again when the particles per rank drifted apart (nmax: the largest count). */
+core_status dsmc_domain_balance(dsmc_scene *s, int64_t nmax, core_error *err);
+/* Sum over blocks of per-block values (nper values each, blocks [blk_lo, blk_hi) given here, in
+ * order) into out[nper]: in block order, so the same bits on any number of ranks. */
+core_status dsmc_block_sum(const dsmc_scene *s, const double *local, size_t nper, double *out,
+                           core_error *err);
 /* Cell index of a position (clamped to the grid). */
 static inline uint32_t dsmc_cell_of(const dsmc_scene *s, double x, double y, double z)
 {

@@ -1,8 +1,10 @@
 /* DSMC measurements: moments of the velocity distribution (temperature, kurtosis, a2), the
  * kinetic-theory collision frequency, per-cell fields, layer profiles and histograms. */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
+#include "core/comm.h"
 #include "dsmc/dsmc_internal.h"
 
 /* Sums of |c|^2 and |c|^4 over particles a .. a + N - 1, c = v - u the peculiar velocity. */
@@ -23,32 +25,73 @@ static void peculiar_sums(const dsmc_scene *s, size_t a, size_t N, const double 
     *s4 = q4;
 }
 
+/* Sums over the particles of each block of this rank (block b at out[(b - blk_lo) * 4]):
+ * pass 0: sum v_k (k < D) and sum |v|^2; pass 1: sum |v - u|^2 and |v - u|^4. */
+static void block_sums(const dsmc_scene *s, int pass, const double *u, double *out)
+{
+    const int D = s->D;
+    const long b0 = (long)s->blk_lo, b1 = (long)s->blk_hi;
+#pragma omp parallel for schedule(dynamic, 16) if (s->n >= 200000)
+    for (long b = b0; b < b1; b++) {
+        size_t c0 = (size_t)b << s->blk_shift, c1 = ((size_t)b + 1) << s->blk_shift;
+        c1 = c1 < s->ncells ? c1 : s->ncells;
+        size_t a = s->start[c0], e = s->start[c1];
+        double *o = out + (b - b0) * 4;
+        o[0] = o[1] = o[2] = o[3] = 0;
+        if (pass == 0) {
+            double sum[3] = {0, 0, 0}, ke = 0;
+            for (int k = 0; k < D; k++)
+                for (size_t i = a; i < e; i++) {
+                    sum[k] += s->v[k][i];
+                    ke += s->v[k][i] * s->v[k][i];
+                }
+            o[0] = sum[0];
+            o[1] = sum[1];
+            o[2] = sum[2];
+            o[3] = ke;
+        } else {
+            peculiar_sums(s, a, e - a, u, &o[0], &o[1]);
+        }
+    }
+}
+
+/* Per block, then blocks in order (dsmc_block_sum): the same bits on any number of ranks. */
 void dsmc_measure_moments(const dsmc_scene *s, dsmc_moments *out)
 {
     memset(out, 0, sizeof *out);
     const int D = s->D;
-    size_t n = s->n;
+    size_t n = dsmc_count(s);
     out->n = n;
     if (n == 0) {
         out->kurtosis = out->a2 = NAN;
         return;
     }
-    double sum[3] = {0, 0, 0}, ke = 0;
-    for (int k = 0; k < D; k++)
-        for (size_t i = 0; i < n; i++) {
-            sum[k] += s->v[k][i];
-            ke += s->v[k][i] * s->v[k][i];
-        }
-    double u[3] = {0, 0, 0};
-    for (int k = 0; k < D; k++) {
-        u[k] = sum[k] / (double)n;
-        out->mean_velocity[k] = u[k];
-        out->momentum[k] = s->mass * sum[k];
+    size_t nb = s->blk_hi - s->blk_lo;
+    double *part = malloc((nb ? nb : 1) * 4 * sizeof *part), tot[4] = {0, 0, 0, 0}, u[3] = {0, 0, 0};
+    core_error err;
+    int ok = part != NULL;
+    if (s->distributed)
+        ok = comm_all(ok);
+    if (ok) {
+        block_sums(s, 0, NULL, part);
+        ok = dsmc_block_sum(s, part, 4, tot, &err) == CORE_OK;
     }
-    out->kinetic_energy = 0.5 * s->mass * ke;
-    double s2, s4;
-    peculiar_sums(s, 0, n, u, &s2, &s4);
-    double m2 = s2 / (double)n, m4 = s4 / (double)n;
+    for (int k = 0; k < D; k++) {
+        u[k] = tot[k] / (double)n;
+        out->mean_velocity[k] = u[k];
+        out->momentum[k] = s->mass * tot[k];
+    }
+    out->kinetic_energy = 0.5 * s->mass * tot[3];
+    if (ok) {
+        block_sums(s, 1, u, part);
+        ok = dsmc_block_sum(s, part, 4, tot, &err) == CORE_OK;
+    }
+    free(part);
+    if (!ok) { /* out of memory for a few kilobytes, on some rank: every rank says so */
+        out->temperature = out->t_over_m = out->kinetic_energy = out->kurtosis = out->a2 = NAN;
+        return;
+    }
+    double m2 = tot[0] / (double)n, m4 = tot[1] / (double)n;
     out->t_over_m = m2 / D;
     out->temperature = s->mass * out->t_over_m;
     out->kurtosis = m2 > 0 ? m4 / (m2 * m2) : NAN;
@@ -57,12 +100,13 @@ void dsmc_measure_moments(const dsmc_scene *s, dsmc_moments *out)
 
 double dsmc_collision_frequency(const dsmc_scene *s)
 {
-    if (s->n < 2)
+    size_t N = dsmc_count(s);
+    if (N < 2)
         return 0;
     dsmc_moments m;
     dsmc_measure_moments(s, &m);
-    double V = dsmc_volume(s), n = (double)(s->n - 1) / V;
-    double chi = dsmc_chi(s, (double)s->n * s->vpart / V), sd = 2 * s->def.radius;
+    double V = dsmc_volume(s), n = (double)(N - 1) / V;
+    double chi = dsmc_chi(s, (double)N * s->vpart / V), sd = 2 * s->def.radius;
     double w = s->D == 2 ? 2 * sqrt(DSMC_PI) * n * sd : 4 * sqrt(DSMC_PI) * n * sd * sd;
     return w * chi * sqrt(m.t_over_m);
 }

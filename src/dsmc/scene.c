@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/comm.h"
 #include "dsmc/dsmc_internal.h"
 
 static const char AXIS[3] = {'x', 'y', 'z'};
@@ -120,6 +121,13 @@ core_status dsmc_create(const dsmc_scene_def *def, dsmc_scene **out, core_error 
             s->cell_volume *= s->h[k];
     }
     s->ncells = (size_t)ncells;
+    /* at most 4096 blocks: the all-gather of per-block sums stays small, and a cut between
+     * ranks lands within 1/4096 of the grid of where balance wants it */
+    while ((s->ncells + ((size_t)1 << s->blk_shift) - 1) >> s->blk_shift > 4096)
+        s->blk_shift++;
+    s->nblk = (s->ncells + ((size_t)1 << s->blk_shift) - 1) >> s->blk_shift;
+    s->blk_hi = s->nblk;
+    s->cell_hi = s->ncells;
     s->remainder = calloc(s->ncells, sizeof *s->remainder);
     s->start = calloc(s->ncells + 1, sizeof *s->start);
     s->next = calloc(s->ncells, sizeof *s->next);
@@ -142,6 +150,8 @@ void dsmc_destroy(dsmc_scene *s)
         free(s->v[k]);
     }
     free(s->cell);
+    free(s->id);
+    free(s->cuts);
     free(s->remainder);
     free(s->start);
     free(s->next);
@@ -153,7 +163,7 @@ double dsmc_mass(const dsmc_scene *s) { return s->mass; }
 double dsmc_cross_section(const dsmc_scene *s) { return s->sigma; }
 double dsmc_particle_volume(const dsmc_scene *s) { return s->vpart; }
 size_t dsmc_cell_count(const dsmc_scene *s) { return s->ncells; }
-size_t dsmc_count(const dsmc_scene *s) { return s->n; }
+size_t dsmc_count(const dsmc_scene *s) { return s->distributed ? s->n_global : s->n; }
 double dsmc_time(const dsmc_scene *s) { return s->t; }
 long dsmc_steps_done(const dsmc_scene *s) { return s->steps; }
 double dsmc_total_collisions(const dsmc_scene *s) { return s->total_collisions; }
@@ -171,7 +181,7 @@ void dsmc_cell_size(const dsmc_scene *s, double h[3])
 
 void dsmc_memory(const dsmc_scene *s, size_t *particle_bytes, size_t *cell_bytes)
 {
-    *particle_bytes = s->cap * (2 * (size_t)s->D * sizeof(double) + sizeof(uint32_t));
+    *particle_bytes = s->cap * (2 * (size_t)s->D * sizeof(double) + 2 * sizeof(uint32_t));
     *cell_bytes = s->ncells * (sizeof(double) + 2 * sizeof(size_t)) + sizeof(size_t);
 }
 
@@ -196,39 +206,59 @@ double dsmc_chi(const dsmc_scene *s, double nu)
 }
 
 /* ---- particles ------------------------------------------------------------------------------- */
-static core_status reserve(dsmc_scene *s, size_t n, core_error *err)
+int dsmc_resize(dsmc_scene *s, size_t cap)
+{
+    if (cap < s->n)
+        cap = s->n;
+    if (cap == 0)
+        cap = 1;
+    /* each array keeps its old contents on failure; the capacity is the smallest of them */
+    int bad = 0;
+    for (int k = 0; k < s->D; k++) {
+        double *a = realloc(s->x[k], cap * sizeof(double));
+        bad |= !a;
+        s->x[k] = a ? a : s->x[k];
+        a = realloc(s->v[k], cap * sizeof(double));
+        bad |= !a;
+        s->v[k] = a ? a : s->v[k];
+    }
+    uint32_t *c = realloc(s->cell, cap * sizeof *c);
+    bad |= !c;
+    s->cell = c ? c : s->cell;
+    c = realloc(s->id, cap * sizeof *c);
+    bad |= !c;
+    s->id = c ? c : s->id;
+    if (bad)
+        return -1;
+    s->cap = cap;
+    return 0;
+}
+
+core_status dsmc_reserve(dsmc_scene *s, size_t n, core_error *err)
 {
     if (n <= s->cap)
         return CORE_OK;
     size_t cap = 2 * s->cap > n ? 2 * s->cap : n; /* exact on a first fill */
-    for (int k = 0; k < s->D; k++) {
-        double *a = realloc(s->x[k], cap * sizeof(double));
-        if (!a)
-            return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu particles", n);
-        s->x[k] = a;
-        a = realloc(s->v[k], cap * sizeof(double));
-        if (!a)
-            return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu particles", n);
-        s->v[k] = a;
-    }
-    uint32_t *c = realloc(s->cell, cap * sizeof *c);
-    if (!c)
+    if (dsmc_resize(s, cap) && dsmc_resize(s, n))
         return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu particles", n);
-    s->cell = c;
-    s->cap = cap;
     return CORE_OK;
 }
 
 static core_status check_room(const dsmc_scene *s, size_t n, const char *what, core_error *err)
 {
-    /* Positions, velocities (3 + 3 doubles) and a cell index per particle, within the same
-     * fixed 8 GiB budget as the cell grid, for the same reason (overcommitted allocations). */
-    const double budget = 8.0 * 1024 * 1024 * 1024, per = 6 * sizeof(double) + sizeof(uint32_t);
+    /* Positions, velocities (3 + 3 doubles), a cell index and an identity per particle, within
+     * the same fixed 8 GiB budget as the cell grid, for the same reason (overcommitted
+     * allocations). */
+    const double budget = 8.0 * 1024 * 1024 * 1024, per = 6 * sizeof(double) + 2 * sizeof(uint32_t);
     if (((double)s->n + (double)n) * per > budget)
         return core_fail(err, CORE_ERR_ARG,
                          "%s %zu particles: %zu particles need %.3g bytes, above the limit of "
                          "%.3g bytes (8 GiB) (field 'n')",
                          what, n, s->n + n, ((double)s->n + (double)n) * per, budget);
+    if ((double)s->next_id + (double)n > 4294967296.0)
+        return core_fail(err, CORE_ERR_ARG,
+                         "%s %zu particles: a scene numbers at most 2^32 particles over its life "
+                         "(%.0f numbered already)", what, n, (double)s->next_id);
     size_t cap = dsmc_capacity(s);
     if (n > cap || s->n + n > cap)
         return core_fail(err, CORE_ERR_ARG,
@@ -241,8 +271,10 @@ static core_status check_room(const dsmc_scene *s, size_t n, const char *what, c
 
 static void after_add(dsmc_scene *s, size_t first)
 {
-    for (size_t i = first; i < s->n; i++)
+    for (size_t i = first; i < s->n; i++) {
         s->cell[i] = dsmc_cell_of(s, s->x[0][i], s->x[1][i], s->D == 3 ? s->x[2][i] : 0);
+        s->id[i] = (uint32_t)s->next_id++;
+    }
     dsmc_sort(s);
 }
 
@@ -257,6 +289,8 @@ dsmc_fill_def dsmc_default_fill_def(void)
 core_status dsmc_fill(dsmc_scene *s, const dsmc_fill_def *f, core_error *err)
 {
     int D = s->D;
+    if (s->distributed)
+        return core_fail(err, CORE_ERR_STATE, "the scene is distributed: dsmc_gather first");
     if (f->temperature < 0 || f->speed < 0 || !isfinite(f->temperature) || !isfinite(f->speed))
         return core_fail(err, CORE_ERR_ARG, "temperature and speed must be finite and >= 0");
     if (f->temperature > 0 && f->speed > 0)
@@ -286,7 +320,7 @@ core_status dsmc_fill(dsmc_scene *s, const dsmc_fill_def *f, core_error *err)
                          "limit nu_rcp = %g (packing fraction would be %.3g)", f->n,
                          floor(s->def.packing_limit * vol / s->vpart), s->def.packing_limit,
                          (double)f->n * s->vpart / vol);
-    if ((st = reserve(s, s->n + f->n, err)))
+    if ((st = dsmc_reserve(s, s->n + f->n, err)))
         return st;
     rng r;
     rng_seed(&r, f->seed, 0);
@@ -324,6 +358,8 @@ core_status dsmc_add(dsmc_scene *s, size_t n, const double *x, const double *y, 
                      const double *vx, const double *vy, const double *vz, core_error *err)
 {
     const double *p[3] = {x, y, z}, *v[3] = {vx, vy, vz};
+    if (s->distributed)
+        return core_fail(err, CORE_ERR_STATE, "the scene is distributed: dsmc_gather first");
     for (size_t i = 0; i < n; i++)
         for (int k = 0; k < s->D; k++) {
             if (!isfinite(p[k][i]) || !isfinite(v[k][i]))
@@ -334,7 +370,7 @@ core_status dsmc_add(dsmc_scene *s, size_t n, const double *x, const double *y, 
                                  "[%g, %g]", i + 1, AXIS[k], p[k][i], s->def.lo[k], s->def.hi[k]);
         }
     core_status st = check_room(s, n, "cannot add", err);
-    if (st || (st = reserve(s, s->n + n, err)))
+    if (st || (st = dsmc_reserve(s, s->n + n, err)))
         return st;
     size_t first = s->n;
     for (size_t i = 0; i < n; i++)
@@ -354,6 +390,7 @@ void dsmc_get_particles(const dsmc_scene *s, dsmc_particles *p)
         p->v[k] = k < s->D ? s->v[k] : NULL;
     }
     p->cell = s->cell;
+    p->id = s->id;
 }
 
 /* ---- walls ----------------------------------------------------------------------------------- */
@@ -420,15 +457,18 @@ core_status dsmc_check_validity(const dsmc_scene *s, double dt, dsmc_validity *o
                                 core_error *err)
 {
     memset(out, 0, sizeof *out);
-    if (s->n < 2)
-        return core_fail(err, CORE_ERR_STATE, "the scene has %zu particles (2 or more needed)",
-                         s->n);
-    double sum2 = 0;
-    for (size_t c = 0; c < s->ncells; c++) {
-        double nc = (double)(s->start[c + 1] - s->start[c]);
+    size_t N = dsmc_count(s);
+    if (N < 2)
+        return core_fail(err, CORE_ERR_STATE, "the scene has %zu particles (2 or more needed)", N);
+    /* an integer sum: the same on any number of ranks */
+    int64_t sum2 = 0;
+    for (size_t c = s->cell_lo; c < s->cell_hi; c++) {
+        int64_t nc = (int64_t)(s->start[c + 1] - s->start[c]);
         sum2 += nc * (nc - 1);
     }
-    double n = sum2 / ((double)s->n * s->cell_volume);
+    if (s->distributed)
+        comm_sum_i64(&sum2, 1);
+    double n = (double)sum2 / ((double)N * s->cell_volume);
     dsmc_moments m;
     dsmc_measure_moments(s, &m);
     double sd = 2 * s->def.radius;

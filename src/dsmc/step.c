@@ -1,11 +1,14 @@
 /* The DSMC step (paper Sec. 4): free flight with gravity and walls, the in-place counting sort
  * into cells, and the collisions of Eq. 1 in every cell. Threads split particles (flight) and
- * cells (collisions); every cell and every wall hit draws from its own random stream, so the
- * result does not depend on the number of threads. */
+ * cells (collisions); every cell and every wall hit draws from its own random stream, and each
+ * cell's particles are taken in identity order, so the result does not depend on the number of
+ * threads, nor on the number of MPI ranks (domain.c). */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "core/clock.h"
+#include "core/comm.h"
 #include "core/interrupt.h"
 #include "dsmc/dsmc_internal.h"
 
@@ -28,10 +31,18 @@ dsmc_run_def dsmc_default_run_def(void)
  * number: first a serial partition into DSMC_SORT_BLOCKS fixed ranges of cells (only the few
  * particles that crossed a range boundary move), then every range is sorted by cell on its own,
  * ranges in parallel. Measured on the 10^6-particle benchmark: the single serial sort took 60% of
- * a step (perf), and bound two threads to 1.3x at best. */
-#define DSMC_SORT_BLOCKS 64
+ * a step (perf), and bound two threads to 1.3x at best.
+ * Within a cell the order is left as the flag sort makes it, which depends on the order it
+ * started from, and so on the decomposition over ranks: the collisions index each cell's
+ * particles in identity order through a small permutation (cell_perm) instead, and the arrays
+ * are put in that order only between runs (dsmc_order_cells), for everything that reads them.
+ * The price of that independence, measured by callgrind against the code before identities
+ * (flight, sort and collisions): +28% of the instructions on the cooling benchmark (20 per
+ * cell: sorting 20 keys per cell), +14% on Herrmann's Fig. 2 gas (0.7 per cell); ordering the
+ * arrays themselves every step cost +33% on the former. */
 
-static void swap_particles(dsmc_scene *s, size_t i, size_t j)
+static inline __attribute__((always_inline)) void swap_particles(dsmc_scene *s, size_t i,
+                                                                  size_t j)
 {
     for (int k = 0; k < s->D; k++) {
         double t = s->x[k][i];
@@ -44,6 +55,9 @@ static void swap_particles(dsmc_scene *s, size_t i, size_t j)
     uint32_t c = s->cell[i];
     s->cell[i] = s->cell[j];
     s->cell[j] = c;
+    c = s->id[i];
+    s->id[i] = s->id[j];
+    s->id[j] = c;
 }
 
 /* Sorts particles [lo, hi) by key(cell) into buckets [0, nb), key(c) = (c - c0) >> shift (the
@@ -90,7 +104,7 @@ static void flag_sort(dsmc_scene *s, size_t lo, size_t hi, size_t *start, size_t
 
 /* Cells per sort range: a power of two (a shift, not a division, per particle) giving at most
  * DSMC_SORT_BLOCKS ranges. */
-static int block_shift(size_t nc)
+int dsmc_sort_shift(size_t nc)
 {
     int sh = 0;
     while ((nc + ((size_t)1 << sh) - 1) >> sh > DSMC_SORT_BLOCKS)
@@ -98,26 +112,136 @@ static int block_shift(size_t nc)
     return sh;
 }
 
-static void sort_counted(dsmc_scene *s, const size_t *bcount)
+static int cmp_u64(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* The identity order of a cell's N particles: P[k] = the slot (from the cell's first) of the
+ * k-th smallest identity. key: N scratch entries. */
+static void cell_perm(const uint32_t *id, size_t N, uint64_t *key, uint32_t *P)
+{
+    for (size_t k = 0; k < N; k++)
+        key[k] = (uint64_t)id[k] << 32 | (uint64_t)k;
+    if (N > 64) {
+        qsort(key, N, sizeof *key, cmp_u64);
+    } else { /* identities are unique: no ties */
+        for (size_t k = 1; k < N; k++) {
+            uint64_t x = key[k];
+            size_t j = k;
+            for (; j > 0 && key[j - 1] > x; j--)
+                key[j] = key[j - 1];
+            key[j] = x;
+        }
+    }
+    for (size_t k = 0; k < N; k++)
+        P[k] = (uint32_t)key[k];
+}
+
+/* Puts the particles [a, a + N) of one cell in identity order, through a buffer (an insertion
+ * sort moving whole particles when out of memory). */
+static void order_cell(dsmc_scene *s, size_t a, size_t N)
+{
+    uint32_t *id = s->id + a;
+    size_t i = 1;
+    while (i < N && id[i - 1] < id[i])
+        i++;
+    if (i >= N)
+        return;
+    const int D = s->D;
+    double *X[3] = {s->x[0] + a, s->x[1] + a, D == 3 ? s->x[2] + a : NULL};
+    double *V[3] = {s->v[0] + a, s->v[1] + a, D == 3 ? s->v[2] + a : NULL};
+    enum { SMALL = 64 };
+    uint64_t kbuf[SMALL];
+    double tbuf[SMALL];
+    uint32_t pbuf[SMALL];
+    uint64_t *key = kbuf;
+    double *tmp = tbuf;
+    uint32_t *P = pbuf;
+    void *heap = NULL;
+    if (N > SMALL) {
+        heap = malloc(N * (sizeof *key + sizeof *tmp + sizeof *P));
+        if (!heap) {
+            for (; i < N; i++) {
+                uint32_t ki = id[i];
+                double x[3], v[3];
+                for (int k = 0; k < D; k++) {
+                    x[k] = X[k][i];
+                    v[k] = V[k][i];
+                }
+                size_t j = i;
+                for (; j > 0 && id[j - 1] > ki; j--) {
+                    for (int k = 0; k < D; k++) {
+                        X[k][j] = X[k][j - 1];
+                        V[k][j] = V[k][j - 1];
+                    }
+                    id[j] = id[j - 1];
+                }
+                for (int k = 0; k < D; k++) {
+                    X[k][j] = x[k];
+                    V[k][j] = v[k];
+                }
+                id[j] = ki;
+            }
+            return;
+        }
+        key = heap;
+        tmp = (double *)(key + N);
+        P = (uint32_t *)(tmp + N);
+    }
+    cell_perm(id, N, key, P);
+    for (int q = 0; q < 2 * D; q++) {
+        double *A = q < D ? X[q] : V[q - D];
+        for (size_t k = 0; k < N; k++)
+            tmp[k] = A[P[k]];
+        memcpy(A, tmp, N * sizeof *tmp);
+    }
+    for (size_t k = 0; k < N; k++)
+        id[k] = (uint32_t)(key[k] >> 32);
+    free(heap);
+}
+
+void dsmc_order_cells(dsmc_scene *s)
+{
+    const long c0 = (long)s->cell_lo, c1 = (long)s->cell_hi;
+#pragma omp parallel for schedule(dynamic, 256) if (s->n >= DSMC_PARALLEL_MIN)
+    for (long c = c0; c < c1; c++)
+        if (s->start[c + 1] - s->start[c] > 1)
+            order_cell(s, s->start[c], s->start[c + 1] - s->start[c]);
+}
+
+void dsmc_sort_counted(dsmc_scene *s, const size_t *bcount)
 {
     size_t nc = s->ncells;
-    int sh = block_shift(nc);
+    int sh = dsmc_sort_shift(nc);
     size_t width = (size_t)1 << sh, nb = (nc + width - 1) >> sh;
     size_t bstart[DSMC_SORT_BLOCKS + 1], bnext[DSMC_SORT_BLOCKS];
     flag_sort(s, 0, s->n, bstart, bnext, nb, 0, sh, bcount);
     bstart[nb] = s->n;
     size_t *start = s->start, *next = s->next;
-    const long nbl = (long)nb;
+    /* Only this rank's cells [cell_lo, cell_hi) hold particles (all of them on one rank): the
+     * offsets of other ranks' cells are left alone, so the cost of a rank's sort goes with its
+     * share of the grid, not with the whole grid. */
+    const size_t lo = s->cell_lo, hi = s->cell_hi;
+    const long b0 = hi > lo ? (long)(lo >> sh) : 0, b1 = hi > lo ? (long)((hi - 1) >> sh) + 1 : 0;
 #pragma omp parallel for schedule(dynamic, 1) if (s->n >= DSMC_PARALLEL_MIN)
-    for (long b = 0; b < nbl; b++) {
+    for (long b = b0; b < b1; b++) {
         size_t c0 = (size_t)b * width, c1 = c0 + width < nc ? c0 + width : nc;
+        c0 = c0 > lo ? c0 : lo;
+        c1 = c1 < hi ? c1 : hi;
         flag_sort(s, bstart[b], bstart[b + 1], start + c0, next + c0, c1 - c0, (uint32_t)c0, 0,
                   NULL);
     }
+    start[hi] = s->n;
     start[nc] = s->n;
 }
 
-void dsmc_sort(dsmc_scene *s) { sort_counted(s, NULL); }
+void dsmc_sort(dsmc_scene *s)
+{
+    dsmc_sort_counted(s, NULL);
+    dsmc_order_cells(s);
+}
 
 /* ---- free flight ------------------------------------------------------------------------------ */
 typedef struct wall_state {
@@ -169,7 +293,7 @@ typedef struct flight_consts {
 
 /* Walls for one particle that is outside the walls on a non-periodic axis (the slow path). */
 static __attribute__((noinline)) long walls_one(const dsmc_scene *s, const flight_consts *fc,
-                                                int D, long i, double x[3], double v[3])
+                                                int D, uint64_t id, double x[3], double v[3])
 {
     long hits = 0;
     for (int k = 0; k < D; k++) {
@@ -183,7 +307,7 @@ static __attribute__((noinline)) long walls_one(const dsmc_scene *s, const fligh
                 break;
             rng r = {{0, 0, 0, 0}};
             if (s->walls[side].kind == DSMC_WALL_DIFFUSE)
-                dsmc_stream(&r, fc->seed, STREAM_WALL, fc->step, (uint64_t)i * 8 + (uint64_t)bounce);
+                dsmc_stream(&r, fc->seed, STREAM_WALL, fc->step, id * 8 + (uint64_t)bounce);
             reflect(s, side, &ws[side], fc->dt, x, v, &r);
             hits++;
         }
@@ -243,7 +367,7 @@ flight_dim(dsmc_scene *s, const flight_consts *fc, size_t bcount[DSMC_SORT_BLOCK
             }
         }
         if (any_wall && out)
-            hits += walls_one(s, fc, D, i, x, v);
+            hits += walls_one(s, fc, D, s->id[i], x, v);
         size_t c = 0;
         double chk = 0;
         for (int k = D - 1; k >= 0; k--) {
@@ -282,7 +406,7 @@ static flight_totals flight(dsmc_scene *s, double dt, size_t bcount[DSMC_SORT_BL
         if (fc.ws[side].active)
             dsmc_wall_motion(s, side, s->t + dt, &fc.ws[side].pos, &fc.ws[side].vel);
     }
-    fc.sh = block_shift(s->ncells);
+    fc.sh = dsmc_sort_shift(s->ncells);
     fc.seed = s->def.seed;
     fc.step = (uint64_t)s->steps;
     return s->D == 2 ? flight_dim(s, &fc, bcount, 2) : flight_dim(s, &fc, bcount, 3);
@@ -346,7 +470,7 @@ static inline void collide_3d(double *vi, double *vj, const double gv[3], double
 static collide_totals collide(dsmc_scene *s, double dt)
 {
     const int D = s->D;
-    const long nc = (long)s->ncells;
+    const long c_lo = (long)s->cell_lo, nc = (long)s->cell_hi;
     const size_t *start = s->start;
     double *rem = s->remainder;
     double *V[3] = {s->v[0], s->v[1], s->v[2]};
@@ -358,18 +482,34 @@ static collide_totals collide(dsmc_scene *s, double dt)
     long attempts = 0, collisions = 0, raised = 0, overpacked = 0;
 #pragma omp parallel for schedule(dynamic, 64) \
     reduction(+ : attempts, collisions, raised, overpacked) if (s->n >= DSMC_PARALLEL_MIN)
-    for (long c = 0; c < nc; c++) {
+    for (long c = c_lo; c < nc; c++) {
         size_t a = start[c], N = start[c + 1] - a;
         if (N < 2)
             continue;
+        /* The cell's particles in identity order: P[k] is the k-th (offset from a). Out of
+         * memory for a large cell: the arrays themselves are put in order, P = NULL. */
+        uint64_t kbuf[64];
+        uint32_t pbuf[64], *P = pbuf;
+        uint64_t *key = kbuf;
+        void *heap = NULL;
+        if (N > 64) {
+            heap = malloc(N * (sizeof *key + sizeof *P));
+            key = heap;
+            P = heap ? (uint32_t *)(key + N) : NULL;
+            if (!heap)
+                order_cell(s, a, N);
+        }
+        if (P)
+            cell_perm(s->id + a, N, key, P);
         /* v_max: twice the largest speed about the cell's mean velocity bounds every pair's
-         * relative speed at the start of the step; raised when a collision exceeds it. */
+         * relative speed at the start of the step; raised when a collision exceeds it. The
+         * mean sums in identity order, so its bits do not depend on the layout. */
         double u[3] = {0, 0, 0};
         for (int k = 0; k < D; k++) {
             const double *vk = V[k] + a;
             double sum = 0;
             for (size_t i = 0; i < N; i++)
-                sum += vk[i];
+                sum += vk[P ? P[i] : i];
             u[k] = sum / (double)N;
         }
         double m2 = 0;
@@ -382,8 +522,10 @@ static collide_totals collide(dsmc_scene *s, double dt)
             m2 = q > m2 ? q : m2;
         }
         double vmax = 2 * sqrt(m2);
-        if (vmax == 0)
+        if (vmax == 0) {
+            free(heap);
             continue;
+        }
         double Nd = (double)N, Veff = Vc, chi = 1;
         if (excl == DSMC_EXCLUDED_FREE_VOLUME) {
             Veff = Vc - Nd * vb / rcp;
@@ -404,15 +546,19 @@ static collide_totals collide(dsmc_scene *s, double dt)
         double Mi = floor(M);
         rem[c] = M - Mi;
         long m = (long)Mi;
-        if (m == 0)
+        if (m == 0) {
+            free(heap);
             continue;
+        }
         rng r;
         dsmc_stream(&r, seed, STREAM_COLLIDE, step, (uint64_t)c);
         attempts += m;
         for (long t = 0; t < m; t++) {
-            size_t i = a + rng_below(&r, N), j = a + rng_below(&r, N - 1);
+            size_t i = rng_below(&r, N), j = rng_below(&r, N - 1);
             if (j >= i)
                 j++;
+            i = a + (P ? P[i] : i);
+            j = a + (P ? P[j] : j);
             double gv[3] = {0, 0, 0}, g2 = 0;
             for (int k = 0; k < D; k++) {
                 gv[k] = V[k][i] - V[k][j];
@@ -447,6 +593,7 @@ static collide_totals collide(dsmc_scene *s, double dt)
                 }
             }
         }
+        free(heap);
     }
     return (collide_totals){attempts, collisions, raised, overpacked};
 }
@@ -459,12 +606,33 @@ core_status dsmc_run(dsmc_scene *s, const dsmc_run_def *run, long *done, core_er
         return core_fail(err, CORE_ERR_ARG, "dt must be positive, got %g", run->dt);
     if (run->steps < 0)
         return core_fail(err, CORE_ERR_ARG, "steps must be >= 0, got %ld", run->steps);
-    double c0 = clock_cpu(), w0 = clock_wall();
+    /* several ranks: every decision below (stop, rebalance) is taken by all of them together */
+    const bool multi = comm_size() > 1;
     core_status st = CORE_OK;
+    if (multi && (st = dsmc_domain_split(s, err)))
+        return st;
+    double c0 = clock_cpu(), w0 = clock_wall();
+    comm_stats cs0;
+    comm_get_stats(&cs0);
+    /* this rank's counts for the run, added to the statistics at the end (summed over ranks) */
+    int64_t cnt[6] = {0, 0, 0, 0, 0, 0}; /* moves, wall hits, attempts, collisions, raised, over */
+    long nsteps = 0;
+    double tsum = 0;
+    bool sorted = true;
     while (*done < run->steps) {
         if (run->time_end >= 0 && s->t >= run->time_end * (1 - 1e-14))
             break;
-        if (interrupt_pending()) {
+        int intr = interrupt_pending();
+        if (multi) {
+            int64_t q[2] = {intr, (int64_t)s->n};
+            comm_max_i64(q, 2);
+            intr = q[0] != 0;
+            if (!intr && (st = dsmc_domain_balance(s, q[1], err))) {
+                sorted = false; /* out of memory, maybe in the middle of a migration */
+                break;
+            }
+        }
+        if (intr) {
             st = core_fail(err, CORE_ERR_INTERRUPTED,
                            "interrupted at step %ld (t = %.6g s); the scene is intact", s->steps,
                            s->t);
@@ -475,29 +643,63 @@ core_status dsmc_run(dsmc_scene *s, const dsmc_run_def *run, long *done, core_er
             dt = run->time_end - s->t;
         size_t bcount[DSMC_SORT_BLOCKS];
         flight_totals ft = flight(s, dt, bcount);
-        if (ft.bad) {
+        sorted = false;
+        if (multi ? comm_any(ft.bad) : ft.bad) {
             st = core_fail(err, CORE_ERR_UNSTABLE,
                            "step %ld (t = %.6g s): a particle's position or velocity is not "
                            "finite", s->steps, s->t);
             break;
         }
-        sort_counted(s, bcount);
+        if (multi && (st = dsmc_domain_migrate(s, bcount, err)))
+            break;
+        dsmc_sort_counted(s, bcount);
+        sorted = true;
         collide_totals ct = collide(s, dt);
         s->t += dt;
         s->steps++;
         ++*done;
-        s->stats.steps++;
-        s->stats.particle_moves += (double)s->n;
-        s->stats.wall_hits += (double)ft.wall_hits;
-        s->stats.attempts += (double)ct.attempts;
-        s->stats.collisions += (double)ct.collisions;
-        s->stats.vmax_raised += (double)ct.raised;
-        s->stats.cells_overpacked += (double)ct.overpacked;
-        s->stats.time += dt;
-        s->total_collisions += (double)ct.collisions;
+        nsteps++;
+        tsum += dt;
+        cnt[0] += (int64_t)s->n;
+        cnt[1] += ft.wall_hits;
+        cnt[2] += ct.attempts;
+        cnt[3] += ct.collisions;
+        cnt[4] += ct.raised;
+        cnt[5] += ct.overpacked;
     }
-    s->stats.cpu_s += clock_cpu() - c0;
-    s->stats.wall_s += clock_wall() - w0;
+    /* between runs the arrays are in cell then identity order, for everything that reads them
+     * (unless a step stopped between its flight and its sort: non-finite, or out of memory) */
+    if (sorted)
+        dsmc_order_cells(s);
+    double cpu = clock_cpu() - c0, wall = clock_wall() - w0;
+    comm_stats cs1;
+    comm_get_stats(&cs1);
+    /* summed: CPU of all ranks, bytes and messages they sent; the slowest: wall time, time in
+     * communication, particles held (the imbalance) */
+    double sum[3] = {cpu, cs1.bytes - cs0.bytes, cs1.messages - cs0.messages};
+    double most[3] = {wall, cs1.seconds - cs0.seconds, (double)s->n};
+    if (s->distributed) {
+        comm_sum_i64(cnt, 6);
+        comm_sum_double(sum, 3);
+        comm_max_double(most, 3);
+    }
+    cpu = sum[0];
+    wall = most[0];
+    s->stats.comm_bytes += sum[1];
+    s->stats.comm_messages += sum[2];
+    s->stats.comm_s += most[1];
+    s->stats.imbalance = dsmc_count(s) ? most[2] * comm_size() / (double)dsmc_count(s) : 1;
+    s->stats.steps += nsteps;
+    s->stats.particle_moves += (double)cnt[0];
+    s->stats.wall_hits += (double)cnt[1];
+    s->stats.attempts += (double)cnt[2];
+    s->stats.collisions += (double)cnt[3];
+    s->stats.vmax_raised += (double)cnt[4];
+    s->stats.cells_overpacked += (double)cnt[5];
+    s->stats.time += tsum;
+    s->total_collisions += (double)cnt[3];
+    s->stats.cpu_s += cpu;
+    s->stats.wall_s += wall;
     return st;
 }
 

@@ -29,7 +29,7 @@ core_status dsmc_vtk_particles(const dsmc_scene *s, const char *path, core_error
     const double mass = dsmc_mass(s);
     for (size_t i = 0; i < n; i++) {
         conn[i] = (int64_t)i;
-        id[i] = (int64_t)i + 1;
+        id[i] = (int64_t)p.id[i] + 1;
         r[i] = def->radius;
         m[i] = mass;
         cell[i] = (int64_t)p.cell[i] + 1;

@@ -172,6 +172,9 @@ void bind_new_type(lua_State *L, const char *tname, const bind_fn *methods, cons
  * threads, rng, progress, write_file) and help.c (doc, doc_of). */
 void bind_open_core(lua_State *L, int idx);
 void bind_open_help(lua_State *L, int idx);
+/* grainlab.mpi onto the table at idx (lua_mpi.c); on ranks > 0 also turns the Lua functions that
+ * write files (io.open for writing, io.output, os.remove, os.rename) into no-ops. */
+void bind_open_mpi(lua_State *L, int idx);
 
 /* Registers the global `dem` module (lua_dem.c). */
 void bind_open_dem(lua_State *L);

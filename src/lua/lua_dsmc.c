@@ -23,6 +23,18 @@ static dsmc_scene *check_scene(lua_State *L, int idx)
     return u->s;
 }
 
+/* The scene of a call that needs all of it (particles, per-cell fields, files): on a scene
+ * distributed over ranks by its last run, gathers it back to every rank first (collective: every
+ * rank of an SPMD script makes the same call). The one guard of those entry points. */
+static dsmc_scene *whole_scene(lua_State *L, int idx, const char *call)
+{
+    dsmc_scene *s = check_scene(L, idx);
+    core_error err;
+    if (dsmc_gather(s, &err))
+        bind_raise(L, call, &err);
+    return s;
+}
+
 static void set_number(lua_State *L, const char *k, double v)
 {
     lua_pushnumber(L, v);
@@ -174,7 +186,7 @@ static const char *const FILL_FIELDS[] = {"n",        "temperature", "speed", "r
 
 static int l_fill(lua_State *L)
 {
-    dsmc_scene *s = check_scene(L, 1);
+    dsmc_scene *s = whole_scene(L, 1, "fill");
     int D = dsmc_def(s)->dim;
     bind_check_table(L, 2, "fill");
     bind_check_fields(L, 2, "fill", FILL_FIELDS);
@@ -229,7 +241,7 @@ static const char *const ADD_FIELDS[] = {"x", "y", "z", "vx", "vy", "vz", NULL};
 
 static int l_add(lua_State *L)
 {
-    dsmc_scene *s = check_scene(L, 1);
+    dsmc_scene *s = whole_scene(L, 1, "add");
     int D = dsmc_def(s)->dim;
     bind_check_table(L, 2, "add");
     bind_check_fields(L, 2, "add", ADD_FIELDS);
@@ -273,7 +285,7 @@ static int l_add(lua_State *L)
 
 static int l_particles(lua_State *L)
 {
-    dsmc_scene *s = check_scene(L, 1);
+    dsmc_scene *s = whole_scene(L, 1, "particles");
     int D = dsmc_def(s)->dim;
     size_t n = dsmc_count(s);
     dsmc_particles p;
@@ -293,6 +305,12 @@ static int l_particles(lua_State *L)
         lua_rawseti(L, -2, (lua_Integer)i + 1);
     }
     lua_setfield(L, -2, "speed");
+    lua_createtable(L, (int)n, 0);
+    for (size_t i = 0; i < n; i++) {
+        lua_pushinteger(L, (lua_Integer)p.id[i] + 1);
+        lua_rawseti(L, -2, (lua_Integer)i + 1);
+    }
+    lua_setfield(L, -2, "id");
     lua_pushinteger(L, (lua_Integer)n);
     lua_setfield(L, -2, "count");
     return 1;
@@ -533,7 +551,14 @@ static void measure_stats(lua_State *L, dsmc_scene *s)
     set_number(L, "collision_frequency", 2 * st.collisions / (N * st.time));
     set_number(L, "collision_frequency_theory", dsmc_collision_frequency(s));
     set_number(L, "total_collisions", dsmc_total_collisions(s));
-    (void)steps;
+    /* a distributed run's traffic (0 on one rank): totals over ranks, and per step per rank */
+    set_number(L, "comm_bytes", st.comm_bytes);
+    set_number(L, "comm_messages", st.comm_messages);
+    set_number(L, "comm_s", st.comm_s);
+    set_number(L, "ranks", (double)dsmc_ranks(s));
+    set_number(L, "imbalance", st.imbalance);
+    set_number(L, "comm_bytes_per_step_per_rank", st.comm_bytes / (steps * dsmc_ranks(s)));
+    set_number(L, "comm_messages_per_step_per_rank", st.comm_messages / (steps * dsmc_ranks(s)));
 }
 
 static const char *const HISTOGRAM_FIELDS[] = {"bins", "range", "quantity", NULL};
@@ -550,6 +575,8 @@ static int l_measure(lua_State *L)
     const dsmc_scene_def *d = dsmc_def(s);
     int D = d->dim;
     int what = bind_check_option(L, 2, NULL, what_names);
+    if (what == 1 || what == 2 || what == 3 || what == 5) /* a2, fields, histogram, profile */
+        whole_scene(L, 1, "measure");
     int has_opts = !lua_isnoneornil(L, 3);
     if (has_opts)
         bind_check_table(L, 3, "measure");
@@ -840,12 +867,17 @@ void bind_open_dsmc(lua_State *L)
          "range 5 sqrt(T/m)). stats (SPARTA's vocabulary, since s:reset_stats()): steps, "
          "particle_moves, particle_moves_per_cpu_s, attempts, collisions (= accepted), "
          "attempts_per_particle_per_step, collisions_per_particle_per_step, acceptance, "
-         "wall_hits, vmax_raised, collision_frequency (measured: 2 collisions / (N t)) and "
-         "collision_frequency_theory. profile {axis = dim, bins = cells}: position, count, "
+         "wall_hits, vmax_raised, collision_frequency (measured: 2 collisions / (N t)), "
+         "collision_frequency_theory; under mpirun ranks, comm_bytes, comm_messages (sent, all "
+         "ranks), comm_s (the slowest rank's), comm_bytes_per_step_per_rank and "
+         "comm_messages_per_step_per_rank, imbalance (the busiest rank's particles over the mean, "
+         "at the end of the last run). profile {axis = dim, bins = cells}: position, count, "
          "density, packing, temperature per layer. validity {dt = 0}: the paper's conditions "
          "with their numbers."},
         {"particles", l_particles, "s:particles()",
-         "Arrays x, y, (z), vx, vy, (vz), speed over the particles, and count."},
+         "Arrays x, y, (z), vx, vy, (vz), speed and id (the particle's identity: its order of "
+         "addition, from 1) over the particles, sorted by cell and within a cell by id; and "
+         "count. The same on any number of MPI ranks."},
         {"reset_stats", l_reset_stats, "s:reset_stats()",
          "Zeroes the run statistics of s:measure('stats') (not the collision count since "
          "creation)."},
@@ -880,7 +912,9 @@ void bind_open_dsmc(lua_State *L)
          "1]. excluded_volume: the paper's free volume V_c - V_b/nu_rcp in Eq. 1 (default; chi "
          "= 1/(1 - nu/nu_rcp)), the Enskog chi(nu) of the cell, or none (chi = 1). "
          "packing_limit nu_rcp: 0.82 (2D), 0.64 (3D). Results depend on the seed, not on the "
-         "number of threads."},
+         "number of threads, nor on the number of MPI ranks (under mpirun the first run "
+         "splits the grid between the ranks; queries that need every particle gather it "
+         "back)."},
         {NULL, NULL, NULL, NULL}};
     lua_newtable(L);
     bind_register(L, -1, fns);
@@ -898,6 +932,10 @@ dsmc_scene *bind_check_dsmc_scene(lua_State *L, int idx, const char *call)
     lscene *u = bind_check_udata(L, idx, SCENE, call);
     if (!u->s)
         luaL_error(L, "%s: the dsmc.scene was closed", call);
+    /* its callers (save, write_vtk) write the whole scene */
+    core_error err;
+    if (dsmc_gather(u->s, &err))
+        bind_raise(L, call, &err);
     return u->s;
 }
 

@@ -4,6 +4,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "core/comm.h"
 #include "core/progress.h"
 #include "lua/bind.h"
 #include "mpm/mpm.h"
@@ -282,8 +283,20 @@ static const char *const SCENE_FIELDS[] = {"cells",   "size",     "origin", "per
                                            "gravity", "walls",    "update", "pic",
                                            "shape",   "wall_gap", NULL};
 
+/* MPM has no decomposition: under mpirun every rank would run the whole scene and, with only
+ * rank 0 writing, silently waste the others. Refused before anything is built. */
+static void refuse_distributed(lua_State *L, const char *call)
+{
+    if (comm_size() > 1)
+        luaL_error(L,
+                   "%s: MPM does not run distributed yet (this run has %d ranks under "
+                   "mpirun); run MPM scripts without mpirun (OpenMP threads still apply)",
+                   call, comm_size());
+}
+
 static int l_scene(lua_State *L)
 {
+    refuse_distributed(L, "mpm.scene");
     bind_check_table(L, 1, "scene");
     bind_check_fields(L, 1, "scene", SCENE_FIELDS);
     mpm_scene_def def = mpm_default_scene_def();
@@ -1042,6 +1055,7 @@ mpm_scene *bind_check_mpm_scene(lua_State *L, int idx, const char *call)
 
 mpm_scene **bind_new_mpm_scene(lua_State *L)
 {
+    refuse_distributed(L, "mpm.load");
     lscene *u = lua_newuserdatauv(L, sizeof *u, 1);
     u->s = NULL;
     luaL_setmetatable(L, SCENE);

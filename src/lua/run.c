@@ -105,7 +105,9 @@ static int fail(lua_State *L, int guard, progress *prog, const bind_run *r, cons
                 long done, const core_error *err)
 {
     disarm(L, guard);
-    int interrupted = (err && err->status == CORE_ERR_INTERRUPTED) || interrupt_pending();
+    /* this rank's own flag: an error path may be taken by some ranks only (the kernels' stop on
+     * the flag is agreed by all ranks: CORE_ERR_INTERRUPTED) */
+    int interrupted = (err && err->status == CORE_ERR_INTERRUPTED) || interrupt_pending_here();
     progress_end_early(prog, interrupted ? "interrupted" : "failed");
     char of[64] = "";
     if (r->expect > 0)

@@ -38,6 +38,7 @@ static int open_grainlab(lua_State *L)
     int g = lua_gettop(L);
     bind_open_core(L, g);
     bind_open_help(L, g);
+    bind_open_mpi(L, g);
     lua_createtable(L, 0, 2);
     if (opt->report_path) {
         lua_pushstring(L, opt->report_path);

@@ -1,13 +1,16 @@
 -- One DEM scene for the rank-count comparisons of tests/dem/mpi_compare.sh: run on 1, 2 and 3
--- ranks, every rank writes what it sees (positions and velocities as %a, energies, wall forces)
--- to out.<rank>; every file of every rank count must be the same bits.
+-- ranks. Every rank formats what it sees (positions, velocities, spins, forces as %a, energies,
+-- stress, coordination, wall forces) and checks it against rank 0's (grainlab.mpi.bcast): queries
+-- give the same answer on every rank. Rank 0 writes it to out.0; every rank count must give the
+-- same bits.
 --   grainlab tests/dem/mpi_case.lua dim=2 integrator=velocity_verlet spring=1 walls=1
 --            periodic=0 servo=0 gravity=1 n=150 steps=300 out=PREFIX fast=0 dt=5e-7|auto chunks=1
 local P = params
 local dim = P.dim or 2
 local n = P.n or 150
 local steps = P.steps or 300
-local rank = tonumber(os.getenv("OMPI_COMM_WORLD_RANK") or "0")
+local mpi = grainlab.mpi
+local lines = {} -- what this rank sees
 local per = (P.periodic or 0) >= 1
 local allper = (P.periodic or 0) == 2 -- every axis periodic, no walls: momentum is conserved
 local L = P.L or 0.02
@@ -112,7 +115,7 @@ if (P.check_momentum or 0) == 1 then -- no walls, no gravity: contacts conserve 
            string.format("momentum %d: %.17g before, %.17g after (scale %g)", d, m0[d], m1[d], mscale))
   end
 end
-local f = assert(io.open((P.out or "out") .. "." .. rank, "w"))
+local f = { write = function(_, ...) lines[#lines + 1] = table.concat({ ... }) end }
 local p = s:particles()
 local axes = dim == 2 and { "x", "y" } or { "x", "y", "z" }
 local vax = dim == 2 and { "vx", "vy" } or { "vx", "vy", "vz" }
@@ -147,11 +150,18 @@ if top then
   local wp = s:wall_point(top)
   f:write(string.format("servo %a\n", wp[2]))
 end
-f:close()
+local mine = table.concat(lines)
+local ref = mpi.bcast(mine) -- rank 0's
+if ref ~= mine then
+  error(string.format("rank %d of %d sees other answers than rank 0", mpi.rank(), mpi.size()))
+end
+local fo = assert(io.open((P.out or "out") .. ".0", "w")) -- rank 0 writes it
+fo:write(mine)
+fo:close()
 local info = s:info()
 if info.distributed then -- how the ranks shared the work (not compared: one rank has none)
   local d = info.distributed
-  local g = assert(io.open((P.out or "out") .. ".stats." .. rank, "w"))
+  local g = assert(io.open((P.out or "out") .. ".stats.0", "w")) -- the same on every rank
   g:write(string.format("ranks %d rebuilds %d rebalances %d migrations %d owned_min %d owned_max %d" ..
                         " rebuild_ms %.3f rebalance_ms %.3f comm_ms %.3f halos %d\n",
                         d.ranks, d.rebuilds, d.rebalances, d.migrations, d.owned_min, d.owned_max,

@@ -6,7 +6,7 @@ local m = grainlab.material{ name = "quartz", density = 2650, young = 1e8, poiss
 s:add_disk{ pos = { 0.004, 0.005 }, radius = 0.0005, material = m }
 s:add_disk{ pos = { 0.0052, 0.005 }, radius = 0.0005, material = m }
 s:springs{ i = { 1 }, j = { 2 }, k = 10 }
-local ranks = tonumber(os.getenv("OMPI_COMM_WORLD_SIZE") or "1")
+local ranks = grainlab.mpi.size()
 local ok, err = pcall(s.run, s, { steps = 10, dt = 1e-7 })
 if ranks == 1 then
   assert(ok, err)
@@ -30,6 +30,8 @@ for k = 0, 19 do
 end
 local ok2, err2 = pcall(t.run, t, { steps = 200, dt = 2e-7, force = true })
 assert(not ok2, "the run through the wall went ahead")
-local f = assert(io.open((params.out or "refuse") .. "." .. (os.getenv("OMPI_COMM_WORLD_RANK") or "0"), "w"))
-f:write(tostring(err2), "\n", t:info().steps, "\n")
+local mine = tostring(err2) .. "\n" .. t:info().steps .. "\n"
+assert(grainlab.mpi.bcast(mine) == mine, "rank " .. grainlab.mpi.rank() .. " stopped otherwise than rank 0")
+local f = assert(io.open((params.out or "refuse") .. ".0", "w")) -- rank 0 writes it
+f:write(mine)
 f:close()

@@ -13,10 +13,8 @@ trap 'rm -rf "$out"' EXIT
 for np in 2 3; do
   mpi_run "$out/err$np" "$mpiexec" $np "$grainlab" --quiet "$here/mpi_refuse.lua" out="$out/np$np" ||
     { echo "FAIL: $np ranks"; exit 1; }
-  for r in $(seq 0 $((np - 1))); do
-    cmp -s "$out/np1.0" "$out/np$np.$r" ||
-      { echo "FAIL: rank $r of $np stopped otherwise:"; diff "$out/np1.0" "$out/np$np.$r"; exit 1; }
-  done
+  cmp -s "$out/np1.0" "$out/np$np.0" ||
+    { echo "FAIL: $np ranks stopped otherwise:"; diff "$out/np1.0" "$out/np$np.0"; exit 1; }
 done
 cat "$out/np1.0"
 echo "OK"

@@ -120,6 +120,21 @@ local calls = {
   },
 }
 
+-- grainlab.mpi (lua_mpi.c): on one rank, as the fuzz tests run. bcast sends any value but a
+-- function (or userdata); root is a rank: 0 here.
+calls["grainlab.mpi.rank"] = {}
+calls["grainlab.mpi.size"] = {}
+calls["grainlab.mpi.barrier"] = {}
+calls["grainlab.mpi.stats"] = {}
+calls["grainlab.mpi.reset_stats"] = {}
+local SENDABLE = {}
+for _, c in ipairs(ALL) do if c ~= "function" then SENDABLE[#SENDABLE + 1] = c end end
+for _, c in ipairs{ "short", "long", "entry_nan", "entry_inf", "entry_huge", "entry_string", "entry_table" } do
+  SENDABLE[#SENDABLE + 1] = c
+end
+calls["grainlab.mpi.bcast"] = { args = function() return { { 1, 2 }, 0 } end,
+  pos = { SENDABLE, { "nil", "zero" } } }
+
 -- grainlab.vtk.series (lua_vtk.c): the options are checked at creation, nothing is written.
 calls["grainlab.vtk.series"] = {
   args = function() return { "r.pvd", { contacts = true, walls = true, grid = true, cells = true } } end,
@@ -181,7 +196,8 @@ end
 local stdout = io.stdout
 io.stdout = { write = function(f) return f end, flush = function(f) return f end }
 local ok, err = pcall(fuzz.run, {
-  modules = { grainlab = grainlab_fns, ["grainlab.pack"] = grainlab.pack, ["grainlab.vtk"] = grainlab.vtk },
+  modules = { grainlab = grainlab_fns, ["grainlab.pack"] = grainlab.pack, ["grainlab.vtk"] = grainlab.vtk,
+              ["grainlab.mpi"] = grainlab.mpi },
   types = { ["grainlab.rng"] = grainlab.rng{}, ["grainlab.progress"] = grainlab.progress{ total = 1 } },
   calls = calls, skip = skip })
 io.stdout = stdout
