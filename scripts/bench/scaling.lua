@@ -1,73 +1,281 @@
--- Strong scaling over MPI ranks and OpenMP threads (issue 14, "Measurements to publish").
---   grainlab scripts/bench/scaling.lua engine=dsmc [n=500000] [steps=30] [warm=5] [threads=1]
---   mpirun -np K grainlab scripts/bench/scaling.lua engine=dsmc threads=1 ...
--- Each invocation measures one configuration (K ranks x threads); run it for 1 rank x 1 thread,
--- 2 ranks x 1 thread and 1 rank x 2 threads, alternating, and compare particle_steps_per_s.
--- (Under mpirun only rank 0's output appears: docs/mpi.md.)
-local engine = params.engine or "dsmc"
+-- Strong scaling over MPI ranks and a communication model projected to Herrmann & Mueller's 512
+-- processors (issue 14; the paper's Figs. 1 and 2).
+--
+--   grainlab scripts/bench/scaling.lua [engines=dem,dsmc] [reps=3] [dem_n=20000] [dem_steps=2000]
+--                                      [dsmc_n=500000] [dsmc_steps=40] [out=DIR]
+--
+-- Cases, each run alternately (1 rank, 2 ranks, 1 rank on 2 threads, …) `reps` times; medians:
+--   dem   scripts/bench/dem_dense.lua's pile of dem_n disks (prepared once by that script's
+--         export=, which leaves a checkpoint: the same state for every run), its laws (Hertz,
+--         Brilliantov per pair, Cundall-Strack springs), dt = 1e-7 s, 200 warm-up steps (the
+--         decomposition and the first rebuilds) then dem_steps timed.
+--   dsmc  Fig. 2's gas: dsmc_n disks, 2D, volume fraction 0.1, e = 0.9, cells one mean free path
+--         wide (0.76 particles per cell), Maxwellian at T/m = 1 m^2/s^2, periodic square,
+--         dt = a tenth of the mean collision time; 5 warm-up steps, dsmc_steps timed.
+-- Traffic: every rank's bytes and messages per step and seconds inside communication per step
+-- (grainlab.mpi.stats over the timed steps), at 2 ranks and, as counts only (oversubscribed: their
+-- times mean nothing on 2 cores), at 4 ranks.
+--
+-- The model (Hockney): a message of b bytes costs alpha + beta b. alpha and beta are fitted to a
+-- ping-pong between two ranks (grainlab.mpi.bcast of 8 B to 4 MiB). A rank's step on P ranks:
+--   t(P) = t1 / P  +  alpha m(P)  +  beta b(P)
+-- t1 = the 1-rank step; b(P) the bytes a rank sends per step, proportional to the length of the
+-- subdomain's interior boundary (the halo, the migrants), c g(N, P), c fitted to the counts at 2 and
+-- 4 ranks. DEM cuts by recursive bisection: a subdomain is a square of side ~ sqrt(N / P) with on
+-- average 4 (1 - 1 / sqrt P) interior sides (0 at 1 rank, ~1 at 2, 2 at 4, -> 4), g = sqrt(N / P)
+-- 4 (1 - 1 / sqrt P). DSMC cuts the cell index into ranges, i.e. slabs the width of the box with
+-- on average 2 (1 - 1 / P) interior sides, g = sqrt N 2 (1 - 1 / P): its traffic per rank does not
+-- shrink with P, which caps its speed-up (the model shows by how much). m(P) the messages per step, the measured count at 4
+-- ranks plus 2 per doubling beyond (the tree of the per-step reductions). The model's t(2) is set
+-- against the measured one; the projection to 512 ranks uses the measured alpha, beta (this
+-- machine's shared memory) and, labelled as such, an assumed cluster network (alpha = 1.5 us,
+-- beta = 0.1 ns/B: 10 GB/s). The figure plots the measured speed-ups, the ideal line and the
+-- projections (dashed, "projection").
+--
+-- Not a test: it times things. Writes scaling.png and scaling.md into images/ for the full run
+-- (the defaults), into out/ otherwise.
+local figures = require("grainlab.figures")
+local mpi = grainlab.mpi
 
--- ---- DSMC: Herrmann Fig. 2's gas -------------------------------------------------------------
--- N = 500,000 disks in 2D at volume fraction nu = 0.1 (R = 1 mm, quartz), e = 0.9, periodic
--- square, Maxwellian at T/m = 1 m^2/s^2; cells one mean free path wide (as
--- scripts/bench/largest.lua: lambda = 1 / (2 sqrt2 n_A 2R chi), Henderson's chi); dt a tenth of
--- the mean collision time. `warm` steps (not timed) decompose the gas and settle the layout,
--- then `steps` are timed. Metrics: particle_steps_per_s (wall), and per step per rank the bytes
--- and messages the ranks sent (core/comm.h counters) and the seconds inside communication.
-local function dsmc_scaling()
-  local n = math.floor(params.n or 500000)
-  local steps = params.steps or 30
-  local warm = params.warm or 5
+local P = {
+  engines = params.engines or "dem,dsmc", reps = params.reps or 3,
+  dem_n = params.dem_n or 20000, dem_steps = params.dem_steps or 2000,
+  dsmc_n = params.dsmc_n or 500000, dsmc_steps = params.dsmc_steps or 40,
+}
+
+-- ---- the cases (run by the driver below, under mpirun or not) --------------------------------
+local function result(t)
+  if mpi.rank() ~= 0 then return end
+  local parts = {}
+  for k, v in pairs(t) do parts[#parts + 1] = string.format("%s=%.17g", k, v) end
+  table.sort(parts)
+  print("SCALING " .. table.concat(parts, " "))
+end
+
+local function traffic(steps)
+  -- every rank's counters, on every rank (bcast from each in turn); max over ranks per step
+  local st = mpi.stats()
+  local bytes, msgs, secs = 0, 0, 0
+  for r = 0, mpi.size() - 1 do
+    local x = mpi.bcast(st, r)
+    bytes = math.max(bytes, x.bytes / steps)
+    msgs = math.max(msgs, x.messages / steps)
+    secs = math.max(secs, x.seconds / steps)
+  end
+  return bytes, msgs, secs
+end
+
+local function timed(s, run)
+  mpi.barrier()
+  mpi.reset_stats()
+  local t0 = grainlab.clock()
+  s:run(run)
+  mpi.barrier()
+  local wall = mpi.bcast(grainlab.clock() - t0) -- rank 0's clock decides
+  return wall, traffic(run.steps)
+end
+
+local function case_dem()
+  local s = dem.load(params.ckpt)
+  local n = s:info().count
+  s:run{ steps = 200, dt = 1e-7, progress = false }
+  local wall, bytes, msgs, secs = timed(s, { steps = params.steps, dt = 1e-7, progress = false })
+  local d = s:info().distributed or {}
+  result{ n = n, steps = params.steps, wall = wall, rate = n * params.steps / wall, bytes = bytes,
+          messages = msgs, comm_s = secs, rebuilds = d.rebuilds or 0,
+          imbalance = d.owned_max and d.owned_max / (n / mpi.size()) or 1 }
+end
+
+local function fig2_scene(n)
   local nu, R = 0.1, 1e-3
   local L = math.sqrt(n * math.pi * R * R / nu)
-  local chi = (1 - 7 / 16 * nu) / (1 - nu) ^ 2
+  local chi = (1 - 7 / 16 * nu) / (1 - nu) ^ 2 -- 2D Enskog factor (Henderson)
   local lambda = 1 / (2 * math.sqrt(2) * (n / (L * L)) * 2 * R * chi)
   local nc = math.ceil(L / lambda)
-  if params.threads then grainlab.threads(params.threads) end
-  local s = dsmc.scene{ dim = 2, size = { L, L }, cells = { nc, nc }, radius = R, restitution = 0.9,
-                        seed = 3 }
+  local s = dsmc.scene{ dim = 2, size = { L, L }, cells = { nc, nc }, radius = R, restitution = 0.9, seed = 3 }
   s:fill{ n = n, temperature = s:info().mass * 1.0, seed = 5 }
+  return s
+end
+
+local function case_dsmc()
+  local n = params.n
+  local s = fig2_scene(n)
   local dt = 0.1 / s:measure("temperature").collision_frequency
-  s:run{ steps = warm, dt = dt, progress = false, warn = false }
-  s:reset_stats()
-  local w0 = grainlab.clock()
-  s:run{ steps = steps, dt = dt, progress = false, warn = false }
-  local wall = grainlab.clock() - w0
-  local st = s:measure("stats")
-  local T = s:measure("temperature").temperature -- a digest: the same bits on any rank count
-  local info = s:info()
-  return {
-    params = { engine = "dsmc", n = n, steps = steps, warm = warm, cells = nc * nc, packing = nu,
-               ranks = st.ranks, threads = params.threads or "default" },
-    metrics = {
-      particle_steps_per_s = n * steps / wall,
-      wall_s = wall,
-      step_ms = 1000 * wall / steps,
-      comm_bytes_per_step_per_rank = st.comm_bytes_per_step_per_rank,
-      comm_messages_per_step_per_rank = st.comm_messages_per_step_per_rank,
-      comm_s_per_step = st.comm_s / steps,
-      imbalance = st.imbalance,
-      collisions_per_particle_per_step = st.collisions_per_particle_per_step,
-      bytes_per_particle_this_rank = info.particle_bytes / n * st.ranks,
-      temperature_bits = string.format("%a", T),
-    },
-  }
+  -- warn = false: at nu = 0.1 a cell one mean free path wide holds 0.7 particles, below the
+  -- validity check's few per cell (the paper's case; the run is timed, not validated)
+  s:run{ steps = 5, dt = dt, progress = false, warn = false }
+  local wall, bytes, msgs, secs = timed(s, { steps = params.steps, dt = dt, progress = false, warn = false })
+  result{ n = n, steps = params.steps, wall = wall, rate = n * params.steps / wall, bytes = bytes,
+          messages = msgs, comm_s = secs }
 end
 
-local result
-if engine == "dsmc" then
-  result = dsmc_scaling()
-else
-  error("scaling.lua: engine must be 'dsmc' (the DEM part is another section), got " ..
-        tostring(engine))
+local function case_pingpong()
+  -- alpha, beta between two ranks: a bcast from rank 0 to rank 1 of b bytes, repeated
+  local sizes = { 8, 1024, 16384, 262144, 4194304 }
+  local out = {}
+  for k, b in ipairs(sizes) do
+    local msg = string.rep("x", b)
+    local reps = b >= 262144 and 20 or 200
+    mpi.bcast(msg)
+    mpi.barrier()
+    local t0 = grainlab.clock()
+    for _ = 1, reps do mpi.bcast(msg) end
+    mpi.barrier()
+    out["t" .. k] = mpi.bcast((grainlab.clock() - t0) / reps)
+    out["b" .. k] = b
+  end
+  result(out)
 end
 
-do
-  local m = result.metrics
-  print(string.format("scaling %s: %d ranks x %s threads: %.4g particle-steps/s (%.2f ms/step), " ..
-                      "%.0f bytes and %.1f messages per step per rank, %.3f ms/step in comm, " ..
-                      "imbalance %.4f, T %s",
-                      result.params.engine, result.params.ranks, tostring(result.params.threads),
-                      m.particle_steps_per_s, m.step_ms, m.comm_bytes_per_step_per_rank,
-                      m.comm_messages_per_step_per_rank, 1000 * m.comm_s_per_step,
-                      m.imbalance, m.temperature_bits))
+if params.case then
+  local cases = { dem = case_dem, dsmc = case_dsmc, pingpong = case_pingpong }
+  assert(cases[params.case], "scaling.lua: unknown case " .. tostring(params.case))(cases[params.case])()
+  return
 end
+
+-- ---- the driver ----------------------------------------------------------------------------------
+assert(mpi.size() == 1, "scaling.lua starts its own mpirun runs: run it without mpirun")
+local published = figures.published(P, { engines = "dem,dsmc", reps = 3, dem_n = 20000, dem_steps = 2000,
+                                        dsmc_n = 500000, dsmc_steps = 40 })
+local dir = figures.dir and figures.dir({ published = published, out = params.out })
+  or (published and "images" or (params.out or "out"))
+local work = "out/scaling"
+os.execute("mkdir -p " .. work)
+local exe = arg[-1] -- this grainlab
+local mpirun = "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 mpirun --oversubscribe --bind-to none"
+
+local function launch(ranks, threads, args)
+  local cmd = string.format("%s %s --threads %d scripts/bench/scaling.lua %s 2>&1",
+                            ranks > 1 and (mpirun .. " -np " .. ranks) or "", exe, threads, args)
+  local f = assert(io.popen(cmd))
+  local txt = f:read("a")
+  f:close()
+  local line = txt:match("SCALING ([^\n]*)")
+  if not line then error("scaling.lua: no result from: " .. cmd .. "\n" .. txt) end
+  local r = {}
+  for k, v in line:gmatch("(%w+)=(%S+)") do r[k] = tonumber(v) end
+  return r
+end
+
+local function median(xs)
+  local c = {}
+  for i, x in ipairs(xs) do c[i] = x end
+  table.sort(c)
+  return c[(#c + 1) // 2]
+end
+
+local function load1() -- the 1-minute load average
+  local f = io.open("/proc/loadavg")
+  local l = f and tonumber(f:read("a"):match("^(%S+)")) or 0
+  if f then f:close() end
+  return l
+end
+
+-- alpha, beta: least squares of t = alpha + beta b over the ping-pong sizes
+local pp = launch(2, 1, "case=pingpong")
+local sx, sy, sxx, sxy, k = 0, 0, 0, 0, 0
+for i = 1, 5 do
+  local b, t = pp["b" .. i], pp["t" .. i]
+  sx, sy, sxx, sxy, k = sx + b, sy + t, sxx + b * b, sxy + b * t, k + 1
+end
+local beta = (k * sxy - sx * sy) / (k * sxx - sx * sx)
+local alpha = math.max((sy - beta * sx) / k, pp.t1 - beta * 8)
+print(string.format("ping-pong (2 ranks, shared memory): alpha = %.3g us, beta = %.3g ns/B (%.3g GB/s)",
+                    alpha * 1e6, beta * 1e9, 1e-9 / beta))
+
+local engines = {}
+for e in P.engines:gmatch("[^,]+") do engines[#engines + 1] = e end
+local rows, curves = {}, {}
+for _, eng in ipairs(engines) do
+  local args
+  if eng == "dem" then
+    local data = string.format("%s/pile%d.data", work, P.dem_n)
+    if not io.open(data .. ".ckpt") then
+      assert(os.execute(string.format("%s scripts/bench/dem_dense.lua n=%d export=%s", exe, P.dem_n, data)))
+    end
+    args = string.format("case=dem ckpt=%s steps=%d", data .. ".ckpt", P.dem_steps)
+  elseif eng == "dsmc" then
+    args = string.format("case=dsmc n=%d steps=%d", P.dsmc_n, P.dsmc_steps)
+  else
+    error("scaling.lua: engines are dem and dsmc, got " .. eng)
+  end
+  local configs = { { 1, 1 }, { 2, 1 }, { 1, 2 } }
+  local runs = { {}, {}, {} }
+  local loads = {}
+  for rep = 1, P.reps do
+    for c, cfg in ipairs(configs) do
+      loads[#loads + 1] = load1()
+      local r = launch(cfg[1], cfg[2], args)
+      runs[c][#runs[c] + 1] = r
+      io.stderr:write(string.format("%s rep %d: %d rank(s) x %d thread(s): %.4g particle-steps/s\n",
+                                    eng, rep, cfg[1], cfg[2], r.rate))
+    end
+  end
+  local four = launch(4, 1, args) -- traffic counts only (4 ranks on 2 cores)
+  local function med(c, key)
+    local xs = {}
+    for i, r in ipairs(runs[c]) do xs[i] = r[key] end
+    return median(xs)
+  end
+  local r1, r2, rt = med(1, "rate"), med(2, "rate"), med(3, "rate")
+  local N = runs[1][1].n
+  local b2, m2, c2 = med(2, "bytes"), med(2, "messages"), med(2, "comm_s")
+  local b4, m4 = four.bytes, four.messages
+  local t1 = N / r1
+  local function g_of(n, p) -- the interior boundary of a subdomain (see the header)
+    if eng == "dsmc" then return math.sqrt(n) * 2 * (1 - 1 / p) end
+    return math.sqrt(n / p) * 4 * (1 - 1 / math.sqrt(p))
+  end
+  -- c from the counts at 2 and 4 ranks (least squares through the origin)
+  local x2, x4 = g_of(N, 2), g_of(N, 4)
+  local cb = (b2 * x2 + b4 * x4) / (x2 * x2 + x4 * x4)
+  local function m_of(p) return p <= 2 and m2 or (p <= 4 and m4 or m4 + 2 * (math.log(p, 2) - 2)) end
+  local function t_of(p, n, a, b) return t1 * (n / N) / p + (p > 1 and (a * m_of(p) + b * cb * g_of(n, p)) or 0) end
+  local model2 = t_of(2, N, alpha, beta)
+  rows[#rows + 1] = string.format(
+    "| %s | %d | %.3g | %.3g | %.3g | %.2f | %.2f | %.0f / %.0f | %.1f / %.1f | %.3g | %.3g | %.1f–%.1f |",
+    eng, N, r1, r2, rt, r2 / r1 / 2, r2 / rt, b2, b4, m2, m4, N / r2, model2,
+    math.min(table.unpack(loads)), math.max(table.unpack(loads)))
+  local nproj = eng == "dsmc" and 500000 or 1000000
+  local ps, ideal, meas, proj_sm, proj_cl = {}, {}, {}, {}, {}
+  for e = 0, 9 do
+    local p = 2 ^ e
+    ps[#ps + 1] = p
+    proj_sm[#proj_sm + 1] = t_of(1, nproj, alpha, beta) / t_of(p, nproj, alpha, beta)
+    proj_cl[#proj_cl + 1] = t_of(1, nproj, 1.5e-6, 1e-10) / t_of(p, nproj, 1.5e-6, 1e-10)
+  end
+  curves[#curves + 1] = { eng = eng, ps = ps, proj_sm = proj_sm, proj_cl = proj_cl, n = nproj,
+                          meas_p = { 1, 2 }, meas_s = { 1, r2 / r1 }, s512_cl = proj_cl[#proj_cl],
+                          s512_sm = proj_sm[#proj_sm] }
+end
+
+local md = {
+  string.format("ping-pong between two ranks (shared memory): alpha = %.3g us, beta = %.3g ns/B", alpha * 1e6, beta * 1e9),
+  "",
+  "| engine | N | 1 rank (p-steps/s) | 2 ranks | 1 rank, 2 threads | efficiency at 2 ranks | 2 ranks / 2 threads | bytes per step per rank (2 / 4 ranks) | messages per step per rank (2 / 4 ranks) | step at 2 ranks, measured (s) | model (s) | 1-min load |",
+  "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|",
+}
+for _, r in ipairs(rows) do md[#md + 1] = r end
+md[#md + 1] = ""
+for _, c in ipairs(curves) do
+  md[#md + 1] = string.format("projection, %s, N = %d: speed-up at 512 ranks %.0f (this machine's alpha, beta), %.0f (cluster network, assumed)",
+                              c.eng, c.n, c.s512_sm, c.s512_cl)
+end
+local text = table.concat(md, "\n")
+print(text)
+local f = assert(io.open(dir .. "/scaling.md", "w"))
+f:write(text, "\n")
+f:close()
+
+local series = {}
+local ideal_x, ideal_y = {}, {}
+for e = 0, 9 do ideal_x[#ideal_x + 1] = 2 ^ e; ideal_y[#ideal_y + 1] = 2 ^ e end
+series[#series + 1] = { x = ideal_x, y = ideal_y, label = "ideal", style = "line" }
+for _, c in ipairs(curves) do
+  series[#series + 1] = { x = c.meas_p, y = c.meas_s, label = c.eng .. ", measured (N = " .. (c.eng == "dem" and P.dem_n or P.dsmc_n) .. ")", style = "both" }
+  series[#series + 1] = { x = c.ps, y = c.proj_cl, label = c.eng .. ", projection N = " .. c.n .. ", cluster network", style = "line" }
+  series[#series + 1] = { x = c.ps, y = c.proj_sm, label = c.eng .. ", projection N = " .. c.n .. ", this machine's network", style = "line" }
+end
+render.plot{ file = dir .. "/scaling.png", title = "Speed-up over MPI ranks: measured (1-2 ranks) and projected (model)",
+             xlabel = "ranks", ylabel = "speed-up", xlog = true, ylog = true, series = series }
+print("wrote " .. dir .. "/scaling.png and scaling.md")

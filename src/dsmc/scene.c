@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "core/comm.h"
+#include "core/memory.h"
 #include "dsmc/dsmc_internal.h"
 
 static const char AXIS[3] = {'x', 'y', 'z'};
@@ -81,14 +82,15 @@ core_status dsmc_create(const dsmc_scene_def *def, dsmc_scene **out, core_error 
     }
     {
         /* Per-cell arrays (collision remainders, cell starts, next-in-cell) are allocated here;
-         * a calloc far beyond the machine may "succeed" on an overcommitting system and kill the
-         * process later, so the grid has a fixed budget of 8 GiB, stated with the numbers. */
+         * a calloc beyond the machine may "succeed" on an overcommitting system and kill the
+         * process later, so the grid must fit in the machine's memory (core/memory.h). */
         const dsmc_scene *z = NULL;
-        const double budget = 8.0 * 1024 * 1024 * 1024;
+        const double budget = core_memory_budget();
         double bytes = ncells * (double)(sizeof *z->remainder + sizeof *z->start + sizeof *z->next);
         if (bytes > budget)
             return core_fail(err, CORE_ERR_ARG,
-                             "%.4g cells need %.3g bytes, above the limit of %.3g bytes (8 GiB); "
+                             "%.4g cells need %.3g bytes, above the limit of %.3g bytes (the machine's memory, or "
+                             "GRAINLAB_MEMORY_LIMIT); "
                              "use fewer cells (field 'cells')",
                              ncells, bytes, budget);
     }
@@ -247,13 +249,12 @@ core_status dsmc_reserve(dsmc_scene *s, size_t n, core_error *err)
 static core_status check_room(const dsmc_scene *s, size_t n, const char *what, core_error *err)
 {
     /* Positions, velocities (3 + 3 doubles), a cell index and an identity per particle, within
-     * the same fixed 8 GiB budget as the cell grid, for the same reason (overcommitted
-     * allocations). */
-    const double budget = 8.0 * 1024 * 1024 * 1024, per = 6 * sizeof(double) + 2 * sizeof(uint32_t);
+     * the same budget as the cell grid, for the same reason (overcommitted allocations). */
+    const double budget = core_memory_budget(), per = 6 * sizeof(double) + 2 * sizeof(uint32_t);
     if (((double)s->n + (double)n) * per > budget)
         return core_fail(err, CORE_ERR_ARG,
                          "%s %zu particles: %zu particles need %.3g bytes, above the limit of "
-                         "%.3g bytes (8 GiB) (field 'n')",
+                         "%.3g bytes (the machine's memory, or GRAINLAB_MEMORY_LIMIT) (field 'n')",
                          what, n, s->n + n, ((double)s->n + (double)n) * per, budget);
     if ((double)s->next_id + (double)n > 4294967296.0)
         return core_fail(err, CORE_ERR_ARG,

@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/memory.h"
 #include "mpm/mpm_internal.h"
 
 mpm_scene_def mpm_default_scene_def(void)
@@ -114,16 +115,16 @@ core_status mpm_create(const mpm_scene_def *def, mpm_scene **out, core_error *er
     {
         /* The grid at creation holds 9 doubles and 2 bytes per node, and frictional contact adds
          * per-grain fields later. Calloc of a huge grid may "succeed" on an overcommitting
-         * system and kill the process at the first step, so a grid above a fixed budget is
-         * refused here, with the numbers: 8 GiB for the creation fields (about 1.1e8 nodes,
-         * e.g. 10000 x 10000 cells). */
-        const double budget = 8.0 * 1024 * 1024 * 1024;
+         * system and kill the process at the first step, so a grid whose creation fields do not
+         * fit in the machine's memory (core/memory.h) is refused here, with the numbers. */
+        const double budget = core_memory_budget();
         double nodes = (def->cells[0] + 3.0) * (def->cells[1] + 3.0);
         double bytes = nodes * (9 * sizeof(double) + 2);
         if (bytes > budget)
             return core_fail(err, CORE_ERR_ARG,
                              "cells %d x %d need %.3g bytes of grid fields, above the limit of "
-                             "%.3g bytes (8 GiB); use fewer cells (field 'cells')",
+                             "%.3g bytes (the machine's memory, or GRAINLAB_MEMORY_LIMIT); use fewer cells "
+                             "(field 'cells')",
                              def->cells[0], def->cells[1], bytes, budget);
     }
     mpm_scene *s = calloc(1, sizeof *s);

@@ -132,7 +132,7 @@ check.eq(mat.density, 1000, "density unchanged")
 
 -- Absurd sizes are refused with the limit in the message.
 check.errors(function() mpm.scene{ cells = { 1048576, 1048576 }, size = { 1, 1 } } end,
-  "above the limit of 8.59e+09 bytes (8 GiB); use fewer cells (field 'cells')", "grid above the memory budget")
+  "bytes (the machine's memory, or GRAINLAB_MEMORY_LIMIT); use fewer cells (field 'cells')", "grid above the memory budget")
 check.errors(function() mpm.scene{ cells = { 8, 8 }, size = { 1e300, 1 } } end,
   "bad field 'size' in argument #1 to 'scene' (array of 2 positive numbers of at most 1e+100 expected", "size 1e300")
 check.errors(function() scene():run{ time = 1e99 } end,

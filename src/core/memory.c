@@ -1,0 +1,19 @@
+#include "core/memory.h"
+
+#include <stdlib.h>
+#include <unistd.h>
+
+double core_memory_budget(void)
+{
+    const char *env = getenv("GRAINLAB_MEMORY_LIMIT");
+    if (env && *env) {
+        char *end = NULL;
+        double v = strtod(env, &end);
+        if (end && *end == '\0' && v > 0)
+            return v;
+    }
+    long pages = sysconf(_SC_PHYS_PAGES), size = sysconf(_SC_PAGE_SIZE);
+    if (pages > 0 && size > 0)
+        return (double)pages * (double)size;
+    return 8.0 * 1024 * 1024 * 1024; /* unknown: a conservative 8 GiB */
+}
