@@ -129,7 +129,9 @@ end
 
 if params.case then
   local cases = { dem = case_dem, dsmc = case_dsmc, pingpong = case_pingpong }
-  assert(cases[params.case], "scaling.lua: unknown case " .. tostring(params.case))(cases[params.case])()
+  local fn = cases[params.case]
+  if not fn then error("scaling.lua: unknown case " .. tostring(params.case) .. " (dem, dsmc, pingpong)") end
+  fn()
   return
 end
 
