@@ -55,6 +55,19 @@ static void exchange_self(int npeers, const int *peers, const void *const *send,
     }
 }
 
+/* One rank's all-to-all: its own block, copied (with or without MPI). */
+static int alltoallv_self(const void *send, const size_t *send_bytes, const size_t *send_off,
+                          void **recv, size_t *recv_bytes, size_t *recv_off)
+{
+    recv_bytes[0] = send_bytes[0];
+    recv_off[0] = 0;
+    *recv = malloc(send_bytes[0] ? send_bytes[0] : 1);
+    if (!*recv)
+        return -1;
+    memcpy(*recv, (const char *)send + send_off[0], send_bytes[0]);
+    return 0;
+}
+
 int comm_available(void)
 {
 #ifdef GRAINLAB_HAVE_MPI
@@ -257,15 +270,8 @@ int comm_alltoallv(const void *send, const size_t *send_bytes, const size_t *sen
                    size_t *recv_bytes, size_t *recv_off)
 {
     const int P = comm_n;
-    if (P == 1) {
-        recv_bytes[0] = send_bytes[0];
-        recv_off[0] = 0;
-        *recv = malloc(send_bytes[0] ? send_bytes[0] : 1);
-        if (!*recv)
-            return -1;
-        memcpy(*recv, (const char *)send + send_off[0], send_bytes[0]);
-        return 0;
-    }
+    if (P == 1)
+        return alltoallv_self(send, send_bytes, send_off, recv, recv_bytes, recv_off);
     double t0 = t_enter();
     /* Sizes first. */
     uint64_t *sb = malloc(2 * (size_t)P * sizeof *sb);
@@ -441,13 +447,7 @@ int comm_allgatherv(const void *buf, size_t bytes, void **out, size_t *out_bytes
 int comm_alltoallv(const void *send, const size_t *send_bytes, const size_t *send_off, void **recv,
                    size_t *recv_bytes, size_t *recv_off)
 {
-    recv_bytes[0] = send_bytes[0];
-    recv_off[0] = 0;
-    *recv = malloc(send_bytes[0] ? send_bytes[0] : 1);
-    if (!*recv)
-        return -1;
-    memcpy(*recv, (const char *)send + send_off[0], send_bytes[0]);
-    return 0;
+    return alltoallv_self(send, send_bytes, send_off, recv, recv_bytes, recv_off);
 }
 
 void comm_exchange(int npeers, const int *peers, const void *const *send, const size_t *send_bytes,
