@@ -339,35 +339,6 @@ int comm_alltoallv(const void *send, const size_t *send_bytes, const size_t *sen
     return 0;
 }
 
-int comm_allgatherv(const void *buf, size_t bytes, void **out, size_t *out_bytes, size_t *counts)
-{
-    const int P = comm_n;
-    if (P == 1) {
-        *out = malloc(bytes ? bytes : 1);
-        if (!*out)
-            return -1;
-        memcpy(*out, buf, bytes);
-        *out_bytes = bytes;
-        if (counts)
-            counts[0] = bytes;
-        return 0;
-    }
-    /* Every rank sends the same block to every rank: an all-to-all with equal blocks. */
-    size_t *sb = malloc(4 * (size_t)P * sizeof *sb);
-    if (!sb)
-        comm_abort(70);
-    size_t *so = sb + P, *rb = sb + 2 * P, *ro = sb + 3 * P;
-    for (int r = 0; r < P; r++)
-        sb[r] = bytes, so[r] = 0;
-    int st = comm_alltoallv(buf, sb, so, out, rb, ro);
-    if (st == 0) {
-        *out_bytes = ro[P - 1] + rb[P - 1];
-        if (counts)
-            memcpy(counts, rb, (size_t)P * sizeof *counts);
-    }
-    free(sb);
-    return st;
-}
 
 void comm_exchange(int npeers, const int *peers, const void *const *send, const size_t *send_bytes,
                    void *const *recv, const size_t *recv_bytes, int tag)
@@ -432,17 +403,6 @@ int comm_any(int flag) { return flag != 0; }
 int comm_all(int flag) { return flag != 0; }
 void comm_bcast(void *buf, size_t bytes, int root) { (void)buf, (void)bytes, (void)root; }
 
-int comm_allgatherv(const void *buf, size_t bytes, void **out, size_t *out_bytes, size_t *counts)
-{
-    *out = malloc(bytes ? bytes : 1);
-    if (!*out)
-        return -1;
-    memcpy(*out, buf, bytes);
-    *out_bytes = bytes;
-    if (counts)
-        counts[0] = bytes;
-    return 0;
-}
 
 int comm_alltoallv(const void *send, const size_t *send_bytes, const size_t *send_off, void **recv,
                    size_t *recv_bytes, size_t *recv_off)
@@ -458,3 +418,24 @@ void comm_exchange(int npeers, const int *peers, const void *const *send, const 
 }
 
 #endif
+
+/* With or without MPI: the same block to every rank is an all-to-all with equal blocks (on one
+ * rank, alltoallv_self's copy). */
+int comm_allgatherv(const void *buf, size_t bytes, void **out, size_t *out_bytes, size_t *counts)
+{
+    const int P = comm_n;
+    size_t *sb = malloc(4 * (size_t)P * sizeof *sb);
+    if (!sb)
+        comm_abort(70);
+    size_t *so = sb + P, *rb = sb + 2 * P, *ro = sb + 3 * P;
+    for (int r = 0; r < P; r++)
+        sb[r] = bytes, so[r] = 0;
+    int st = comm_alltoallv(buf, sb, so, out, rb, ro);
+    if (st == 0) {
+        *out_bytes = ro[P - 1] + rb[P - 1];
+        if (counts)
+            memcpy(counts, rb, (size_t)P * sizeof *counts);
+    }
+    free(sb);
+    return st;
+}

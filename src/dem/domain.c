@@ -909,12 +909,18 @@ typedef struct wall_term {
     double fn;
 } wall_term;
 
+/* Lexicographic order of two pairs of keys: (wall, id), (i, j). */
+static int order2(uint32_t a0, uint32_t a1, uint32_t b0, uint32_t b1)
+{
+    if (a0 != b0)
+        return (a0 > b0) - (a0 < b0);
+    return (a1 > b1) - (a1 < b1);
+}
+
 static int cmp_term(const void *pa, const void *pb)
 {
     const wall_term *a = pa, *b = pb;
-    if (a->wall != b->wall)
-        return (a->wall > b->wall) - (a->wall < b->wall);
-    return (a->gid > b->gid) - (a->gid < b->gid);
+    return order2(a->wall, a->gid, b->wall, b->gid);
 }
 
 static core_status wall_sums(dem_scene *s, core_error *err);
@@ -1001,17 +1007,13 @@ typedef struct pair_rec {
 static int cmp_pair(const void *pa, const void *pb)
 {
     const pair_rec *a = pa, *b = pb;
-    if (a->i != b->i)
-        return (a->i > b->i) - (a->i < b->i);
-    return (a->j > b->j) - (a->j < b->j);
+    return order2(a->i, a->j, b->i, b->j);
 }
 
 static int cmp_u32x2(const void *pa, const void *pb)
 {
     const uint32_t *a = pa, *b = pb;
-    if (a[0] != b[0])
-        return (a[0] > b[0]) - (a[0] < b[0]);
-    return (a[1] > b[1]) - (a[1] < b[1]);
+    return order2(a[0], a[1], b[0], b[1]);
 }
 
 core_status dem_replicate(dem_scene *s, core_error *err)
