@@ -30,13 +30,9 @@ local s, run_def, extra
 if engine == "dsmc" then
   n = math.floor(params.n or 2e8)
   steps = steps or 4
-  local nu, R = 0.1, 1e-3
-  local L = math.sqrt(n * math.pi * R * R / nu)
-  local chi = (1 - 7 / 16 * nu) / (1 - nu) ^ 2 -- 2D Enskog factor (Henderson), as dsmc uses
-  local lambda = 1 / (2 * math.sqrt(2) * (n / (L * L)) * 2 * R * chi)
-  local nc = math.ceil(L / lambda)
-  s = dsmc.scene{ dim = 2, size = { L, L }, cells = { nc, nc }, radius = R, restitution = 0.9, seed = 3 }
-  s:fill{ n = n, temperature = s:info().mass * 1.0, seed = 5 }
+  local fig2_gas = dofile((arg[0]:match("^(.*)/") or ".") .. "/fig2_gas.lua")
+  local nc
+  s, nc = fig2_gas(n)
   run_def = { steps = steps, dt = 0.1 / s:measure("temperature").collision_frequency, progress = false }
   extra = function()
     local st = s:measure("stats")

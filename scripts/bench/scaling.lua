@@ -89,16 +89,7 @@ local function case_dem()
           imbalance = d.owned_max and d.owned_max / (n / mpi.size()) or 1 }
 end
 
-local function fig2_scene(n)
-  local nu, R = 0.1, 1e-3
-  local L = math.sqrt(n * math.pi * R * R / nu)
-  local chi = (1 - 7 / 16 * nu) / (1 - nu) ^ 2 -- 2D Enskog factor (Henderson)
-  local lambda = 1 / (2 * math.sqrt(2) * (n / (L * L)) * 2 * R * chi)
-  local nc = math.ceil(L / lambda)
-  local s = dsmc.scene{ dim = 2, size = { L, L }, cells = { nc, nc }, radius = R, restitution = 0.9, seed = 3 }
-  s:fill{ n = n, temperature = s:info().mass * 1.0, seed = 5 }
-  return s
-end
+local fig2_scene = dofile((arg[0]:match("^(.*)/") or ".") .. "/fig2_gas.lua")
 
 local function case_dsmc()
   local n = params.n
