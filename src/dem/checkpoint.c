@@ -167,6 +167,11 @@ static core_status write_scene(const dem_scene *s, ckpt_writer *w, core_error *e
     }
     if ((st = end(w, err)))
         return st;
+    int shaped = 0; /* walls beyond planes: their own section, absent from a scene without them */
+    for (int k = 0; k < s->nwalls; k++)
+        shaped |= s->walls[k].shape != NULL;
+    if (shaped && (st = dem_shapes_save(s, w, err)))
+        return st;
 
     /* The Verlet list as built, with what each pair carries between steps. */
     const dem_pairs *p = &s->pairs;
@@ -634,6 +639,11 @@ static void read_all(reader *r, ckpt_reader *ck, const dem_boundary_restorer *re
                 bad(r, "wall candidate out of range");
     }
     close_section(r);
+    if (!r->st && ckpt_has(ck, "wall_shapes")) {
+        open_section(r, ck, "wall_shapes");
+        if (!r->st)
+            r->st = dem_shapes_load(s, &r->sec, r->err);
+    }
 
     open_section(r, ck, "pairs");
     read_pairs(r, s);

@@ -157,7 +157,8 @@ typedef struct dem_wall_def {
 int dem_add_wall(dem_scene *s, const dem_wall_def *w, core_error *err); /* wall id or -1 */
 core_status dem_remove_wall(dem_scene *s, int id, core_error *err);
 core_status dem_set_wall_velocity(dem_scene *s, int id, const double v[3], core_error *err);
-/* Wall slots (removed walls keep their id); geometry of wall id now, *active = 0 if removed. */
+/* Wall slots (removed walls keep their id); geometry of wall id now, *active = 0 if removed or
+ * not a plane (dem_wall_outline draws the others). */
 int dem_wall_count(const dem_scene *s);
 core_status dem_wall_geometry(const dem_scene *s, int id, double point[3], double normal[3],
                               int *active, core_error *err);
@@ -172,6 +173,59 @@ core_status dem_wall_force(const dem_scene *s, int id, double *fn, core_error *e
  * the mass filters the contact noise. mass = 0 switches it off (the wall keeps its velocity). */
 core_status dem_wall_servo(dem_scene *s, int id, double force, double mass, double rate,
                            core_error *err);
+
+/* ---- walls beyond planes (walls.c) --------------------------------------------------------- *
+ * Segments and polylines (2D), triangles and triangle meshes (3D), circles (2D) and cylinders (3D,
+ * infinite or finite along their axis, open at the ends), with the particles inside (a drum) or
+ * outside (a post). A particle's contact is at the closest point of the wall's surface, edges and
+ * end points included; on a polyline or mesh each element in contact gives a hit, and a hit whose
+ * closest point is an end point, vertex or edge is dropped when another element sharing that
+ * feature is as close (ties: the lower element index keeps it), so a particle on a shared vertex
+ * or edge feels one force, while one in a concave corner feels both faces. At most
+ * DEM_WALL_MAXHIT hits per particle and wall (the closest). Walls are two-sided except cylinders.
+ * The stiffness is the flat-wall one (R* = the particle radius) whatever the wall's curvature.
+ * Each such wall moves as a rigid body: its centre translates at `velocity` and it turns at
+ * `omega` about the centre (2D: omega[2]), constants or a piecewise-linear table of the scene time
+ * (held at the end values outside it), sampled by the step itself (no callback in the step). */
+enum { DEM_WALL_MAXHIT = 4 };
+
+typedef enum dem_wall_kind {
+    DEM_WALL_PLANE,     /* dem_add_wall */
+    DEM_WALL_SEGMENTS,  /* 2D: a polyline of n points (n - 1 segments; n with closed) */
+    DEM_WALL_TRIANGLES, /* 3D: n triangles (a mesh: vertices shared by equal coordinates) */
+    DEM_WALL_CYLINDER   /* 2D circle, 3D cylinder */
+} dem_wall_kind;
+
+typedef struct dem_shape_def {
+    dem_wall_kind kind;
+    size_t n;             /* SEGMENTS: points; TRIANGLES: triangles */
+    const double *points; /* SEGMENTS: 3 n (x, y, ignored); TRIANGLES: 9 n (three corners) */
+    int closed;           /* SEGMENTS: the last point joins the first */
+    int has_center;       /* 0: the mean of the points (SEGMENTS, TRIANGLES) */
+    double center[3];     /* centre of rotation, of the torque and (CYLINDER) of the cylinder */
+    double radius;        /* CYLINDER */
+    double axis[3];       /* CYLINDER, 3D */
+    double length;        /* CYLINDER, 3D: 0 = infinite */
+    int inside;           /* CYLINDER: the particles are inside (1) or outside (0) */
+    double velocity[3], omega[3]; /* constant motion (2D: omega[2] only) */
+    size_t nmotion;       /* > 0: the motion table instead, nmotion rows of 7: t, v[3], omega[3] */
+    const double *motion; /* times strictly increasing */
+    double friction;      /* < 0: the smaller of the particle's and the wall material's */
+    int material;         /* < 0: the particle's material */
+} dem_shape_def;
+
+dem_shape_def dem_default_shape_def(void); /* inside, no motion, no friction override */
+int dem_add_shape_wall(dem_scene *s, const dem_shape_def *def, core_error *err); /* id or -1 */
+dem_wall_kind dem_wall_kind_of(const dem_scene *s, int id); /* PLANE for a bad id */
+/* The force the particles exert on the wall (N, the reaction of the contact forces) and its
+ * torque about the wall's centre at the last force evaluation. Planes: the normal part only,
+ * -fn normal, and no torque (they have no centre). */
+core_status dem_wall_load(const dem_scene *s, int id, double force[3], double torque[3],
+                          core_error *err);
+/* The wall's surface now as line strips (2D: polylines; 3D: polygons): nv[k] points of strip k
+ * follow each other in pts (3 per point). Returns the number of strips, 0 for planes; NULL arrays
+ * just count (*npts gets the points). Cylinders: `segments` points around. */
+int dem_wall_outline(const dem_scene *s, int id, int segments, int *nv, double *pts, size_t *npts);
 
 /* ---- time stepping ------------------------------------------------------------------------- */
 typedef enum dem_integrator {

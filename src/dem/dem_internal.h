@@ -11,6 +11,8 @@
 
 #define DEM_PI 3.14159265358979323846
 
+typedef struct dem_shape dem_shape; /* walls beyond planes (walls.c) */
+
 typedef struct dem_wall {
     int active;
     double point[3], normal[3], velocity[3];
@@ -24,6 +26,7 @@ typedef struct dem_wall {
     double fn;             /* normal force the wall exerts on the particles, last evaluation */
     int servo;             /* force-controlled: the wall is a damped body pushed with servo_force */
     double servo_force, servo_mass, servo_rate;
+    dem_shape *shape; /* NULL: a plane (point, normal); else its geometry and motion */
 } dem_wall;
 
 /* The Verlet list: pairs (i < j) closer than r_i + r_j + skin at the last build, sorted by i then
@@ -156,6 +159,53 @@ void dem_free_pairs(dem_pairs *p);
 void dem_pair_parameters(dem_scene *s, size_t i, size_t j, double *k, double *gamma, double *mu);
 void dem_wall_parameters(const dem_scene *s, const dem_wall *w, size_t i, double *k,
                          double *gamma, double *mu);
+
+/* walls.c: walls beyond planes. The geometry is kept in the wall's body frame (relative to its
+ * centre, at orientation `rot`), so a turning wall costs one rotation of the particle's position
+ * per contact test, not a transform of its vertices per step. */
+struct dem_shape {
+    dem_wall_kind kind;
+    size_t nv, ne;
+    double *v;                    /* body-frame vertices, 3 each */
+    uint32_t *e;                  /* elements: 2 (segments) or 3 (triangles) vertex ids each */
+    double radius, axis[3], half; /* CYLINDER: half length (INFINITY: infinite) */
+    int inside;
+    double reach;            /* largest distance of a vertex (or rim) from the centre */
+    int spins_in_place;      /* a cylinder turning about its own axis: turning moves no surface */
+    double center[3];        /* now */
+    double angle;            /* 2D orientation */
+    double rot[9];           /* body to world, row-major (2D: from angle) */
+    double vel[3], omega[3]; /* now (at the time of the next force evaluation) */
+    size_t nt;               /* motion table rows (t, v[3], omega[3]); 0: constants */
+    double *tab;
+    double moved;               /* bound on any surface point's displacement since the list build */
+    double force[3], torque[3]; /* on the wall at the last evaluation */
+    double *cload; /* per candidate: force and torque on the wall (6), summed in order */
+    size_t cap_load;
+};
+
+typedef struct dem_wall_hit {
+    double dist;     /* of the centre from the surface along n (< 0: through it) */
+    double n[3];     /* unit normal from the wall to the particle */
+    double point[3]; /* the contact point on the surface */
+    double vel[3];   /* the surface's velocity there: v + omega x (point - centre) */
+} dem_wall_hit;
+
+/* The hits of particle i (dist < r_i), closest first; 0 when none. */
+int dem_shape_hits(const dem_scene *s, const dem_wall *wl, size_t i, dem_wall_hit *hit);
+/* Smallest distance of x from the wall's surface (signed for cylinders). */
+double dem_shape_distance(const dem_scene *s, const dem_wall *wl, const double *x);
+/* Candidates of a shaped wall at a list build (within r + skin). */
+core_status dem_shape_candidates(dem_scene *s, dem_wall *wl, core_error *err);
+/* Moves the wall by one step dt from time s->time; samples the motion at the new time. */
+void dem_shape_move(dem_scene *s, dem_wall *wl, double dt);
+/* Samples the prescribed motion at time t into vel and omega. */
+void dem_shape_sample(dem_shape *sh, double t);
+void dem_shape_free(dem_shape *sh);
+/* Any shaped wall moving (or tabulated to move): the scene is driven. */
+int dem_shape_driven(const dem_shape *sh);
+core_status dem_shapes_save(const dem_scene *s, struct ckpt_writer *w, core_error *err);
+core_status dem_shapes_load(dem_scene *s, struct ckpt_section *sec, core_error *err);
 
 /* forces.c: the force evaluation, instantiated for 2D and 3D. dem_compute_forces fills f and tq
  * (pairs, walls, gravity) and returns the index of a particle that went through a wall, or

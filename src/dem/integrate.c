@@ -91,6 +91,8 @@ static int driven(const dem_scene *s)
         if (wl->active &&
             (wl->servo || wl->velocity[0] != 0 || wl->velocity[1] != 0 || wl->velocity[2] != 0))
             return 1;
+        if (wl->active && wl->shape && dem_shape_driven(wl->shape))
+            return 1;
     }
     int pres = 0;
     for (size_t i = 0; i < s->n && !pres; i++)
@@ -210,7 +212,7 @@ static core_status forces(dem_scene *s, double dt, double disp2, core_error *err
             double d2 = 0;
             for (int d = 0; d < s->dim; d++)
                 d2 += (wl->point[d] - wl->point_build[d]) * (wl->point[d] - wl->point_build[d]);
-            if (wl->active && d2 > lim)
+            if (wl->active && (d2 > lim || (wl->shape && wl->shape->moved > 0.5 * s->skin)))
                 s->need_rebuild = 1;
         }
     } else {
@@ -292,6 +294,10 @@ static void move_walls(dem_scene *s, double dt)
 {
     for (int w = 0; w < s->nwalls; w++) {
         dem_wall *wl = &s->walls[w];
+        if (wl->shape) { /* a rigid body: translation and rotation (walls.c) */
+            dem_shape_move(s, wl, dt);
+            continue;
+        }
         if (wl->servo && wl->active) { /* force control: a damped body along the normal */
             double vn = 0;
             for (int d = 0; d < s->dim; d++)
@@ -636,6 +642,13 @@ static core_status run_steps(dem_scene *s, const dem_run_def *run, core_error *e
                          "boundary conditions (pressure tractions, the minimal boundary, springs, "
                          "ties to walls, prescribed spins) do not yet run distributed "
                          "(comm_size() > 1): run this scene on one rank");
+    for (int w = 0; w < s->nwalls && comm_size() > 1; w++)
+        if (s->walls[w].active && s->walls[w].shape)
+            return core_fail(err, CORE_ERR_STATE,
+                             "walls beyond planes (segments, polylines, triangles, circles, "
+                             "cylinders; wall %d) do not yet run distributed (comm_size() > 1): "
+                             "run this scene on one rank",
+                             w + 1);
     core_status st = prepare(s, run, err);
     if (st)
         return st;

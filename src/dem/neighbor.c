@@ -458,6 +458,13 @@ core_status dem_build_pairs(dem_scene *s, core_error *err)
         dem_wall *wl = &s->walls[w];
         if (!wl->active)
             continue;
+        if (wl->shape) { /* beyond planes: distance to the surface (walls.c) */
+            if ((st = dem_shape_candidates(s, wl, err))) {
+                dem_free_pairs(&old);
+                return st;
+            }
+            continue;
+        }
         wl->ncand = 0;
         for (size_t i = 0; i < n; i++) {
             if (s->ghost && s->ghost[i])

@@ -111,6 +111,7 @@ void dem_destroy(dem_scene *s)
         for (int d = 0; d < 4; d++)
             free(s->walls[w].hist[d]);
         free(s->walls[w].cand);
+        dem_shape_free(s->walls[w].shape);
     }
     free(s->walls), free(s->mats);
     dem_free_pairs(&s->pairs);
@@ -358,8 +359,11 @@ long dem_add_particle(dem_scene *s, const dem_particle_def *p, core_error *err)
         if (!wl->active)
             continue;
         double dist = 0;
-        for (int d = 0; d < D; d++)
-            dist += (p->x[d] - wl->point[d]) * wl->normal[d];
+        if (wl->shape)
+            dist = dem_shape_distance(s, wl, p->x);
+        else
+            for (int d = 0; d < D; d++)
+                dist += (p->x[d] - wl->point[d]) * wl->normal[d];
         if (dist < p->radius * (1 - 1e-9)) /* touching is fine, up to rounding */
             return core_fail(err, CORE_ERR_ARG,
                              "particle at pos (%g, %g%s) overlaps wall %d: its centre is %g from "
@@ -491,7 +495,7 @@ int dem_add_wall(dem_scene *s, const dem_wall_def *w, core_error *err)
     }
     for (int k = 0; k < s->nwalls; k++) {
         const dem_wall *o = &s->walls[k];
-        if (!o->active)
+        if (!o->active || o->shape)
             continue;
         double dot = 0, off = 0;
         for (int d = 0; d < D; d++) {
@@ -541,10 +545,15 @@ core_status dem_set_wall_velocity(dem_scene *s, int id, const double v[3], core_
     core_status st = check_wall(s, id, err);
     if (st != CORE_OK)
         return st;
+    dem_shape *sh = s->walls[id].shape;
+    if (sh && sh->nt)
+        return core_fail(err, CORE_ERR_ARG, "wall %d moves by its motion table", id + 1);
     for (int d = 0; d < s->dim; d++) {
         if (!isfinite(v[d]))
             return core_fail(err, CORE_ERR_ARG, "wall velocity must be finite");
         s->walls[id].velocity[d] = v[d];
+        if (sh)
+            sh->vel[d] = v[d];
     }
     dem_invalidate(s, 0); /* damping and friction see the wall's velocity */
     return CORE_OK;
@@ -561,7 +570,7 @@ core_status dem_wall_geometry(const dem_scene *s, int id, double point[3], doubl
         point[d] = s->walls[id].point[d];
         normal[d] = s->walls[id].normal[d];
     }
-    *active = s->walls[id].active;
+    *active = s->walls[id].active && !s->walls[id].shape; /* planes only: see dem_wall_outline */
     return CORE_OK;
 }
 
@@ -586,6 +595,9 @@ core_status dem_wall_servo(dem_scene *s, int id, double force, double mass, doub
     if (!isfinite(rate) || rate < 0)
         return core_fail(err, CORE_ERR_ARG, "servo rate must be >= 0, got %g", rate);
     dem_wall *wl = &s->walls[id];
+    if (wl->shape)
+        return core_fail(err, CORE_ERR_ARG, "wall %d is not a plane: a servo moves planes only",
+                         id + 1);
     wl->servo = mass > 0;
     wl->servo_force = force;
     wl->servo_mass = mass;

@@ -497,6 +497,311 @@ static int l_wall_point(lua_State *L)
     return 1;
 }
 
+/* ---- walls beyond planes --------------------------------------------------------------------- */
+/* The argument number the user sees (a method's self is not counted), as args.c says it. */
+static int shown_arg(lua_State *L, int arg)
+{
+    lua_Debug ar;
+    if (lua_getstack(L, 0, &ar) && lua_getinfo(L, "n", &ar) && ar.namewhat &&
+        strcmp(ar.namewhat, "method") == 0)
+        return arg - 1;
+    return arg;
+}
+
+/* A field holding an array of arrays of `per` finite numbers (points, motion rows), or for
+ * triangles (nest = 3) an array of arrays of 3 such arrays. Returns the number of outer entries;
+ * the numbers go into a userdata buffer left on the stack (freed by the GC, also on error).
+ * Absent: 0 and nothing pushed, or an error with `required`. */
+static size_t read_rows(lua_State *L, int arg, const char *call, const char *field, int per,
+                        int nest, int required, double **out)
+{
+    char expected[96];
+    if (nest > 1)
+        snprintf(expected, sizeof expected, "array of triangles (3 arrays of %d finite numbers)",
+                 per);
+    else
+        snprintf(expected, sizeof expected, "array of arrays of %d finite numbers", per);
+    int t = lua_getfield(L, arg, field);
+    if (t == LUA_TNIL && !required) {
+        lua_pop(L, 1);
+        return 0;
+    }
+    if (t != LUA_TTABLE || luaL_len(L, -1) < 1)
+        return (size_t)bind_field_error(L, arg, call, field, expected);
+    const lua_Integer n = luaL_len(L, -1);
+    if (n > (1 << 22))
+        return (size_t)bind_field_error(L, arg, call, field, "at most 4194304 entries");
+    const int vals = per * nest;
+    double *buf = lua_newuserdatauv(L, (size_t)n * (size_t)vals * sizeof *buf, 0);
+    lua_insert(L, -2); /* buffer below the table */
+    for (lua_Integer k = 1; k <= n; k++) {
+        lua_rawgeti(L, -1, k);
+        for (int m = 0; m < nest; m++) {
+            if (nest > 1) {
+                if (lua_type(L, -1) != LUA_TTABLE || luaL_len(L, -1) != nest)
+                    goto bad;
+                lua_rawgeti(L, -1, m + 1);
+            }
+            if (lua_type(L, -1) != LUA_TTABLE || luaL_len(L, -1) != per)
+                goto bad;
+            for (int d = 0; d < per; d++) {
+                lua_rawgeti(L, -1, d + 1);
+                int isnum;
+                double v = lua_tonumberx(L, -1, &isnum);
+                if (!isnum || lua_type(L, -1) != LUA_TNUMBER || !isfinite(v) || fabs(v) > 1e100)
+                    goto bad;
+                lua_pop(L, 1);
+                buf[((size_t)(k - 1) * (size_t)nest + (size_t)m) * (size_t)per + (size_t)d] = v;
+            }
+            if (nest > 1)
+                lua_pop(L, 1);
+        }
+        lua_pop(L, 1);
+        continue;
+    bad : {
+        char got[64];
+        bind_describe(L, -1, got, sizeof got);
+        return (size_t)luaL_error(L,
+                                  "bad field '%s' in argument #%d to '%s' (%s expected, got %s "
+                                  "in entry %d)",
+                                  field, shown_arg(L, arg), call, expected, got, (int)k);
+    }
+    }
+    lua_pop(L, 1); /* the table; the buffer stays */
+    *out = buf;
+    return (size_t)n;
+}
+
+/* The motion fields shared by the shaped walls: velocity, omega (2D: a number), and motion: a
+ * table of rows {t, velocity..., omega...} or a function(t) -> velocity, omega tabulated by this
+ * call from the scene's time every motion_step until motion_until (never called in a step). */
+static int read_motion(lua_State *L, int arg, const char *call, dem_scene *s, dem_shape_def *def)
+{
+    const int D = dem_dim(s), nw = D == 2 ? 1 : 3, per = 1 + D + nw;
+    bind_field_vector(L, arg, call, "velocity", D, def->velocity, 0);
+    if (D == 2)
+        def->omega[2] = bind_field_number(L, arg, call, "omega", 0, 0);
+    else
+        bind_field_vector(L, arg, call, "omega", 3, def->omega, 0);
+    const int t = lua_getfield(L, arg, "motion");
+    lua_pop(L, 1);
+    const int has_step = lua_getfield(L, arg, "motion_step") != LUA_TNIL;
+    lua_pop(L, 1);
+    const int has_until = lua_getfield(L, arg, "motion_until") != LUA_TNIL;
+    lua_pop(L, 1);
+    const int consts =
+        lua_getfield(L, arg, "velocity") != LUA_TNIL || lua_getfield(L, arg, "omega") != LUA_TNIL;
+    lua_pop(L, 2);
+    if (t != LUA_TFUNCTION && (has_step || has_until)) {
+        lua_getfield(L, arg, has_step ? "motion_step" : "motion_until");
+        return bind_field_error(L, arg, call, has_step ? "motion_step" : "motion_until",
+                                "nil (without a motion function)");
+    }
+    if (t != LUA_TNIL && consts) {
+        lua_getfield(L, arg, "motion");
+        return bind_field_error(L, arg, call, "motion", "nil (velocity and omega are given)");
+    }
+    double *rows = NULL;
+    size_t n = 0;
+    if (t == LUA_TFUNCTION) {
+        const double step =
+            bind_field_number(L, arg, call, "motion_step", 0, BIND_REQUIRED | BIND_POSITIVE);
+        const double until = bind_field_number(L, arg, call, "motion_until", 0, BIND_REQUIRED);
+        const double t0 = dem_time(s);
+        if (!(until > t0))
+            return bind_field_error(L, arg, call, "motion_until", "time after the scene's time");
+        const double count = floor((until - t0) / step) + 2;
+        if (count > 1e6) {
+            lua_getfield(L, arg, "motion_step");
+            return bind_field_error(L, arg, call, "motion_step", "step giving at most 1e6 rows");
+        }
+        n = (size_t)count;
+        rows = lua_newuserdatauv(L, n * 7 * sizeof *rows, 0);
+        for (size_t k = 0; k < n; k++) {
+            const double tk = k + 1 == n ? until : fmin(until, t0 + (double)k * step);
+            lua_getfield(L, arg, "motion");
+            lua_pushnumber(L, tk);
+            lua_call(L, 1, 2); /* here, before any step: never inside one */
+            double *r = rows + 7 * k;
+            memset(r, 0, 7 * sizeof *r);
+            r[0] = tk;
+            int ok = lua_type(L, -2) == LUA_TTABLE && luaL_len(L, -2) == D;
+            for (int d = 0; ok && d < D; d++) {
+                lua_rawgeti(L, -2, d + 1);
+                r[1 + d] = lua_tonumber(L, -1);
+                ok = lua_type(L, -1) == LUA_TNUMBER && isfinite(r[1 + d]);
+                lua_pop(L, 1);
+            }
+            if (ok && D == 2) {
+                r[6] = lua_tonumber(L, -1);
+                ok = (lua_type(L, -1) == LUA_TNUMBER && isfinite(r[6])) || lua_isnil(L, -1);
+            } else if (ok && !lua_isnil(L, -1)) {
+                ok = lua_type(L, -1) == LUA_TTABLE && luaL_len(L, -1) == 3;
+                for (int d = 0; ok && d < 3; d++) {
+                    lua_rawgeti(L, -1, d + 1);
+                    r[4 + d] = lua_tonumber(L, -1);
+                    ok = lua_type(L, -1) == LUA_TNUMBER && isfinite(r[4 + d]);
+                    lua_pop(L, 1);
+                }
+            }
+            lua_pop(L, 2);
+            if (!ok) {
+                char tb[64];
+                snprintf(tb, sizeof tb, "%.17g", tk);
+                return luaL_error(L,
+                                  "bad field 'motion' in argument #%d to '%s' (function "
+                                  "returning velocity {%d numbers}, omega (%s) expected "
+                                  "at t = %s)",
+                                  shown_arg(L, arg), call, D, D == 2 ? "a number" : "{3 numbers}",
+                                  tb);
+            }
+        }
+    } else if (t != LUA_TNIL) {
+        double *raw = NULL;
+        if (t != LUA_TTABLE) {
+            lua_getfield(L, arg, "motion");
+            return bind_field_error(L, arg, call, "motion",
+                                    "table of rows {t, velocity, omega} or function");
+        }
+        n = read_rows(L, arg, call, "motion", per, 1, 1, &raw);
+        rows = lua_newuserdatauv(L, n * 7 * sizeof *rows, 0);
+        for (size_t k = 0; k < n; k++) {
+            double *r = rows + 7 * k;
+            memset(r, 0, 7 * sizeof *r);
+            r[0] = raw[per * k];
+            for (int d = 0; d < D; d++)
+                r[1 + d] = raw[per * k + 1 + (size_t)d];
+            for (int d = 0; d < nw; d++)
+                r[(D == 2 ? 6 : 4) + d] = raw[per * k + 1 + (size_t)D + (size_t)d];
+        }
+    }
+    def->nmotion = n;
+    def->motion = rows; /* on the stack until the call returns */
+    return 0;
+}
+
+static const char *const SHAPE_COMMON[] = {"center",      "velocity",     "omega",    "motion",
+                                           "motion_step", "motion_until", "friction", "material"};
+
+/* Fields of the shaped-wall calls: their own, then SHAPE_COMMON. */
+static int shape_wall(lua_State *L, const char *call, dem_shape_def *def)
+{
+    dem_scene *s = check_scene(L, 1);
+    const int D = dem_dim(s);
+    if (!def->has_center)
+        def->has_center = bind_field_vector(L, 2, call, "center", D, def->center, 0);
+    read_motion(L, 2, call, s, def);
+    def->friction = bind_field_number(L, 2, call, "friction", -1, 0);
+    if (def->friction < 0 && lua_getfield(L, 2, "friction") != LUA_TNIL)
+        return bind_field_error(L, 2, call, "friction", "non-negative number");
+    def->material = material_index(L, 1, 2, call, "material", -1);
+    core_error err;
+    int id = dem_add_shape_wall(s, def, &err);
+    if (id < 0)
+        return bind_raise(L, call, &err);
+    lua_pushinteger(L, id + 1);
+    return 1;
+}
+
+static void check_shape_fields(lua_State *L, const char *call, const char *const own[])
+{
+    const char *all[24];
+    size_t n = 0;
+    for (; own[n]; n++)
+        all[n] = own[n];
+    for (size_t k = 0; k < sizeof SHAPE_COMMON / sizeof *SHAPE_COMMON; k++)
+        all[n++] = SHAPE_COMMON[k];
+    all[n] = NULL;
+    bind_check_table(L, 2, call);
+    bind_check_fields(L, 2, call, all);
+}
+
+static const char *const POLYLINE_FIELDS[] = {"points", "closed", NULL};
+
+static int l_add_polyline(lua_State *L)
+{
+    dem_scene *s = check_scene(L, 1);
+    check_shape_fields(L, "add_polyline", POLYLINE_FIELDS);
+    if (dem_dim(s) != 2)
+        return luaL_error(L, "bad argument #1 to 'add_polyline' (2D scene expected, got a 3D "
+                             "one: use add_mesh)");
+    dem_shape_def def = dem_default_shape_def();
+    def.kind = DEM_WALL_SEGMENTS;
+    double *pts2 = NULL;
+    size_t n = read_rows(L, 2, "add_polyline", "points", 2, 1, 1, &pts2);
+    double *pts = lua_newuserdatauv(L, 3 * n * sizeof *pts, 0);
+    for (size_t k = 0; k < n; k++)
+        pts[3 * k] = pts2[2 * k], pts[3 * k + 1] = pts2[2 * k + 1], pts[3 * k + 2] = 0;
+    def.n = n;
+    def.points = pts;
+    def.closed = bind_field_boolean(L, 2, "add_polyline", "closed", 0);
+    return shape_wall(L, "add_polyline", &def);
+}
+
+static const char *const MESH_FIELDS[] = {"triangles", NULL};
+
+static int l_add_mesh(lua_State *L)
+{
+    dem_scene *s = check_scene(L, 1);
+    check_shape_fields(L, "add_mesh", MESH_FIELDS);
+    if (dem_dim(s) != 3)
+        return luaL_error(L, "bad argument #1 to 'add_mesh' (3D scene expected, got a 2D one: "
+                             "use add_polyline)");
+    dem_shape_def def = dem_default_shape_def();
+    def.kind = DEM_WALL_TRIANGLES;
+    double *pts = NULL;
+    def.n = read_rows(L, 2, "add_mesh", "triangles", 3, 3, 1, &pts);
+    def.points = pts;
+    return shape_wall(L, "add_mesh", &def);
+}
+
+static const char *const CYLINDER_FIELDS[] = {"radius", "axis", "length", "inside", NULL};
+
+static int l_add_cylinder(lua_State *L)
+{
+    dem_scene *s = check_scene(L, 1);
+    const int D = dem_dim(s);
+    check_shape_fields(L, "add_cylinder", CYLINDER_FIELDS);
+    dem_shape_def def = dem_default_shape_def();
+    def.kind = DEM_WALL_CYLINDER;
+    bind_field_vector(L, 2, "add_cylinder", "center", D, def.center, BIND_REQUIRED);
+    def.has_center = 1;
+    def.radius =
+        bind_field_number(L, 2, "add_cylinder", "radius", 0, BIND_REQUIRED | BIND_POSITIVE);
+    if (D == 3) {
+        bind_field_vector(L, 2, "add_cylinder", "axis", 3, def.axis, BIND_REQUIRED);
+        def.length = bind_field_number(L, 2, "add_cylinder", "length", 0, BIND_NONNEG);
+    } else {
+        const char *f3[] = {"axis", "length"};
+        for (int k = 0; k < 2; k++)
+            if (lua_getfield(L, 2, f3[k]) != LUA_TNIL)
+                return bind_field_error(L, 2, "add_cylinder", f3[k], "nil (a 2D circle)");
+            else
+                lua_pop(L, 1);
+    }
+    def.inside = bind_field_boolean(L, 2, "add_cylinder", "inside", 1);
+    return shape_wall(L, "add_cylinder", &def);
+}
+
+/* s:wall_load(id) -> force on the wall {fx, fy[, fz]}, torque about its centre (2D: a number). */
+static int l_wall_load(lua_State *L)
+{
+    dem_scene *s = check_scene_local(L, 1);
+    core_error serr;
+    if (dem_sync_walls(s, &serr) != CORE_OK)
+        return bind_raise(L, "wall_load", &serr);
+    double f[3], t[3];
+    core_error err;
+    if (dem_wall_load(s, wall_arg(L, 2, "wall_load"), f, t, &err))
+        return bind_raise(L, "wall_load", &err);
+    push_vector(L, f, dem_dim(s));
+    if (dem_dim(s) == 2)
+        lua_pushnumber(L, t[2]);
+    else
+        push_vector(L, t, 3);
+    return 2;
+}
+
 /* ---- time stepping -------------------------------------------------------------------------- */
 static void push_timestep(lua_State *L, const dem_timestep *t)
 {
@@ -1092,6 +1397,36 @@ void bind_open_dem(lua_State *L)
          "}",
          "Adds a planar wall (normal into the domain), optionally moving and with its own "
          "friction; returns the wall id."},
+        {"add_polyline", l_add_polyline,
+         "s:add_polyline{ points = {{x, y}, ...}, closed = false, center = {x, y}, velocity = "
+         "{vx, vy}, omega = w, motion = rows or function, motion_step =, motion_until =, "
+         "friction = mu, material = m }",
+         "Adds a 2D wall made of segments joining the points (a single segment: two points; "
+         "closed joins the last to the first). Contact at the closest point, end points "
+         "included; a particle on a shared vertex feels one force. The wall moves as a rigid "
+         "body: its centre (default the mean of the points) at velocity, turning at omega "
+         "(rad/s) about it; or motion = {{t, vx, vy, w}, ...} piecewise linear in the scene "
+         "time, or motion = function(t) return {vx, vy}, w end tabulated now every "
+         "motion_step until motion_until (never called during a step). Returns the wall id."},
+        {"add_mesh", l_add_mesh,
+         "s:add_mesh{ triangles = {{{x,y,z}, {x,y,z}, {x,y,z}}, ...}, center =, velocity =, "
+         "omega = {wx, wy, wz}, motion =, motion_step =, motion_until =, friction =, material = }",
+         "Adds a 3D wall of triangles (a mesh: corners with equal coordinates are shared). "
+         "Contact at the closest point, edges and corners included, one force per shared "
+         "feature. Motion as add_polyline (rows {t, vx, vy, vz, wx, wy, wz}). Returns the wall "
+         "id."},
+        {"add_cylinder", l_add_cylinder,
+         "s:add_cylinder{ center = {...}, radius = R, axis = {ax, ay, az}, length = 0, inside = "
+         "true, velocity =, omega =, motion =, motion_step =, motion_until =, friction =, "
+         "material = }",
+         "Adds a circle (2D) or a cylinder (3D, along axis; length 0 = infinite, else open at "
+         "its ends) with the particles inside (a drum) or outside (a post). It turns about its "
+         "centre at omega: a rotating drum drags the particles by friction. Returns the wall "
+         "id."},
+        {"wall_load", l_wall_load, "s:wall_load(id)",
+         "The force the particles exert on the wall ({fx, fy[, fz]}, N) and its torque about "
+         "the wall's centre (2D: a number, N m) at the last force evaluation; for a plane the "
+         "normal part only and no torque."},
         {"remove_wall", l_remove_wall, "s:remove_wall(id)", "Removes a wall during a run."},
         {"wall_velocity", l_wall_velocity, "s:wall_velocity(id, {vx, vy})",
          "Sets a wall's velocity."},
