@@ -526,6 +526,42 @@ static uint32_t vertex_id(double *v, size_t *nv, const double *p)
     return (uint32_t)(*nv)++;
 }
 
+/* A triangle given twice would push twice: refused (sorted corner ids, compared after a sort). */
+static int cmp_tri(const void *pa, const void *pb)
+{
+    const uint32_t *a = pa, *b = pb;
+    for (int k = 0; k < 3; k++)
+        if (a[k] != b[k])
+            return a[k] < b[k] ? -1 : 1;
+    return a[3] < b[3] ? -1 : a[3] > b[3];
+}
+
+static core_status unique_triangles(const dem_shape *sh, core_error *err)
+{
+    uint32_t(*t)[4] = malloc((sh->ne ? sh->ne : 1) * sizeof *t);
+    if (!t)
+        return core_fail(err, CORE_ERR_NOMEM, "cannot allocate the wall's triangles");
+    for (size_t k = 0; k < sh->ne; k++) {
+        uint32_t a = sh->e[3 * k], b = sh->e[3 * k + 1], c = sh->e[3 * k + 2], x;
+        if (a > b)
+            x = a, a = b, b = x;
+        if (b > c)
+            x = b, b = c, c = x;
+        if (a > b)
+            x = a, a = b, b = x;
+        t[k][0] = a, t[k][1] = b, t[k][2] = c, t[k][3] = (uint32_t)k;
+    }
+    qsort(t, sh->ne, sizeof *t, cmp_tri);
+    core_status st = CORE_OK;
+    for (size_t k = 1; k < sh->ne && !st; k++)
+        if (t[k][0] == t[k - 1][0] && t[k][1] == t[k - 1][1] && t[k][2] == t[k - 1][2])
+            st = core_fail(err, CORE_ERR_ARG,
+                           "triangle %u repeats triangle %u (field 'triangles')",
+                           (unsigned)t[k][3] + 1, (unsigned)t[k - 1][3] + 1);
+    free(t);
+    return st;
+}
+
 static core_status build_geometry(const dem_scene *s, const dem_shape_def *def, dem_shape *sh,
                                   core_error *err)
 {
@@ -559,10 +595,10 @@ static core_status build_geometry(const dem_scene *s, const dem_shape_def *def, 
     const size_t n = def->n, npts = seg ? n : 3 * n;
     if (seg ? n < 2 : n < 1)
         return core_fail(err, CORE_ERR_ARG, "%s",
-                         seg ? "a polyline needs at least 2 points"
-                             : "a mesh needs at least 1 triangle");
+                         seg ? "a polyline needs at least 2 points (field 'points')"
+                             : "a mesh needs at least 1 triangle (field 'triangles')");
     if (seg && def->closed && n < 3)
-        return core_fail(err, CORE_ERR_ARG, "a closed polyline needs at least 3 points");
+        return core_fail(err, CORE_ERR_ARG, "a closed polyline needs at least 3 points (field 'closed')");
     if (npts > (size_t)1 << 24)
         return core_fail(err, CORE_ERR_ARG, "too many points (%zu)", npts);
     if (!finite_n(def->points, 3 * npts))
@@ -597,7 +633,7 @@ static core_status build_geometry(const dem_scene *s, const dem_shape_def *def, 
             if (sh->e[2 * k] == sh->e[2 * k + 1])
                 st = core_fail(err, CORE_ERR_ARG,
                                "segment %zu has no length (points %zu and %zu "
-                               "are equal)",
+                               "are equal, field 'points')",
                                k + 1, k + 1, (k + 1) % n + 1);
         } else {
             for (int a = 0; a < 3; a++)
@@ -610,10 +646,12 @@ static core_status build_geometry(const dem_scene *s, const dem_shape_def *def, 
             x[0] = u[1] * w[2] - u[2] * w[1], x[1] = u[2] * w[0] - u[0] * w[2];
             x[2] = u[0] * w[1] - u[1] * w[0];
             if (!(dot3(x, x) > 1e-24 * dot3(u, u) * dot3(w, w)))
-                st = core_fail(err, CORE_ERR_ARG, "triangle %zu is degenerate (no area)", k + 1);
+                st = core_fail(err, CORE_ERR_ARG, "triangle %zu is degenerate (no area, field 'triangles')", k + 1);
         }
     }
     free(ids);
+    if (!st && !seg)
+        st = unique_triangles(sh, err);
     for (size_t k = 0; k < sh->nv; k++)
         sh->reach = fmax(sh->reach, sqrt(dot3(sh->v + 3 * k, sh->v + 3 * k)));
     return st;
@@ -638,7 +676,7 @@ int dem_add_shape_wall(dem_scene *s, const dem_shape_def *def, core_error *err)
             if (!(def->motion[7 * k] > def->motion[7 * (k - 1)]))
                 return core_fail(err, CORE_ERR_ARG,
                                  "motion times must increase (row %zu: %g "
-                                 "after %g)",
+                                 "after %g, field 'motion')",
                                  k + 1, def->motion[7 * k], def->motion[7 * (k - 1)]),
                        -1;
     }

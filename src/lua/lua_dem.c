@@ -589,17 +589,16 @@ static int read_motion(lua_State *L, int arg, const char *call, dem_scene *s, de
     lua_pop(L, 1);
     const int has_until = lua_getfield(L, arg, "motion_until") != LUA_TNIL;
     lua_pop(L, 1);
-    const int consts =
-        lua_getfield(L, arg, "velocity") != LUA_TNIL || lua_getfield(L, arg, "omega") != LUA_TNIL;
-    lua_pop(L, 2);
+    /* the messages of a mismatch name both fields: either may be the mistake */
     if (t != LUA_TFUNCTION && (has_step || has_until)) {
         lua_getfield(L, arg, has_step ? "motion_step" : "motion_until");
         return bind_field_error(L, arg, call, has_step ? "motion_step" : "motion_until",
-                                "nil (without a motion function)");
+                                "nil ('motion' is not a function)");
     }
-    if (t != LUA_TNIL && consts) {
-        lua_getfield(L, arg, "motion");
-        return bind_field_error(L, arg, call, "motion", "nil (velocity and omega are given)");
+    if (t == LUA_TFUNCTION && !(has_step && has_until)) {
+        lua_getfield(L, arg, has_step ? "motion_until" : "motion_step");
+        return bind_field_error(L, arg, call, has_step ? "motion_until" : "motion_step",
+                                "number (with a function as 'motion')");
     }
     double *rows = NULL;
     size_t n = 0;
@@ -608,17 +607,21 @@ static int read_motion(lua_State *L, int arg, const char *call, dem_scene *s, de
             bind_field_number(L, arg, call, "motion_step", 0, BIND_REQUIRED | BIND_POSITIVE);
         const double until = bind_field_number(L, arg, call, "motion_until", 0, BIND_REQUIRED);
         const double t0 = dem_time(s);
-        if (!(until > t0))
+        if (!(until > t0)) {
+            lua_getfield(L, arg, "motion_until");
             return bind_field_error(L, arg, call, "motion_until", "time after the scene's time");
-        const double count = floor((until - t0) / step) + 2;
-        if (count > 1e6) {
+        }
+        /* rows at t0 + k step while before `until`, then `until` itself */
+        while (n < 1000000 && t0 + (double)n * step < until)
+            n++;
+        if (n == 1000000) {
             lua_getfield(L, arg, "motion_step");
             return bind_field_error(L, arg, call, "motion_step", "step giving at most 1e6 rows");
         }
-        n = (size_t)count;
+        n++;
         rows = lua_newuserdatauv(L, n * 7 * sizeof *rows, 0);
         for (size_t k = 0; k < n; k++) {
-            const double tk = k + 1 == n ? until : fmin(until, t0 + (double)k * step);
+            const double tk = k + 1 == n ? until : t0 + (double)k * step;
             lua_getfield(L, arg, "motion");
             lua_pushnumber(L, tk);
             lua_call(L, 1, 2); /* here, before any step: never inside one */
@@ -675,15 +678,23 @@ static int read_motion(lua_State *L, int arg, const char *call, dem_scene *s, de
                 r[(D == 2 ? 6 : 4) + d] = raw[per * k + 1 + (size_t)D + (size_t)d];
         }
     }
+    /* a constant besides a (valid) motion: the constant is the mistake */
+    const char *konst[2] = {"velocity", "omega"};
+    for (int k = 0; k < 2 && t != LUA_TNIL; k++) {
+        if (lua_getfield(L, arg, konst[k]) != LUA_TNIL)
+            return bind_field_error(L, arg, call, konst[k], "nil (a motion is given)");
+        lua_pop(L, 1);
+    }
     def->nmotion = n;
     def->motion = rows; /* on the stack until the call returns */
     return 0;
 }
 
-static const char *const SHAPE_COMMON[] = {"center",      "velocity",     "omega",    "motion",
-                                           "motion_step", "motion_until", "friction", "material"};
+/* The fields every shaped wall takes, after its own. */
+#define SHAPE_COMMON_FIELDS                                                                        \
+    "center", "velocity", "omega", "motion", "motion_step", "motion_until", "friction", "material"
 
-/* Fields of the shaped-wall calls: their own, then SHAPE_COMMON. */
+/* The shaped-wall calls' common part: the centre, motion, friction and material, then the wall. */
 static int shape_wall(lua_State *L, const char *call, dem_shape_def *def)
 {
     dem_scene *s = check_scene(L, 1);
@@ -703,20 +714,13 @@ static int shape_wall(lua_State *L, const char *call, dem_shape_def *def)
     return 1;
 }
 
-static void check_shape_fields(lua_State *L, const char *call, const char *const own[])
+static void check_shape_fields(lua_State *L, const char *call, const char *const fields[])
 {
-    const char *all[24];
-    size_t n = 0;
-    for (; own[n]; n++)
-        all[n] = own[n];
-    for (size_t k = 0; k < sizeof SHAPE_COMMON / sizeof *SHAPE_COMMON; k++)
-        all[n++] = SHAPE_COMMON[k];
-    all[n] = NULL;
     bind_check_table(L, 2, call);
-    bind_check_fields(L, 2, call, all);
+    bind_check_fields(L, 2, call, fields);
 }
 
-static const char *const POLYLINE_FIELDS[] = {"points", "closed", NULL};
+static const char *const POLYLINE_FIELDS[] = {"points", "closed", SHAPE_COMMON_FIELDS, NULL};
 
 static int l_add_polyline(lua_State *L)
 {
@@ -738,7 +742,7 @@ static int l_add_polyline(lua_State *L)
     return shape_wall(L, "add_polyline", &def);
 }
 
-static const char *const MESH_FIELDS[] = {"triangles", NULL};
+static const char *const MESH_FIELDS[] = {"triangles", SHAPE_COMMON_FIELDS, NULL};
 
 static int l_add_mesh(lua_State *L)
 {
@@ -755,7 +759,8 @@ static int l_add_mesh(lua_State *L)
     return shape_wall(L, "add_mesh", &def);
 }
 
-static const char *const CYLINDER_FIELDS[] = {"radius", "axis", "length", "inside", NULL};
+static const char *const CYLINDER_FIELDS[] = {"radius", "axis", "length", "inside",
+                                              SHAPE_COMMON_FIELDS, NULL};
 
 static int l_add_cylinder(lua_State *L)
 {
@@ -1501,6 +1506,9 @@ void bind_open_dem(lua_State *L)
                                                 {"add_disk", NULL, PARTICLE_FIELDS},
                                                 {"add_sphere", NULL, PARTICLE_FIELDS},
                                                 {"add_wall", NULL, WALL_FIELDS},
+                                                {"add_polyline", NULL, POLYLINE_FIELDS},
+                                                {"add_mesh", NULL, MESH_FIELDS},
+                                                {"add_cylinder", NULL, CYLINDER_FIELDS},
                                                 {"wall_servo", NULL, SERVO_FIELDS},
                                                 {"timestep", NULL, TIMESTEP_FIELDS},
                                                 {"run", NULL, RUN_FIELDS},
