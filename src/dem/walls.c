@@ -859,8 +859,8 @@ core_status dem_shapes_save(const dem_scene *s, ckpt_writer *w, core_error *err)
         const dem_shape *sh = s->walls[k].shape;
         if (!sh)
             continue;
-        ckpt_put_u64(w, (uint64_t)k);
-        ckpt_put_u32(w, (uint32_t)sh->kind);
+        ckpt_put_i64(w, k);
+        ckpt_put_i64(w, (int64_t)sh->kind);
         ckpt_put_f64s(w, sh->v, 3 * sh->nv);
         ckpt_put_u32s(w, sh->e, (sh->kind == DEM_WALL_TRIANGLES ? 3 : 2) * sh->ne);
         const double g[5] = {sh->radius, sh->axis[0], sh->axis[1], sh->axis[2], sh->half};
