@@ -86,6 +86,7 @@ struct dem_scene {
 
     dem_wall *walls;
     int nwalls, cap_walls;
+    int nshaped;           /* walls beyond planes (walls.c): 0 keeps every step on the planes' path */
 
     dem_pairs pairs;
     int need_rebuild;
@@ -180,8 +181,10 @@ struct dem_shape {
     double *tab;
     double moved;               /* bound on any surface point's displacement since the list build */
     double force[3], torque[3]; /* on the wall at the last evaluation */
+    uint32_t *cand;        /* particles within r + skin at the last list build (the wall's own
+                            * ncand stays 0: the planes' loop passes over the wall) */
+    size_t ncand, cap_cand;
     double *cload; /* per candidate: force and torque on the wall (6), summed in order */
-    size_t cap_load;
 };
 
 typedef struct dem_wall_hit {
@@ -197,13 +200,15 @@ int dem_shape_hits(const dem_scene *s, const dem_wall *wl, size_t i, dem_wall_hi
 double dem_shape_distance(const dem_scene *s, const dem_wall *wl, const double *x);
 /* Candidates of a shaped wall at a list build (within r + skin). */
 core_status dem_shape_candidates(dem_scene *s, dem_wall *wl, core_error *err);
-/* Moves the wall by one step dt from time s->time; samples the motion at the new time. */
-void dem_shape_move(dem_scene *s, dem_wall *wl, double dt);
+/* Moves every shaped wall by one step dt from time s->time; samples the motion at the new time. */
+void dem_shapes_move(dem_scene *s, double dt);
+/* A shaped wall's surface moved more than half the skin since the list build. */
+int dem_shapes_moved(const dem_scene *s);
 /* Samples the prescribed motion at time t into vel and omega. */
 void dem_shape_sample(dem_shape *sh, double t);
 void dem_shape_free(dem_shape *sh);
 /* Any shaped wall moving (or tabulated to move): the scene is driven. */
-int dem_shape_driven(const dem_shape *sh);
+int dem_shapes_driven(const dem_scene *s);
 core_status dem_shapes_save(const dem_scene *s, struct ckpt_writer *w, core_error *err);
 core_status dem_shapes_load(dem_scene *s, struct ckpt_section *sec, core_error *err);
 

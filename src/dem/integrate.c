@@ -91,9 +91,9 @@ static int driven(const dem_scene *s)
         if (wl->active &&
             (wl->servo || wl->velocity[0] != 0 || wl->velocity[1] != 0 || wl->velocity[2] != 0))
             return 1;
-        if (wl->active && wl->shape && dem_shape_driven(wl->shape))
-            return 1;
     }
+    if (s->nshaped && dem_shapes_driven(s))
+        return 1;
     int pres = 0;
     for (size_t i = 0; i < s->n && !pres; i++)
         pres = (s->flags[i] & DEM_PRESCRIBED) != 0;
@@ -212,9 +212,11 @@ static core_status forces(dem_scene *s, double dt, double disp2, core_error *err
             double d2 = 0;
             for (int d = 0; d < s->dim; d++)
                 d2 += (wl->point[d] - wl->point_build[d]) * (wl->point[d] - wl->point_build[d]);
-            if (wl->active && (d2 > lim || (wl->shape && wl->shape->moved > 0.5 * s->skin)))
+            if (wl->active && d2 > lim)
                 s->need_rebuild = 1;
         }
+        if (s->nshaped && !s->need_rebuild && dem_shapes_moved(s)) /* turning walls */
+            s->need_rebuild = 1;
     } else {
         s->need_rebuild = 1;
     }
@@ -294,10 +296,6 @@ static void move_walls(dem_scene *s, double dt)
 {
     for (int w = 0; w < s->nwalls; w++) {
         dem_wall *wl = &s->walls[w];
-        if (wl->shape) { /* a rigid body: translation and rotation (walls.c) */
-            dem_shape_move(s, wl, dt);
-            continue;
-        }
         if (wl->servo && wl->active) { /* force control: a damped body along the normal */
             double vn = 0;
             for (int d = 0; d < s->dim; d++)
@@ -309,6 +307,8 @@ static void move_walls(dem_scene *s, double dt)
         for (int d = 0; d < s->dim; d++)
             wl->point[d] += dt * wl->velocity[d];
     }
+    if (s->nshaped) /* walls beyond planes, rigid bodies that also turn (walls.c) */
+        dem_shapes_move(s, dt);
 }
 
 static size_t check_finite(const dem_scene *s)

@@ -551,10 +551,9 @@ core_status dem_set_wall_velocity(dem_scene *s, int id, const double v[3], core_
     for (int d = 0; d < s->dim; d++) {
         if (!isfinite(v[d]))
             return core_fail(err, CORE_ERR_ARG, "wall velocity must be finite");
-        s->walls[id].velocity[d] = v[d];
-        if (sh)
-            sh->vel[d] = v[d];
     }
+    for (int d = 0; d < s->dim; d++) /* a shaped wall's own (its plane velocity stays 0) */
+        *(sh ? &sh->vel[d] : &s->walls[id].velocity[d]) = v[d];
     dem_invalidate(s, 0); /* damping and friction see the wall's velocity */
     return CORE_OK;
 }

@@ -361,6 +361,7 @@ core_status dem_shape_candidates(dem_scene *s, dem_wall *wl, core_error *err)
 {
     dem_shape *sh = wl->shape;
     const int D = s->dim;
+    sh->ncand = 0;
     wl->ncand = 0;
     for (size_t i = 0; i < s->n; i++) {
         const double x[3] = {s->x[0][i], s->x[1][i], D == 3 ? s->x[2][i] : 0};
@@ -373,28 +374,32 @@ core_status dem_shape_candidates(dem_scene *s, dem_wall *wl, core_error *err)
             continue;
         if (!(dem_shape_distance(s, wl, x) < lim))
             continue;
-        if (wl->ncand == wl->cap_cand) {
-            size_t cap = wl->cap_cand ? 2 * wl->cap_cand : 256;
-            uint32_t *c = realloc(wl->cand, cap * sizeof *c);
-            if (!c)
+        if (sh->ncand == sh->cap_cand) {
+            size_t cap = sh->cap_cand ? 2 * sh->cap_cand : 256;
+            uint32_t *c = realloc(sh->cand, cap * sizeof *c);
+            double *l = realloc(sh->cload, 6 * cap * sizeof *l);
+            if (c)
+                sh->cand = c;
+            if (l)
+                sh->cload = l;
+            if (!c || !l)
                 return core_fail(err, CORE_ERR_NOMEM, "cannot allocate wall candidates");
-            wl->cand = c;
-            wl->cap_cand = cap;
+            sh->cap_cand = cap;
         }
-        wl->cand[wl->ncand++] = (uint32_t)i;
-    }
-    if (sh->cap_load < wl->cap_cand || !sh->cload) {
-        size_t cap = wl->cap_cand ? wl->cap_cand : 1;
-        double *c = realloc(sh->cload, 6 * cap * sizeof *c);
-        if (!c)
-            return core_fail(err, CORE_ERR_NOMEM, "cannot allocate wall candidates");
-        sh->cload = c;
-        sh->cap_load = cap;
+        sh->cand[sh->ncand++] = (uint32_t)i;
     }
     for (int d = 0; d < 3; d++)
         wl->point_build[d] = wl->point[d];
     sh->moved = 0;
     return CORE_OK;
+}
+
+int dem_shapes_moved(const dem_scene *s)
+{
+    for (int w = 0; w < s->nwalls; w++)
+        if (s->walls[w].active && s->walls[w].shape && s->walls[w].shape->moved > 0.5 * s->skin)
+            return 1;
+    return 0;
 }
 
 /* ---- motion ---------------------------------------------------------------------------------- */
@@ -454,7 +459,7 @@ static void turn3(double *rot, const double *w)
     memcpy(rot, out, sizeof out);
 }
 
-void dem_shape_move(dem_scene *s, dem_wall *wl, double dt)
+static void shape_move(dem_scene *s, dem_wall *wl, double dt)
 {
     dem_shape *sh = wl->shape;
     const int D = s->dim;
@@ -483,19 +488,30 @@ void dem_shape_move(dem_scene *s, dem_wall *wl, double dt)
     }
     sh->moved += dt * (sqrt(v2) + (turn > 0 ? turn * sh->reach : 0));
     dem_shape_sample(sh, s->time + dt);
-    for (int d = 0; d < 3; d++) {
+    for (int d = 0; d < 3; d++)
         wl->point[d] = sh->center[d];
-        wl->velocity[d] = sh->vel[d];
-    }
 }
 
-int dem_shape_driven(const dem_shape *sh)
+/* After the planes' motion, which passes over these walls (their own velocity stays 0). */
+void dem_shapes_move(dem_scene *s, double dt)
 {
-    if (sh->nt > 0)
-        return 1;
-    for (int d = 0; d < 3; d++)
-        if (sh->vel[d] != 0 || sh->omega[d] != 0)
+    for (int w = 0; w < s->nwalls; w++)
+        if (s->walls[w].shape)
+            shape_move(s, &s->walls[w], dt);
+}
+
+int dem_shapes_driven(const dem_scene *s)
+{
+    for (int w = 0; w < s->nwalls; w++) {
+        const dem_shape *sh = s->walls[w].shape;
+        if (!sh || !s->walls[w].active)
+            continue;
+        if (sh->nt > 0)
             return 1;
+        for (int d = 0; d < 3; d++)
+            if (sh->vel[d] != 0 || sh->omega[d] != 0)
+                return 1;
+    }
     return 0;
 }
 
@@ -503,7 +519,7 @@ void dem_shape_free(dem_shape *sh)
 {
     if (!sh)
         return;
-    free(sh->v), free(sh->e), free(sh->tab), free(sh->cload);
+    free(sh->v), free(sh->e), free(sh->tab), free(sh->cload), free(sh->cand);
     free(sh);
 }
 
@@ -715,11 +731,11 @@ int dem_add_shape_wall(dem_scene *s, const dem_shape_def *def, core_error *err)
             }
         dem_shape_sample(sh, s->time);
     }
+    /* the planes' fields: the centre as its point, no velocity (the planes' motion, which
+     * passes over this wall, must not move it: dem_shapes_move does) */
     dem_wall wl = {.active = 1, .friction = def->friction, .material = def->material, .shape = sh};
-    for (int d = 0; d < 3; d++) {
+    for (int d = 0; d < 3; d++)
         wl.point[d] = wl.point_build[d] = sh->center[d];
-        wl.velocity[d] = sh->vel[d];
-    }
     for (size_t i = 0; i < s->n; i++) {
         const double x[3] = {s->x[0][i], s->x[1][i], D == 3 ? s->x[2][i] : 0};
         double dist = dem_shape_distance(s, &wl, x);
@@ -742,6 +758,7 @@ int dem_add_shape_wall(dem_scene *s, const dem_shape_def *def, core_error *err)
         s->cap_walls = cap;
     }
     s->walls[s->nwalls] = wl;
+    s->nshaped++;
     dem_invalidate(s, 1);
     return s->nwalls++;
 }
@@ -877,6 +894,7 @@ core_status dem_shapes_save(const dem_scene *s, ckpt_writer *w, core_error *err)
         ckpt_put_f64(w, sh->moved);
         ckpt_put_f64s(w, sh->force, 3);
         ckpt_put_f64s(w, sh->torque, 3);
+        ckpt_put_u32s(w, sh->cand, sh->ncand);
     }
     return ckpt_section_end(w, err);
 }
@@ -976,11 +994,23 @@ core_status dem_shapes_load(dem_scene *s, ckpt_section *sec, core_error *err)
                            ckpt_reader_path(sec->r));
             break;
         }
-        size_t cap = wl->cap_cand ? wl->cap_cand : 1;
-        sh->cload = malloc(6 * cap * sizeof *sh->cload);
-        sh->cap_load = cap;
-        if (!sh->cload)
+        if ((st = ckpt_peek_count(sec, s->n, &n, err)))
+            break;
+        sh->cand = malloc((n ? n : 1) * sizeof *sh->cand);
+        sh->cload = malloc(6 * (n ? n : 1) * sizeof *sh->cload);
+        sh->cap_cand = n ? n : 1;
+        if (!sh->cand || !sh->cload) {
             st = core_fail(err, CORE_ERR_NOMEM, "out of memory loading a checkpoint");
+            break;
+        }
+        if ((st = ckpt_get_u32s(sec, sh->cand, n, err)))
+            break;
+        sh->ncand = n;
+        for (size_t k = 0; k < n && !st; k++)
+            if (sh->cand[k] >= s->n)
+                st = core_fail(err, CORE_ERR_IO, "'%s' is corrupt (wall candidate out of range)",
+                               ckpt_reader_path(sec->r));
+        s->nshaped++;
     }
     return st ? st : ckpt_section_done(sec, err);
 }
