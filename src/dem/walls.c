@@ -571,8 +571,7 @@ static core_status unique_triangles(const dem_shape *sh, core_error *err)
     core_status st = CORE_OK;
     for (size_t k = 1; k < sh->ne && !st; k++)
         if (t[k][0] == t[k - 1][0] && t[k][1] == t[k - 1][1] && t[k][2] == t[k - 1][2])
-            st = core_fail(err, CORE_ERR_ARG,
-                           "triangle %u repeats triangle %u (field 'triangles')",
+            st = core_fail(err, CORE_ERR_ARG, "triangle %u repeats triangle %u (field 'triangles')",
                            (unsigned)t[k][3] + 1, (unsigned)t[k - 1][3] + 1);
     free(t);
     return st;
@@ -614,7 +613,8 @@ static core_status build_geometry(const dem_scene *s, const dem_shape_def *def, 
                          seg ? "a polyline needs at least 2 points (field 'points')"
                              : "a mesh needs at least 1 triangle (field 'triangles')");
     if (seg && def->closed && n < 3)
-        return core_fail(err, CORE_ERR_ARG, "a closed polyline needs at least 3 points (field 'closed')");
+        return core_fail(err, CORE_ERR_ARG,
+                         "a closed polyline needs at least 3 points (field 'closed')");
     if (npts > (size_t)1 << 24)
         return core_fail(err, CORE_ERR_ARG, "too many points (%zu)", npts);
     if (!finite_n(def->points, 3 * npts))
@@ -662,7 +662,8 @@ static core_status build_geometry(const dem_scene *s, const dem_shape_def *def, 
             x[0] = u[1] * w[2] - u[2] * w[1], x[1] = u[2] * w[0] - u[0] * w[2];
             x[2] = u[0] * w[1] - u[1] * w[0];
             if (!(dot3(x, x) > 1e-24 * dot3(u, u) * dot3(w, w)))
-                st = core_fail(err, CORE_ERR_ARG, "triangle %zu is degenerate (no area, field 'triangles')", k + 1);
+                st = core_fail(err, CORE_ERR_ARG,
+                               "triangle %zu is degenerate (no area, field 'triangles')", k + 1);
         }
     }
     free(ids);
