@@ -86,7 +86,7 @@ struct dem_scene {
 
     dem_wall *walls;
     int nwalls, cap_walls;
-    int nshaped;           /* walls beyond planes (walls.c): 0 keeps every step on the planes' path */
+    int nshaped; /* walls beyond planes (walls.c): 0 keeps every step on the planes' path */
 
     dem_pairs pairs;
     int need_rebuild;
@@ -181,8 +181,8 @@ struct dem_shape {
     double *tab;
     double moved;               /* bound on any surface point's displacement since the list build */
     double force[3], torque[3]; /* on the wall at the last evaluation */
-    uint32_t *cand;        /* particles within r + skin at the last list build (the wall's own
-                            * ncand stays 0: the planes' loop passes over the wall) */
+    uint32_t *cand;             /* particles within r + skin at the last list build (the wall's own
+                                 * ncand stays 0: the planes' loop passes over the wall) */
     size_t ncand, cap_cand;
     double *cload; /* per candidate: force and torque on the wall (6), summed in order */
 };

@@ -759,8 +759,8 @@ static int l_add_mesh(lua_State *L)
     return shape_wall(L, "add_mesh", &def);
 }
 
-static const char *const CYLINDER_FIELDS[] = {"radius", "axis", "length", "inside",
-                                              SHAPE_COMMON_FIELDS, NULL};
+static const char *const CYLINDER_FIELDS[] = {
+    "radius", "axis", "length", "inside", SHAPE_COMMON_FIELDS, NULL};
 
 static int l_add_cylinder(lua_State *L)
 {
