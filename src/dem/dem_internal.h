@@ -12,6 +12,7 @@
 #define DEM_PI 3.14159265358979323846
 
 typedef struct dem_shape dem_shape; /* walls beyond planes (walls.c) */
+enum { DEM_SHAPE_LOAD = 7 };          /* per candidate: force[3], torque[3], f_n */
 
 typedef struct dem_wall {
     int active;
@@ -184,7 +185,8 @@ struct dem_shape {
     uint32_t *cand;             /* particles within r + skin at the last list build (the wall's own
                                  * ncand stays 0: the planes' loop passes over the wall) */
     size_t ncand, cap_cand;
-    double *cload; /* per candidate: force and torque on the wall (6), summed in order */
+    double *cload; /* per candidate: force, torque on the wall, f_n (DEM_SHAPE_LOAD), summed in
+                    * candidate order */
 };
 
 typedef struct dem_wall_hit {

@@ -377,7 +377,7 @@ core_status dem_shape_candidates(dem_scene *s, dem_wall *wl, core_error *err)
         if (sh->ncand == sh->cap_cand) {
             size_t cap = sh->cap_cand ? 2 * sh->cap_cand : 256;
             uint32_t *c = realloc(sh->cand, cap * sizeof *c);
-            double *l = realloc(sh->cload, 6 * cap * sizeof *l);
+            double *l = realloc(sh->cload, DEM_SHAPE_LOAD * cap * sizeof *l);
             if (c)
                 sh->cand = c;
             if (l)
@@ -998,7 +998,7 @@ core_status dem_shapes_load(dem_scene *s, ckpt_section *sec, core_error *err)
         if ((st = ckpt_peek_count(sec, s->n, &n, err)))
             break;
         sh->cand = malloc((n ? n : 1) * sizeof *sh->cand);
-        sh->cload = malloc(6 * (n ? n : 1) * sizeof *sh->cload);
+        sh->cload = malloc(DEM_SHAPE_LOAD * (n ? n : 1) * sizeof *sh->cload);
         sh->cap_cand = n ? n : 1;
         if (!sh->cand || !sh->cload) {
             st = core_fail(err, CORE_ERR_NOMEM, "out of memory loading a checkpoint");
