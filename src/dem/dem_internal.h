@@ -12,7 +12,7 @@
 #define DEM_PI 3.14159265358979323846
 
 typedef struct dem_shape dem_shape; /* walls beyond planes (walls.c) */
-enum { DEM_SHAPE_LOAD = 7 };          /* per candidate: force[3], torque[3], f_n */
+enum { DEM_SHAPE_LOAD = 7 };        /* per candidate: force[3], torque[3], f_n */
 
 typedef struct dem_wall {
     int active;
