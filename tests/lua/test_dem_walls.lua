@@ -16,7 +16,9 @@
 --  6. a sphere resting inside a horizontal cylinder and on top of one (outside) carries m g; one
 --     beyond a finite post's end touches its rim, the normal through the rim point (1e-12);
 --  7. Newton's third law: disks in a rotating polygon, force (frictional: from the particles' total
---     forces) and torque (frictionless: from the contact list) equal and opposite to round-off.
+--     forces) and torque (frictionless: from the contact list) equal and opposite to round-off;
+--  8. 1 and 2 threads give the same bits for a wall with more than 4096 candidates (the kernel's
+--     parallel loop), particles and wall load alike.
 local check = grainlab.check
 local g = 9.81
 
@@ -259,5 +261,28 @@ for _, law in ipairs{ "none", "coulomb_regularized" } do
     check.gt(math.abs(t), 1e-6, "torque: not zero about an off-centre point")
     check.near_abs(t + tq, 0, 1e-9 * math.abs(t), "torque on the wall = -sum of (p - c) x f")
   end
+end
+-- 8. -------------------------------------------------------------------------------------------
+do
+  local function row(threads)
+    grainlab.threads(threads)
+    local s = dem.scene{ dim = 2, box = { { -0.01, -0.01 }, { 11.1, 0.05 } }, gravity = { 0, -9.81 } }
+    s:contact{ normal = "linear", stiffness = 1e4, damping = "viscous", tangential = "spring" }
+    local w = s:add_polyline{ points = { { 0, 0 }, { 5.5, 0 }, { 11, 0 } }, omega = 1e-4 }
+    for k = 0, 4999 do -- resting on the floor, sliding to and fro
+      s:add_disk{ pos = { 0.001 + 0.0022 * k, 0.001 }, radius = 0.001, vel = { 0.01 * math.sin(k), 0 } }
+    end
+    s:run{ steps = 20, dt = 5e-6 }
+    local f, t = s:wall_load(w)
+    local P = s:particles()
+    local out = { string.format("%a %a %a %a", f[1], f[2], t, s:wall_force(w)) }
+    for i = 1, P.count, 7 do out[#out + 1] = string.format("%a %a %a", P.x[i], P.y[i], P.omega[i]) end
+    return table.concat(out, "\n"), f[2]
+  end
+  local a, fy = row(1)
+  local b = row(2)
+  grainlab.threads(1)
+  check.lt(fy, 0, "5000 candidates: the wall is loaded")
+  check.eq(a, b, "5000 candidates: 1 and 2 threads give the same bits")
 end
 check.done()
