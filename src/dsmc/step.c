@@ -660,14 +660,23 @@ core_status dsmc_run(dsmc_scene *s, const dsmc_run_def *run, long *done, core_er
     long nsteps = 0;
     double tsum = 0;
     bool sorted = true;
+    int64_t lost = 0; /* particles this rank could not store at the last migration */
     while (*done < run->steps) {
         if (run->time_end >= 0 && s->t >= run->time_end * (1 - 1e-14))
             break;
         int intr = interrupt_pending();
         if (multi) {
-            int64_t q[2] = {intr, (int64_t)s->n};
-            comm_max_i64(q, 2);
+            int64_t q[3] = {intr, (int64_t)s->n, lost};
+            comm_max_i64(q, 3);
             intr = q[0] != 0;
+            if (q[2]) {
+                st = core_fail(err, CORE_ERR_NOMEM,
+                               "step %ld: out of memory on a rank storing %lld particles that "
+                               "migrated to it; the scene is incomplete", s->steps - 1,
+                               (long long)q[2]);
+                sorted = false;
+                break;
+            }
             if (!intr && (st = dsmc_domain_balance(s, q[1], err))) {
                 sorted = false; /* out of memory, maybe in the middle of a migration */
                 break;
@@ -685,14 +694,16 @@ core_status dsmc_run(dsmc_scene *s, const dsmc_run_def *run, long *done, core_er
         size_t bcount[DSMC_SORT_BLOCKS];
         flight_totals ft = flight(s, dt, bcount);
         sorted = false;
-        if (multi ? comm_any(ft.bad) : ft.bad) {
+        int bad = ft.bad;
+        /* one synchronisation between flight and collisions: the migration, with the verdict */
+        if (multi && (st = dsmc_domain_migrate(s, bcount, &bad, &lost, err)))
+            break;
+        if (bad) {
             st = core_fail(err, CORE_ERR_UNSTABLE,
                            "step %ld (t = %.6g s): a particle's position or velocity is not "
                            "finite", s->steps, s->t);
             break;
         }
-        if (multi && (st = dsmc_domain_migrate(s, bcount, err)))
-            break;
         dsmc_sort_counted(s, bcount);
         sorted = true;
         collide_totals ct = collide(s, dt);
@@ -718,12 +729,16 @@ core_status dsmc_run(dsmc_scene *s, const dsmc_run_def *run, long *done, core_er
     /* summed: CPU of all ranks, bytes and messages they sent; the slowest: wall time, time in
      * communication, particles held (the imbalance) */
     double sum[3] = {cpu, cs1.bytes - cs0.bytes, cs1.messages - cs0.messages};
-    double most[3] = {wall, cs1.seconds - cs0.seconds, (double)s->n};
+    double most[4] = {wall, cs1.seconds - cs0.seconds, (double)s->n, (double)lost};
     if (s->distributed) {
         comm_sum_i64(cnt, 6);
         comm_sum_double(sum, 3);
-        comm_max_double(most, 3);
+        comm_max_double(most, 4);
     }
+    if (most[3] > 0 && st == CORE_OK) /* at the last step */
+        st = core_fail(err, CORE_ERR_NOMEM,
+                       "out of memory on a rank storing %.0f particles that migrated to it; "
+                       "the scene is incomplete", most[3]);
     cpu = sum[0];
     wall = most[0];
     s->stats.comm_bytes += sum[1];
