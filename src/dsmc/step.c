@@ -416,7 +416,7 @@ flight_dim(dsmc_scene *s, const flight_consts *fc, size_t bcount[DSMC_SORT_BLOCK
             V[k][i] = v[k];
             chk += x[k] + v[k];
             double f = (x[k] - lo[k]) * ih[k];
-            int ci = f < 0 ? 0 : f >= nc[k] ? nc[k] - 1 : (int)f;
+            int ci = !(f >= 0) ? 0 : f >= nc[k] ? nc[k] - 1 : (int)f; /* NaN: 0 */
             c = c * (size_t)nc[k] + (size_t)ci;
         }
         bad |= !isfinite(chk);
@@ -456,6 +456,7 @@ static flight_totals flight(dsmc_scene *s, double dt, size_t bcount[DSMC_SORT_BL
 /* ---- collisions (Eq. 1) ----------------------------------------------------------------------- */
 typedef struct collide_totals {
     long attempts, collisions, raised, overpacked;
+    long overflow; /* cells whose number of candidates was not a number (speeds overflowed) */
 } collide_totals;
 
 /* Post-collision velocities: the normal component of g = v_i - v_j reversed and scaled by e, the
@@ -520,9 +521,9 @@ static collide_totals collide(dsmc_scene *s, double dt)
     const double vb = s->vpart, rcp = s->def.packing_limit;
     const dsmc_excluded excl = s->def.excluded;
     const uint64_t seed = s->def.seed, step = (uint64_t)s->steps;
-    long attempts = 0, collisions = 0, raised = 0, overpacked = 0;
+    long attempts = 0, collisions = 0, raised = 0, overpacked = 0, overflow = 0;
 #pragma omp parallel for schedule(dynamic, 64) \
-    reduction(+ : attempts, collisions, raised, overpacked) if (s->n >= DSMC_PARALLEL_MIN)
+    reduction(+ : attempts, collisions, raised, overpacked, overflow) if (s->n >= DSMC_PARALLEL_MIN)
     for (long c = c_lo; c < nc; c++) {
         size_t a = start[c], N = start[c + 1] - a;
         if (N < 2)
@@ -584,6 +585,11 @@ static collide_totals collide(dsmc_scene *s, double dt)
                          : (1 - nu / 2) / ((1 - nu) * (1 - nu) * (1 - nu));
         }
         double M = Nd * (Nd - 1) * base * vmax * chi / Veff + rem[c];
+        if (!(M < 1e15)) { /* speeds near the overflow (or not finite): the step fails */
+            overflow++;
+            free(heap);
+            continue;
+        }
         double Mi = floor(M);
         rem[c] = M - Mi;
         long m = (long)Mi;
@@ -636,10 +642,18 @@ static collide_totals collide(dsmc_scene *s, double dt)
         }
         free(heap);
     }
-    return (collide_totals){attempts, collisions, raised, overpacked};
+    return (collide_totals){attempts, collisions, raised, overpacked, overflow};
 }
 
 /* ---- the run ---------------------------------------------------------------------------------- */
+static core_status overflow_error(const dsmc_scene *s, core_error *err)
+{
+    return core_fail(err, CORE_ERR_UNSTABLE,
+                     "step %ld (t = %.6g s): a cell's number of collision candidates overflowed "
+                     "(relative speeds near the largest double): the time step or the speeds "
+                     "are out of range", s->steps - 1, s->t);
+}
+
 core_status dsmc_run(dsmc_scene *s, const dsmc_run_def *run, long *done, core_error *err)
 {
     *done = 0;
@@ -660,15 +674,20 @@ core_status dsmc_run(dsmc_scene *s, const dsmc_run_def *run, long *done, core_er
     long nsteps = 0;
     double tsum = 0;
     bool sorted = true;
-    int64_t lost = 0; /* particles this rank could not store at the last migration */
+    int64_t lost = 0;     /* particles this rank could not store at the last migration */
+    int64_t overflow = 0; /* cells of the last step whose collision count overflowed */
     while (*done < run->steps) {
         if (run->time_end >= 0 && s->t >= run->time_end * (1 - 1e-14))
             break;
         int intr = interrupt_pending();
         if (multi) {
-            int64_t q[3] = {intr, (int64_t)s->n, lost};
-            comm_max_i64(q, 3);
+            int64_t q[4] = {intr, (int64_t)s->n, lost, overflow};
+            comm_max_i64(q, 4);
             intr = q[0] != 0;
+            if (q[3]) {
+                st = overflow_error(s, err);
+                break;
+            }
             if (q[2]) {
                 st = core_fail(err, CORE_ERR_NOMEM,
                                "step %ld: out of memory on a rank storing %lld particles that "
@@ -710,6 +729,11 @@ core_status dsmc_run(dsmc_scene *s, const dsmc_run_def *run, long *done, core_er
         s->t += dt;
         s->steps++;
         ++*done;
+        overflow = ct.overflow; /* several ranks: agreed at the next reduction */
+        if (!multi && overflow) {
+            st = overflow_error(s, err);
+            break;
+        }
         nsteps++;
         tsum += dt;
         cnt[0] += (int64_t)s->n;
@@ -729,13 +753,16 @@ core_status dsmc_run(dsmc_scene *s, const dsmc_run_def *run, long *done, core_er
     /* summed: CPU of all ranks, bytes and messages they sent; the slowest: wall time, time in
      * communication, particles held (the imbalance) */
     double sum[3] = {cpu, cs1.bytes - cs0.bytes, cs1.messages - cs0.messages};
-    double most[4] = {wall, cs1.seconds - cs0.seconds, (double)s->n, (double)lost};
+    double most[5] = {wall, cs1.seconds - cs0.seconds, (double)s->n, (double)lost,
+                      (double)overflow};
     if (s->distributed) {
         comm_sum_i64(cnt, 6);
         comm_sum_double(sum, 3);
-        comm_max_double(most, 4);
+        comm_max_double(most, 5);
     }
-    if (most[3] > 0 && st == CORE_OK) /* at the last step */
+    if (s->distributed && st == CORE_OK && most[4] > 0) /* at the last step */
+        st = overflow_error(s, err);
+    if (most[3] > 0 && st == CORE_OK)
         st = core_fail(err, CORE_ERR_NOMEM,
                        "out of memory on a rank storing %.0f particles that migrated to it; "
                        "the scene is incomplete", most[3]);
