@@ -22,6 +22,20 @@ local g, rho, nu = 9.81, 2650, 0.3
 local v_imp = 2.0 -- m/s, the impact velocity the time step is chosen for
 heap_box.gravity, heap_box.density, heap_box.poisson = g, rho, nu
 
+-- The friction coefficients of a script's `mus` parameter ("0.1,0.8" or one number), sorted;
+-- `default` when it is not given.
+function heap_box.mus(text, default)
+  if not text then return default end
+  local mus = {}
+  for v in tostring(text):gmatch("[^,]+") do
+    local mu = tonumber(v)
+    assert(mu and mu >= 0, "mus must be a comma-separated list of non-negative numbers")
+    mus[#mus + 1] = mu
+  end
+  table.sort(mus)
+  return mus
+end
+
 function heap_box.new(o)
   local b = {
     n = o.n, mu = o.mu, seed = o.seed, young = o.young or 1e6, aspect = o.aspect or 0.5,

@@ -98,16 +98,8 @@ for name, v in pairs { young = young, dt_factor = dt_factor, aspect = aspect, v_
 end
 assert(dt_factor <= 1, "dt_factor must be <= 1 (dt above the stability limit)")
 assert(type(csv) == "string", "csv must be a path")
-local mus = { 0.1, 0.2, 0.3, 0.5, 0.8 }
-if params.mus then -- "0.1,0.8" or a single number
-  mus = {}
-  for v in tostring(params.mus):gmatch("[^,]+") do
-    local mu = tonumber(v)
-    assert(mu and mu >= 0, "mus must be a comma-separated list of non-negative numbers")
-    mus[#mus + 1] = mu
-  end
-  table.sort(mus)
-end
+local heap_box = dofile((arg[0]:match("^(.*)/") or ".") .. "/heap_box.lua")
+local mus = heap_box.mus(params.mus, { 0.1, 0.2, 0.3, 0.5, 0.8 })
 -- images/ only from the default run (docs/dem.md shows it); any other run writes to out/.
 local figures = require("grainlab.figures")
 local published = figures.published({ n = n, seed = seed, seeds = seeds, young = young, dt_factor = dt_factor,
@@ -116,8 +108,6 @@ local published = figures.published({ n = n, seed = seed, seeds = seeds, young =
                                     { n = 2000, seed = 1, seeds = 2, young = 1e6, dt_factor = 1, aspect = 0.5,
                                       v_rest = 5e-3, T_max = 4, mus = "0.1,0.2,0.3,0.5,0.8" })
 local png = params.png or figures.path("repose.png", { published = published })
-
-local heap_box = dofile((arg[0]:match("^(.*)/") or ".") .. "/heap_box.lua")
 
 -- One friction coefficient and packing: prepare, collapse, fit (scripts/heap_box.lua).
 local function run_one(mu, sd)

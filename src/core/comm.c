@@ -555,36 +555,20 @@ void comm_barrier(void)
     if (ops)
         ops->barrier();
 }
-void comm_sum_double(double *v, size_t n)
-{
-    if (ops)
-        ops->reduce[0](v, n);
-}
-void comm_min_double(double *v, size_t n)
-{
-    if (ops)
-        ops->reduce[1](v, n);
-}
-void comm_max_double(double *v, size_t n)
-{
-    if (ops)
-        ops->reduce[2](v, n);
-}
-void comm_sum_i64(int64_t *v, size_t n)
-{
-    if (ops)
-        ops->reduce[3](v, n);
-}
-void comm_min_i64(int64_t *v, size_t n)
-{
-    if (ops)
-        ops->reduce[4](v, n);
-}
-void comm_max_i64(int64_t *v, size_t n)
-{
-    if (ops)
-        ops->reduce[5](v, n);
-}
+/* one rank: every reduction leaves its values as they are */
+#define COMM_REDUCE(name, type, k)                                                                 \
+    void name(type *v, size_t n)                                                                   \
+    {                                                                                              \
+        if (ops)                                                                                   \
+            ops->reduce[k](v, n);                                                                  \
+    }
+COMM_REDUCE(comm_sum_double, double, 0)
+COMM_REDUCE(comm_min_double, double, 1)
+COMM_REDUCE(comm_max_double, double, 2)
+COMM_REDUCE(comm_sum_i64, int64_t, 3)
+COMM_REDUCE(comm_min_i64, int64_t, 4)
+COMM_REDUCE(comm_max_i64, int64_t, 5)
+#undef COMM_REDUCE
 int comm_any(int flag) { return ops ? ops->any(flag) : flag != 0; }
 int comm_all(int flag) { return ops ? ops->all(flag) : flag != 0; }
 void comm_bcast(void *buf, size_t bytes, int root)
