@@ -36,6 +36,45 @@ function heap_box.mus(text, default)
   return mus
 end
 
+-- Runs run(mu, seed) for every mu of o.mus and o.seeds packings (seeds o.seed, o.seed + 1, ...)
+-- under a progress line (o.label), and returns one table per mu: mu, runs (run's tables), and
+-- for every key of o.mean the mean over the packings (and key_sd, the standard deviation, when
+-- seeds > 1), of o.max the largest (NaN, a failed fit, stays visible), of o.sum the sum.
+function heap_box.sweep(o)
+  local seeds = o.seeds
+  local progress = grainlab.progress{ label = o.label, total = #o.mus * seeds, unit = "runs" }
+  local results, done = {}, 0
+  for i, mu in ipairs(o.mus) do
+    local r = { mu = mu, runs = {} }
+    for k = 1, seeds do
+      r.runs[k] = o.run(mu, o.seed + k - 1)
+      done = done + 1
+      progress:update(done)
+    end
+    for _, key in ipairs(o.mean or {}) do
+      local m, var = 0, 0
+      for _, x in ipairs(r.runs) do m = m + x[key] / seeds end
+      for _, x in ipairs(r.runs) do var = var + (x[key] - m) ^ 2 end
+      r[key] = m
+      if seeds > 1 then r[key .. "_sd"] = math.sqrt(var / (seeds - 1)) end
+    end
+    for _, key in ipairs(o.max or {}) do
+      r[key] = -math.huge
+      for _, x in ipairs(r.runs) do
+        r[key] = math.max(r[key], x[key])
+        if x[key] ~= x[key] then r[key] = x[key] break end
+      end
+    end
+    for _, key in ipairs(o.sum or {}) do
+      r[key] = 0
+      for _, x in ipairs(r.runs) do r[key] = r[key] + x[key] end
+    end
+    results[i] = r
+  end
+  progress:finish()
+  return results
+end
+
 function heap_box.new(o)
   local b = {
     n = o.n, mu = o.mu, seed = o.seed, young = o.young or 1e6, aspect = o.aspect or 0.5,

@@ -23,8 +23,16 @@
 -- Checks: theta_m > theta_r for every mu (means over the packings); both in (0, 45) deg; both
 -- rise over the mu range; every tilt found its avalanche; every pile at rest when fitted.
 --
--- Measured (default run, n = 1000, 2 packings per mu, 2026-11-26): see the table the run prints
--- and docs/dem.md; about 6 min on 2 cores.
+-- Measured (default run, n = 1000, 2 packings per mu, 2026-11-26; mean of the 2):
+--     mu     theta_m (sd)     theta_r (sd)
+--     0.05   14.27 (0.43)      9.99 (1.72)
+--     0.10   17.36 (1.00)     12.35 (1.56)
+--     0.20   22.67 (2.88)     14.12 (0.04)
+--     0.30   21.14 (0.34)     17.19 (1.37)
+--     0.50   28.46 (0.21)     17.31 (0.25)
+--     0.80   24.15 (0.70)     21.48 (0.76)
+--   linear at mu <= 0.2: theta_m = 11.6 + 56 mu, theta_r = 9.1 + 26 mu (deg). About 9 min on
+--   2 cores shared with other jobs (nice 19).
 --
 --   grainlab scripts/marginal_stability.lua [n=1000] [seed=1] [seeds=2] [mus=0.05,0.1,0.2,0.3,0.5,0.8]
 --       [hold=0.2] [T_max=4] [csv=out/marginal_stability.csv] [verbose=false]

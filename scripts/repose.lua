@@ -136,31 +136,10 @@ local rmin, rmax, e_rest = geometry.rmin, geometry.rmax, geometry.e_rest
 local nu, rho = heap_box.poisson, heap_box.density
 print(string.format("repose: n = %d, box %.1f mm wide, filled to %.1f mm, E = %g Pa, "
                     .. "%d packing(s) per mu", n, W * 1e3, h0 * 1e3, young, seeds))
-local progress = grainlab.progress{ label = "repose", total = #mus * seeds, unit = "runs" }
-local results, done = {}, 0
-for i, mu in ipairs(mus) do
-  local runs = {}
-  for k = 1, seeds do
-    runs[k] = run_one(mu, seed + k - 1)
-    done = done + 1
-    progress:update(done)
-  end
-  local r = { mu = mu, runs = runs, theta = 0, left = 0, points = 0, rms = 0, vmax = 0, t = 0,
-              wall_s = 0, basin_top = -math.huge }
-  for _, x in ipairs(runs) do
-    r.theta = r.theta + x.theta / seeds
-    r.left, r.points = r.left + x.left / seeds, r.points + x.points / seeds
-    r.rms, r.vmax, r.t = math.max(r.rms, x.rms), math.max(r.vmax, x.vmax), math.max(r.t, x.t)
-    r.basin_top, r.wall_s = math.max(r.basin_top, x.basin_top), r.wall_s + x.wall_s
-    r.dt = x.dt
-    if x.rms ~= x.rms then r.rms = x.rms end -- a failed fit stays visible
-  end
-  local var = 0
-  for _, x in ipairs(runs) do var = var + (x.theta - r.theta) ^ 2 end
-  r.sd = seeds > 1 and math.sqrt(var / (seeds - 1)) or nil
-  results[i] = r
-end
-progress:finish()
+local results = heap_box.sweep{ label = "repose", mus = mus, seed = seed, seeds = seeds,
+                                run = run_one, mean = { "theta", "left", "points" },
+                                max = { "rms", "vmax", "t", "basin_top" }, sum = { "wall_s" } }
+for _, r in ipairs(results) do r.dt, r.sd = r.runs[#r.runs].dt, r.theta_sd end
 
 local metrics, checks = { dt_s = results[1].dt }, {}
 local rows = { "mu,atan_mu_deg,theta_r_deg,particles_left,fit_points" }
