@@ -116,7 +116,7 @@ local skip = {}
 -- The methods dem.scene has from lua_dem.c are fuzzed by test_fuzz_dem.lua.
 for _, k in ipairs{ "contact", "add_disk", "add_sphere", "add_wall", "remove_wall", "wall_velocity",
                     "wall_point", "wall_force", "wall_servo", "set_velocity", "timestep", "run", "measure",
-                    "particles", "set_reference", "scale_mass", "scale_stiffness", "drag", "set_forces",
+                    "particles", "set_reference", "scale_mass", "scale_stiffness", "drag", "gravity", "set_forces",
                     "clear_forces", "quasistatic", "info", "damping_time", "save", "write_vtk",
                     "add_polyline", "add_mesh", "add_cylinder", "wall_load" } do
   skip["dem.scene:" .. k] = "fuzzed by test_fuzz_dem.lua"
