@@ -162,7 +162,8 @@ int dem_max_particle_arrays(const dem_scene *s);
  * step and after every step when s->flow is set): removal, then insertion, keeping every
  * per-particle array, the pair list with its history and the integrators' state consistent. */
 typedef struct dem_flow dem_flow;
-core_status dem_flow_step(dem_scene *s, core_error *err);
+/* step: the steps completed (the step is counted after the checks that follow this call). */
+core_status dem_flow_step(dem_scene *s, long step, core_error *err);
 /* What a run must refuse (more than one rank; removal with boundary conditions). */
 core_status dem_flow_check_run(const dem_scene *s, core_error *err);
 /* The scene may start a run without particles: an inserter will bring them. */

@@ -136,9 +136,9 @@ static double smallest_radius(const dem_inserter_def *d)
 {
     if (d->size != DEM_SIZE_DISCRETE)
         return d->r0;
-    double r = INFINITY;
+    double r = INFINITY; /* weights NULL: an inserter's own list, of positive weights only */
     for (size_t k = 0; k < d->nsizes; k++)
-        if (d->weights[k] > 0)
+        if (!d->weights || d->weights[k] > 0)
             r = fmin(r, d->radii[k]);
     return r;
 }
@@ -151,7 +151,7 @@ static double largest_radius(const dem_inserter_def *d)
         return d->r1;
     double r = 0;
     for (size_t k = 0; k < d->nsizes; k++)
-        if (d->weights[k] > 0)
+        if (!d->weights || d->weights[k] > 0)
             r = fmax(r, d->radii[k]);
     return r;
 }
@@ -278,15 +278,20 @@ int dem_add_inserter(dem_scene *s, const dem_inserter_def *d, core_error *err)
             free(in.radii), free(in.cum);
             return core_fail(err, CORE_ERR_NOMEM, "cannot allocate the size distribution"), -1;
         }
+        /* The radii of positive weight only, with their cumulative weights. */
         double wsum = 0, acc = 0;
+        size_t m = 0;
         for (size_t k = 0; k < d->nsizes; k++)
             wsum += d->weights[k];
         for (size_t k = 0; k < d->nsizes; k++) {
-            in.radii[k] = d->radii[k];
+            if (!(d->weights[k] > 0))
+                continue;
+            in.radii[m] = d->radii[k];
             acc += d->weights[k];
-            in.cum[k] = acc / wsum;
+            in.cum[m++] = acc / wsum;
         }
-        in.cum[d->nsizes - 1] = 1;
+        in.cum[m - 1] = 1;
+        in.def.nsizes = m;
     }
     in.def.radii = in.radii;
     in.def.weights = NULL; /* the cumulative weights stand for them */
@@ -358,7 +363,7 @@ static core_status compact(dem_scene *s, const unsigned char *gone, core_error *
             const double sign = gone[i] ? 1 : -1;
             for (int d = 0; d < D; d++)
                 s->f[d][k] += sign * p->f[d][q];
-            for (int d = d0; s->rot && p->c[d] && d < 3; d++)
+            for (int d = d0; d < 3 && s->rot && p->c[d]; d++)
                 s->tq[d][k] += s->r[k] * p->c[d][q];
         }
     }
@@ -600,15 +605,15 @@ static void init_new(dem_scene *s, size_t i)
                 s->gear_w[k][d][i] = 0;
 }
 
-static core_status insert(dem_scene *s, int q, int *changed, core_error *err)
+static core_status insert(dem_scene *s, int q, long step, int *changed, core_error *err)
 {
     dem_flow *f = s->flow;
     inserter *in = &f->ins[q];
     const dem_inserter_def *d = &in->def;
     const int D = s->dim;
-    if (in->done || s->steps < in->next_step)
+    if (in->done || step < in->next_step)
         return CORE_OK;
-    in->next_step = s->steps + d->every;
+    in->next_step = step + d->every;
     /* Due so far: by the rate (the product rounded down, 1e-12 relative for the summed time),
      * or everything at once; capped by the count. */
     long due;
@@ -684,13 +689,13 @@ static core_status insert(dem_scene *s, int q, int *changed, core_error *err)
     return st;
 }
 
-core_status dem_flow_step(dem_scene *s, core_error *err)
+core_status dem_flow_step(dem_scene *s, long step, core_error *err)
 {
     dem_flow *f = s->flow;
     int changed = 0;
     core_status st = removal(s, &changed, err);
     for (int q = 0; q < f->nins && !st; q++)
-        st = insert(s, q, &changed, err);
+        st = insert(s, q, step, &changed, err);
     if (changed)
         s->watch_on = 0; /* energy came or went: the watch takes a new reference */
     return st;

@@ -644,7 +644,7 @@ static core_status run_steps(dem_scene *s, const dem_run_def *run, core_error *e
         return st;
     /* Particles in and out (flow.c) at the step boundaries: before the first step, and after
      * each one before the checks (a particle out through an open side is gone by then). */
-    if (s->flow && run->steps > 0 && (st = dem_flow_step(s, err)))
+    if (s->flow && run->steps > 0 && (st = dem_flow_step(s, s->steps, err)))
         return st;
     if (run->steps > 0 && (st = dem_domain_start(s, err)))
         return st;
@@ -709,7 +709,7 @@ static core_status run_steps(dem_scene *s, const dem_run_def *run, core_error *e
             s->suspect = 0;
         }
         if (!st && s->flow)
-            st = dem_flow_step(s, err);
+            st = dem_flow_step(s, s->steps + 1, err);
         if (st) {
             dem_invalidate(s, 1);
             return st;
