@@ -254,7 +254,7 @@ int dem_add_inserter(dem_scene *s, const dem_inserter_def *d, core_error *err)
     if (rbig > 0.5 * extent || smallest_radius(d) < 1e-9 * reach)
         return core_fail(err, CORE_ERR_ARG,
                          "radii must lie in [%g, %g] (1e-9 of the largest box coordinate, half "
-                         "the box's smallest extent)",
+                         "the box's smallest extent; field 'radius' or 'radii')",
                          1e-9 * reach, 0.5 * extent),
                -1;
     if (flow_on(s, err))

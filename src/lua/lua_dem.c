@@ -1062,7 +1062,7 @@ static double *number_list(lua_State *L, int arg, const char *call, const char *
     if (!lua_istable(L, -1) || luaL_len(L, -1) < 1 ||
         (n_want > 0 && (size_t)luaL_len(L, -1) != n_want))
         bind_field_error(L, arg, call, field,
-                         n_want > 0 ? "array of one weight per radius" : expected);
+                         n_want > 0 ? "array of one weight per entry of 'radii'" : expected);
     *n = (size_t)luaL_len(L, -1);
     double *v = lua_newuserdatauv(L, *n * sizeof *v, 0);
     for (size_t k = 0; k < *n; k++) {
@@ -1099,8 +1099,11 @@ static int l_inserter(lua_State *L)
     } else {
         d.ball = 1;
         if (!bind_field_vector(L, 2, call, "center", D, d.center, 0)) {
-            lua_getfield(L, 2, "box");
-            bind_field_error(L, 2, call, "box", "a box, or a center and an extent");
+            /* neither region: a disk/ball when an extent says so, else a box */
+            int ball = lua_getfield(L, 2, "extent") != LUA_TNIL;
+            lua_getfield(L, 2, ball ? "center" : "box");
+            bind_field_error(L, 2, call, ball ? "center" : "box",
+                             ball ? "a center with the extent" : "a box, or a center and an extent");
         }
         d.extent = bind_field_number(L, 2, call, "extent", 0, BIND_REQUIRED | BIND_POSITIVE);
     }
@@ -1108,14 +1111,21 @@ static int l_inserter(lua_State *L)
     d.count = (long)bind_field_integer(L, 2, call, "count", -1, 0, LONG_MAX, 0);
     d.mass = bind_field_number(L, 2, call, "mass", 0, BIND_POSITIVE);
     if (d.rate == 0 && d.count < 0 && d.mass == 0) {
-        lua_getfield(L, 2, "rate");
-        bind_field_error(L, 2, call, "rate", "a rate, a count or a mass (none given)");
+        lua_getfield(L, 2, "count");
+        bind_field_error(L, 2, call, "count", "a count, a rate or a mass (none given)");
     }
+    double *radii = NULL, *weights = NULL;
     int has_radii = lua_getfield(L, 2, "radii") != LUA_TNIL;
+    lua_pop(L, 1);
+    if (has_radii) { /* the list checked first, so that a bad one is named as such */
+        d.size = DEM_SIZE_DISCRETE;
+        radii = number_list(L, 2, call, "radii", 0, 1, &d.nsizes);
+    }
+    lua_getfield(L, 2, "radii");
     int has_radius = lua_getfield(L, 2, "radius") != LUA_TNIL;
     if (has_radii == has_radius)
         bind_field_error(L, 2, call, "radius",
-                         has_radii ? "nil with radii" : "a radius, {min, max} or radii");
+                         has_radii ? "nil with radii" : "a radius, {min, max}, or a field 'radii',");
     if (has_radius && lua_istable(L, -1)) {
         double r[2];
         bind_field_vector(L, 2, call, "radius", 2, r, BIND_REQUIRED);
@@ -1128,10 +1138,7 @@ static int l_inserter(lua_State *L)
         d.r0 = bind_field_number(L, 2, call, "radius", 0, BIND_REQUIRED | BIND_POSITIVE);
     }
     lua_pop(L, 2);
-    double *radii = NULL, *weights = NULL;
     if (has_radii) {
-        d.size = DEM_SIZE_DISCRETE;
-        radii = number_list(L, 2, call, "radii", 0, 1, &d.nsizes);
         if (lua_getfield(L, 2, "weights") != LUA_TNIL) {
             size_t nw;
             lua_pop(L, 1);
@@ -1179,21 +1186,21 @@ static int l_outflow(lua_State *L)
     int has_box = lua_getfield(L, 2, "box") != LUA_TNIL;
     int has_side = lua_getfield(L, 2, "side") != LUA_TNIL;
     lua_pop(L, 2);
-    if (has_box == has_side) {
-        lua_getfield(L, 2, "box");
-        bind_field_error(L, 2, call, "box", has_box ? "nil with a side (one region)"
-                                                   : "a box, or a side");
-    }
-    if (has_box) {
-        d.side = -1;
-        bind_field_box(L, 2, call, "box", D, d.lo, d.hi);
-    } else {
+    d.side = -1;
+    if (has_side) { /* each value checked first, so that a bad one is named as such */
         d.side = bind_field_option(L, 2, call, "side", SIDE_NAMES, 0, BIND_REQUIRED);
         if (d.side >= 2 * D) {
             lua_getfield(L, 2, "side");
             bind_field_error(L, 2, call, "side",
                              D == 2 ? "'x-', 'x+', 'y-' or 'y+' in 2D" : "a side name");
         }
+    }
+    if (has_box)
+        bind_field_box(L, 2, call, "box", D, d.lo, d.hi);
+    if (has_box == has_side) {
+        lua_getfield(L, 2, "side");
+        bind_field_error(L, 2, call, "side",
+                         has_box ? "nil with a box (one region)" : "a side, or a field 'box',");
     }
     core_error err;
     int id = dem_add_outflow(s, &d, &err);

@@ -370,16 +370,16 @@ do
   check.errors(function() s:inserter{ box = { { 0, 0 }, { 0.2, 0.1 } }, count = 1, radius = 0.001 } end,
     "inserter: the region [0, 0.2] on axis 1 is not inside the domain", "region outside the domain")
   check.errors(function() s:inserter{ box = { { 0, 0 }, { 0.1, 0.1 } }, radius = 0.001 } end,
-    "bad field 'rate' in argument #1 to 'inserter' (a rate, a count or a mass (none given)", "no rate, count or mass")
+    "bad field 'count' in argument #1 to 'inserter' (a count, a rate or a mass (none given)", "no rate, count or mass")
   check.errors(function() s:inserter{ box = { { 0, 0 }, { 0.1, 0.1 } }, count = 1 } end,
     "bad field 'radius' in argument #1 to 'inserter'", "no radius")
   check.errors(function() s:inserter{ box = { { 0, 0 }, { 0.1, 0.1 } }, count = 1, radius = { 0.002, 0.001 } } end,
     "bad field 'radius' in argument #1 to 'inserter' ({min, max} with 0 < min <= max", "min > max")
   check.errors(function() s:inserter{ box = { { 0, 0 }, { 0.1, 0.1 } }, count = 1, radii = { 0.001 }, weights = { 1, 2 } } end,
-    "bad field 'weights' in argument #1 to 'inserter' (array of one weight per radius", "weights per radius")
+    "bad field 'weights' in argument #1 to 'inserter' (array of one weight per entry of 'radii'", "weights per radius")
   check.errors(function() s:outflow{ side = "z+" } end,
     "bad field 'side' in argument #1 to 'outflow' ('x-', 'x+', 'y-' or 'y+' in 2D", "side z+ in 2D")
-  check.errors(function() s:outflow{} end, "bad field 'box' in argument #1 to 'outflow' (a box, or a side", "no region")
+  check.errors(function() s:outflow{} end, "bad field 'side' in argument #1 to 'outflow' (a side, or a field 'box',", "no region")
   -- an empty scene with an inserter runs; without one it is refused
   check.errors(function() s:run{ steps = 1 } end, "no particles", "empty scene without an inserter")
 end
