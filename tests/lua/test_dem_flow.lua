@@ -250,6 +250,55 @@ for _, integ in ipairs{ "velocity_verlet", "gear", "position_verlet" } do
   check.eq(ca.count, cb.count, integ .. ": the same contacts")
 end
 
+-- the same in 3D (every 3D array: positions, three angular velocities and torques, wall history)
+local function pile3(with_p)
+  local s = dem.scene{ dim = 3, box = { { 0, 0, 0 }, { 0.03, 0.03, 0.05 } }, gravity = { 0, 0, -9.81 } }
+  s:contact{ damping = "viscous", tangential = "spring" }
+  s:add_wall{ point = { 0, 0, 0 }, normal = { 0, 0, 1 } }
+  if with_p then s:add_sphere{ pos = { 0.027, 0.027, 0.045 }, radius = 0.002, vel = { 0, 0, -3 }, material = mat } end
+  for k = 0, 17 do
+    local a, b, c = k % 3, (k // 3) % 3, k // 9
+    s:add_sphere{ pos = { 0.005 + a * 0.0052 + c * 0.0026, 0.005 + b * 0.0052 + c * 0.0026, 0.003 + c * 0.0042 },
+                  radius = 0.0025 + 0.0002 * ((k * 5) % 3 - 1), material = mat }
+  end
+  s:outflow{ box = { { 0.02, 0.02, 0.02 }, { 0.03, 0.03, 0.03 } } }
+  s:run{ steps = 3000, dt = 5e-6 }
+  return s
+end
+do
+  local a, b = pile3(true), pile3(false)
+  check.eq(a:flow().removed, 1, "3D: P removed")
+  local function dump3(s)
+    local p, out = s:particles(), {}
+    for i = 1, p.count do
+      out[#out + 1] = string.format("%a %a %a %a %a %a %a %a %a", p.x[i], p.y[i], p.z[i], p.vx[i], p.vy[i],
+        p.vz[i], p.wx[i], p.wy[i], p.fz[i])
+    end
+    return table.concat(out, "\n")
+  end
+  check.is_true(#b:measure("contacts").i > 10, "3D: the pile touches")
+  check.is_true(dump3(a) == dump3(b), "3D: the others carry the bits of a scene without P")
+end
+
+-- the stable step counts the smallest particle an inserter can bring: an empty scene runs
+do
+  local function ts(with_inserter)
+    local s = dem.scene{ dim = 2, box = { { 0, 0 }, { 0.1, 0.1 } }, gravity = { 0, -9.81 } }
+    if with_inserter then
+      s:add_disk{ pos = { 0.05, 0.05 }, radius = 0.004, material = mat }
+      s:inserter{ box = { { 0, 0.08 }, { 0.1, 0.1 } }, count = 5, radius = { 0.001, 0.003 }, material = mat }
+    else
+      s:add_disk{ pos = { 0.05, 0.05 }, radius = 0.001, material = mat }
+    end
+    return s:timestep{ impact_velocity = 1 }.dt_auto
+  end
+  check.eq(ts(true), ts(false), "timestep: the inserter's smallest particle sets dt")
+  local e = dem.scene{ dim = 2, box = { { 0, 0 }, { 0.1, 0.1 } }, gravity = { 0, -9.81 } }
+  e:inserter{ box = { { 0, 0.05 }, { 0.1, 0.1 } }, count = 20, radius = 0.002, material = mat }
+  e:run{ steps = 10 }
+  check.eq(e:flow().count, 20, "an empty scene with an inserter runs")
+end
+
 -- A particle removed while it presses on another: the next step's first kick must not see its push
 -- any more. Without damping the forces depend on positions only, so the survivor's step equals
 -- that of a fresh scene without the removed particle (to rounding: the adjusted sum and the fresh
