@@ -21,7 +21,7 @@ typedef struct dem_scene dem_scene;
 typedef struct dem_scene_def {
     int dim;              /* 2 (disks) or 3 (spheres) */
     double lo[3], hi[3];  /* the domain: a particle leaving it on an axis that is not periodic
-                           * stops the run with an error */
+                           * stops the run with an error (unless an outflow opens that side) */
     bool periodic[3];
     double gravity[3];    /* m/s^2 */
     /* 2D only: > 0 makes disks cylinders of this thickness (m = rho pi r^2 t, I = m r^2 / 2);
@@ -495,22 +495,22 @@ typedef enum dem_size_law {
 } dem_size_law;
 
 typedef struct dem_inserter_def {
-    int ball;                 /* 0: the box [lo, hi]; 1: the disk (2D) or ball (3D) center, extent */
+    int ball; /* 0: the box [lo, hi]; 1: the disk (2D) or ball (3D) center, extent */
     double lo[3], hi[3];
     double center[3], extent;
-    double rate;              /* particles per second (0: everything due at the first event) */
-    long count;               /* total to insert (< 0: no limit; needs a rate or a mass) */
-    double mass;              /* total mass to insert, kg (<= 0: no limit): stops once reached */
+    double rate; /* particles per second (0: everything due at the first event) */
+    long count;  /* total to insert (< 0: no limit; needs a rate or a mass) */
+    double mass; /* total mass to insert, kg (<= 0: no limit): stops once reached */
     dem_size_law size;
     double r0, r1;
-    size_t nsizes;            /* DISCRETE: radii and weights (copied) */
+    size_t nsizes; /* DISCRETE: radii and weights (copied) */
     const double *radii, *weights;
-    double velocity[3];       /* each particle: velocity + spread * uniform(-1, 1) per component */
+    double velocity[3]; /* each particle: velocity + spread * uniform(-1, 1) per component */
     double spread;
     int material;
     unsigned long long seed;
-    long every;               /* steps between insertion events (>= 1) */
-    int attempts;             /* positions tried per particle (>= 1) */
+    long every;   /* steps between insertion events (>= 1) */
+    int attempts; /* positions tried per particle (>= 1) */
 } dem_inserter_def;
 
 /* box of zero size, rate 0, count -1, no mass limit, constant radius 0, every 1, 50 attempts */
@@ -520,16 +520,16 @@ dem_inserter_def dem_default_inserter_def(void);
 int dem_add_inserter(dem_scene *s, const dem_inserter_def *def, core_error *err);
 
 typedef struct dem_outflow_def {
-    int side;                 /* -1: the box [lo, hi]; else 2 axis + (0 lower, 1 upper side) */
+    int side; /* -1: the box [lo, hi]; else 2 axis + (0 lower, 1 upper side) */
     double lo[3], hi[3];
 } dem_outflow_def;
 int dem_add_outflow(dem_scene *s, const dem_outflow_def *def, core_error *err);
 
 typedef struct dem_flow_counts {
-    long count;               /* inserted (inserters) or removed (outflows) so far */
-    double mass;              /* their mass, kg */
-    long skipped;             /* inserters: particles due that found no free place */
-    long events;              /* inserters: insertion events that had particles due */
+    long count;   /* inserted (inserters) or removed (outflows) so far */
+    double mass;  /* their mass, kg */
+    long skipped; /* inserters: particles due that found no free place */
+    long events;  /* inserters: insertion events that had particles due */
 } dem_flow_counts;
 int dem_inserter_count(const dem_scene *s);
 int dem_outflow_count(const dem_scene *s);

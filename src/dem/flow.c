@@ -644,6 +644,7 @@ static core_status insert(dem_scene *s, int q, long step, int *changed, core_err
     }
     const int rate_or_count = d->rate > 0 || d->count >= 0;
     const int fr = s->forces_ready, gr = s->gear_ready, pr = s->prev_ready;
+    int added = 0;
     core_status st = CORE_OK;
     for (long k = 0; k < want && !in->done; k++) {
         if (d->mass > 0 && in->c.mass >= d->mass) {
@@ -674,7 +675,7 @@ static core_status insert(dem_scene *s, int q, long step, int *changed, core_err
         init_new(s, (size_t)i);
         in->c.count++;
         in->c.mass += s->m[i];
-        *changed = 1;
+        *changed = added = 1;
         if ((st = push_near(f, &nnear, (uint32_t)i, err)))
             break;
     }
@@ -684,8 +685,10 @@ static core_status insert(dem_scene *s, int q, long step, int *changed, core_err
         in->done = 1;
     /* dem_add_particle invalidated everything; what is stale is the list only (init_new gave the
      * new particles the state the integrators keep). */
-    s->forces_ready = fr, s->gear_ready = gr, s->prev_ready = pr;
-    s->need_rebuild = 1;
+    if (added) {
+        s->forces_ready = fr, s->gear_ready = gr, s->prev_ready = pr;
+        s->need_rebuild = 1;
+    }
     return st;
 }
 

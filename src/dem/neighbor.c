@@ -67,8 +67,7 @@ void dem_pair_parameters(dem_scene *s, size_t i, size_t j, double *k, double *ga
                    mu);
 }
 
-void dem_probe_parameters(const dem_scene *s, int mat, double r, double m, double *k,
-                          double *gamma)
+void dem_probe_parameters(const dem_scene *s, int mat, double r, double m, double *k, double *gamma)
 {
     const dem_material *a = &s->mats[mat];
     double mu;

@@ -1048,7 +1048,7 @@ static int l_info(lua_State *L)
 
 /* ---- particles in and out during a run (flow.c) --------------------------------------------- */
 static const char *const INSERTER_FIELDS[] = {
-    "box",    "center",   "extent", "rate",     "count", "mass",  "radius",   "radii",
+    "box",     "center",   "extent", "rate",     "count", "mass",  "radius",   "radii",
     "weights", "velocity", "spread", "material", "seed",  "every", "attempts", NULL};
 
 /* An array field of positive (radii) or non-negative (weights) finite numbers, n > 0 entries
@@ -1103,7 +1103,8 @@ static int l_inserter(lua_State *L)
             int ball = lua_getfield(L, 2, "extent") != LUA_TNIL;
             lua_getfield(L, 2, ball ? "center" : "box");
             bind_field_error(L, 2, call, ball ? "center" : "box",
-                             ball ? "a center with the extent" : "a box, or a center and an extent");
+                             ball ? "a center with the extent"
+                                  : "a box, or a center and an extent");
         }
         d.extent = bind_field_number(L, 2, call, "extent", 0, BIND_REQUIRED | BIND_POSITIVE);
     }
@@ -1125,7 +1126,8 @@ static int l_inserter(lua_State *L)
     int has_radius = lua_getfield(L, 2, "radius") != LUA_TNIL;
     if (has_radii == has_radius)
         bind_field_error(L, 2, call, "radius",
-                         has_radii ? "nil with radii" : "a radius, {min, max}, or a field 'radii',");
+                         has_radii ? "nil with radii"
+                                   : "a radius, {min, max}, or a field 'radii',");
     if (has_radius && lua_istable(L, -1)) {
         double r[2];
         bind_field_vector(L, 2, call, "radius", 2, r, BIND_REQUIRED);
@@ -1398,7 +1400,8 @@ void bind_open_dem(lua_State *L)
          "component. Every `every` steps the particles due get `attempts` random positions each "
          "(the inserter's own stream from seed): one that finds no place is skipped and counted. "
          "Returns the inserter id; s:flow() gives the counts."},
-        {"outflow", l_outflow, "s:outflow{ box = {lo, hi} } or s:outflow{ side = 'x-'|'x+'|'y-'|...}",
+        {"outflow", l_outflow,
+         "s:outflow{ box = {lo, hi} } or s:outflow{ side = 'x-'|'x+'|'y-'|...}",
          "Removes the particles whose centre enters the box (fixed ones excepted) after each "
          "step, or that leave the domain through that side (not periodic; without an outflow a "
          "particle leaving the domain stops the run). Ids after a removed particle shift down: "
