@@ -266,40 +266,49 @@ static int fits_int(const size_t *c, const size_t *off, int n)
     return total <= int_limit;
 }
 
-int comm_alltoallv(const void *send, const size_t *send_bytes, const size_t *send_off, void **recv,
-                   size_t *recv_bytes, size_t *recv_off)
+int comm_alltoallv_max(const void *send, const size_t *send_bytes, const size_t *send_off,
+                       void **recv, size_t *recv_bytes, size_t *recv_off, int64_t *words, int nw)
 {
     const int P = comm_n;
     if (P == 1)
         return alltoallv_self(send, send_bytes, send_off, recv, recv_bytes, recv_off);
     double t0 = t_enter();
-    /* Sizes first. */
-    uint64_t *sb = malloc(2 * (size_t)P * sizeof *sb);
+    /* Sizes first, each with the caller's words, which every rank reduces itself. */
+    const size_t w = 1 + (size_t)nw;
+    int64_t *sb = malloc(2 * (size_t)P * w * sizeof *sb);
     if (!sb)
         comm_abort(70);
-    uint64_t *rb = sb + P;
-    for (int r = 0; r < P; r++)
-        sb[r] = send_bytes[r];
-    MPI_Alltoall(sb, 1, MPI_UINT64_T, rb, 1, MPI_UINT64_T, MPI_COMM_WORLD);
+    int64_t *rb = sb + (size_t)P * w;
+    for (int r = 0; r < P; r++) {
+        sb[(size_t)r * w] = (int64_t)send_bytes[r];
+        for (int k = 0; k < nw; k++)
+            sb[(size_t)r * w + 1 + (size_t)k] = words[k];
+    }
+    MPI_Alltoall(sb, (int)w, MPI_INT64_T, rb, (int)w, MPI_INT64_T, MPI_COMM_WORLD);
     size_t total = 0;
     for (int r = 0; r < P; r++) {
-        recv_bytes[r] = (size_t)rb[r];
+        recv_bytes[r] = (size_t)rb[(size_t)r * w];
         recv_off[r] = total;
         total += recv_bytes[r];
+        for (int k = 0; k < nw; k++)
+            if (rb[(size_t)r * w + 1 + (size_t)k] > words[k])
+                words[k] = rb[(size_t)r * w + 1 + (size_t)k];
     }
     *recv = malloc(total ? total : 1);
-    int ok = *recv != NULL;
-    if (!comm_all(ok)) {
+    /* one agreement for both: the buffer was allocated, and every block fits MPI's int counts */
+    int agree[2] = {*recv != NULL,
+                    fits_int(send_bytes, send_off, P) && fits_int(recv_bytes, NULL, P)};
+    allreduce(agree, 2, MPI_INT, sizeof *agree, MPI_LAND);
+    if (!agree[0]) {
         free(*recv), *recv = NULL, free(sb);
+        t_leave(t0, 0, 0);
         return -1;
     }
     double sent = 0, msgs = 0;
     for (int r = 0; r < P; r++)
         if (r != comm_r && send_bytes[r])
             sent += (double)send_bytes[r], msgs++;
-    int small = fits_int(send_bytes, send_off, P) && fits_int(recv_bytes, NULL, P);
-    int all_small = comm_all(small);
-    if (all_small) {
+    if (agree[1]) {
         int *ci = malloc(4 * (size_t)P * sizeof *ci);
         if (!ci)
             comm_abort(70);
@@ -337,6 +346,12 @@ int comm_alltoallv(const void *send, const size_t *send_bytes, const size_t *sen
     free(sb);
     t_leave(t0, sent, msgs);
     return 0;
+}
+
+int comm_alltoallv(const void *send, const size_t *send_bytes, const size_t *send_off, void **recv,
+                   size_t *recv_bytes, size_t *recv_off)
+{
+    return comm_alltoallv_max(send, send_bytes, send_off, recv, recv_bytes, recv_off, NULL, 0);
 }
 
 
@@ -407,6 +422,13 @@ void comm_bcast(void *buf, size_t bytes, int root) { (void)buf, (void)bytes, (vo
 int comm_alltoallv(const void *send, const size_t *send_bytes, const size_t *send_off, void **recv,
                    size_t *recv_bytes, size_t *recv_off)
 {
+    return alltoallv_self(send, send_bytes, send_off, recv, recv_bytes, recv_off);
+}
+
+int comm_alltoallv_max(const void *send, const size_t *send_bytes, const size_t *send_off,
+                       void **recv, size_t *recv_bytes, size_t *recv_off, int64_t *words, int nw)
+{
+    (void)words, (void)nw; /* the maximum over one rank */
     return alltoallv_self(send, send_bytes, send_off, recv, recv_bytes, recv_off);
 }
 

@@ -62,6 +62,11 @@ int comm_allgatherv(const void *buf, size_t bytes, void **out, size_t *out_bytes
  * memory (all ranks agree). */
 int comm_alltoallv(const void *send, const size_t *send_bytes, const size_t *send_off, void **recv,
                    size_t *recv_bytes, size_t *recv_off);
+/* The same, with a maximum over the ranks of nw words riding on the exchange of the sizes
+ * (words: this rank's in, the maximum out), so that a per-step flag (a failed step, an
+ * allocation) costs no collective of its own. Three collectives in all, one of them the data. */
+int comm_alltoallv_max(const void *send, const size_t *send_bytes, const size_t *send_off,
+                       void **recv, size_t *recv_bytes, size_t *recv_off, int64_t *words, int nw);
 
 /* Point-to-point exchange with a known set of peers (a halo whose sizes both sides know):
  * sends send_bytes[k] bytes from send[k] to peers[k] and receives recv_bytes[k] bytes from

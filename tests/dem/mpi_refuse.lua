@@ -46,6 +46,23 @@ local ok2, err2 = pcall(t.run, t, { steps = 200, dt = 2e-7, force = true })
 assert(not ok2, "the run through the wall went ahead")
 local mine = tostring(err2) .. "\n" .. t:info().steps .. "\n"
 assert(grainlab.mpi.bcast(mine) == mine, "rank " .. grainlab.mpi.rank() .. " stopped otherwise than rank 0")
+
+-- A particle leaving through a side with no wall (not periodic): its owner's kicks flag it, the
+-- full checks find it, and every rank stops at the one-rank step with the one-rank message (the
+-- checks run only on the rank whose kicks flagged something, as on one rank).
+local u = dem.scene{ dim = 2, box = { { 0, 0 }, { 0.02, 0.01 } } }
+u:add_wall{ point = { 0, 0 }, normal = { 0, 1 } }
+u:add_wall{ point = { 0, 0 }, normal = { 1, 0 } }
+for k = 0, 19 do
+  u:add_disk{ pos = { 0.0007 + k * 0.00095, 0.001 }, radius = 0.0004, material = m,
+              vel = { k == 18 and 60 or 0, 0 } }
+end
+local ok3, err3 = pcall(u.run, u, { steps = 400, dt = 2e-7, force = true })
+assert(not ok3, "the run that lost a particle went ahead")
+assert(tostring(err3):find("left the domain", 1, true), err3)
+local mine3 = tostring(err3) .. "\n" .. u:info().steps .. "\n"
+assert(grainlab.mpi.bcast(mine3) == mine3, "rank " .. grainlab.mpi.rank() .. " stopped otherwise than rank 0")
+
 local f = assert(io.open((params.out or "refuse") .. ".0", "w")) -- rank 0 writes it
-f:write(mine)
+f:write(mine .. mine3)
 f:close()
