@@ -36,12 +36,13 @@ dsmc_run_def dsmc_default_run_def(void)
  * started from, and so on the decomposition over ranks: the collisions index each cell's
  * particles in identity order through a small permutation (cell_perm) instead, and the arrays
  * are put in that order only between runs (dsmc_order_cells), for everything that reads them.
- * The price of that independence on the cooling benchmark (20 per cell; callgrind, 10^5
- * particles, 20 steps, against the code before identities): +18% of the instructions (642 M
- * against 542 M: the ranks 66 M, the indirection in the collisions 17 M, the identities carried
- * by the sort 6 M) and 0.82x the particle moves per CPU second (4 alternating runs each); ranks
- * by an insertion sort cost +28% and 0.70-0.80x (3 times the mispredicted branches), ordering
- * the arrays themselves every step +33%. On Herrmann's Fig. 2 gas (0.7 per cell) +14%. */
+ * The price of that independence, one process, one thread, against the code before identities
+ * (callgrind instructions; speed from 3 alternating runs each on a quiet machine): the cooling
+ * benchmark (20 per cell) +18% (642 M against 542 M for 10^5 particles x 20 steps: the ranks
+ * 68 M, the indirection in the collisions 18 M, the identities carried by the sort 6 M) and
+ * 0.87x the speed; Herrmann's Fig. 2 gas (0.7 per cell) +8% and 0.87x (the identities add a
+ * tenth to the bytes the sort moves). Ranks by an insertion sort cost +28% and 0.70-0.80x on
+ * the former (3 times the mispredicted branches), ordering the arrays every step +33%. */
 
 static inline __attribute__((always_inline)) void swap_particles(dsmc_scene *s, size_t i,
                                                                   size_t j)
@@ -150,7 +151,7 @@ static inline __attribute__((always_inline)) void rank_small(const v4i32 *sid, s
  * Sorting the keys instead (an insertion sort: N^2/4 moves and a mispredicted branch per
  * particle) cost 118 instructions per particle on the cooling benchmark (20 per cell), more
  * than the collisions themselves. */
-static void cell_perm(const uint32_t *id, size_t N, uint64_t *key, uint32_t *P)
+static void cell_perm_big(const uint32_t *id, size_t N, uint64_t *key, uint32_t *P)
 {
     if (N <= 32) {
         v4i32 sid[8];
@@ -176,6 +177,21 @@ static void cell_perm(const uint32_t *id, size_t N, uint64_t *key, uint32_t *P)
     qsort(key, N, sizeof *key, cmp_u64);
     for (size_t k = 0; k < N; k++)
         P[k] = (uint32_t)key[k];
+}
+
+static inline void cell_perm(const uint32_t *id, size_t N, uint64_t *key, uint32_t *P)
+{
+    if (N > 4) {
+        cell_perm_big(id, N, key, P);
+        return;
+    }
+    /* most cells of a dilute gas (Fig. 2's: 0.7 per cell): in place, without a call */
+    for (size_t k = 0; k < N; k++) {
+        uint32_t r = 0, x = id[k];
+        for (size_t j = 0; j < N; j++)
+            r += id[j] < x;
+        P[r] = (uint32_t)k;
+    }
 }
 
 /* Puts the particles [a, a + N) of one cell in identity order, through a buffer (an insertion
