@@ -192,7 +192,9 @@ static core_status write_scene(const dem_scene *s, ckpt_writer *w, core_error *e
         put_opt(w, p->hist[d], p->n);
     if ((st = end(w, err)))
         return st;
-    return s->bnd ? dem_boundary_save(s, w, err) : CORE_OK;
+    if (s->bnd && (st = dem_boundary_save(s, w, err)))
+        return st;
+    return s->flow ? dem_flow_save(s, w, err) : CORE_OK;
 }
 
 core_status dem_save(const dem_scene *s, const char *path, const char *version, core_error *err)
@@ -657,6 +659,12 @@ static void read_all(reader *r, ckpt_reader *ck, const dem_boundary_restorer *re
         open_section(r, ck, "boundary_update");
         if (!r->st)
             r->st = dem_boundary_load_update(s, &r->sec, restorer, r->err);
+    }
+    if (!r->st && ckpt_has(ck, "flow")) { /* inserters and outflows (flow.c) */
+        open_section(r, ck, "flow");
+        if (!r->st)
+            r->st = dem_flow_load(s, &r->sec, r->err);
+        close_section(r);
     }
     const char *wrong = r->st ? NULL : inconsistent(s, gear_ready, prev_ready, need_rebuild);
     if (wrong)

@@ -21,7 +21,7 @@ typedef struct dem_scene dem_scene;
 typedef struct dem_scene_def {
     int dim;              /* 2 (disks) or 3 (spheres) */
     double lo[3], hi[3];  /* the domain: a particle leaving it on an axis that is not periodic
-                           * stops the run with an error */
+                           * stops the run with an error (unless an outflow opens that side) */
     bool periodic[3];
     double gravity[3];    /* m/s^2 */
     /* 2D only: > 0 makes disks cylinders of this thickness (m = rho pi r^2 t, I = m r^2 / 2);
@@ -532,5 +532,68 @@ core_status dem_load_with(const char *path, const dem_boundary_restorer *restore
                           core_error *err);
 /* dem_load_with without a restorer. */
 core_status dem_load(const char *path, dem_scene **out, core_error *err);
+
+/* ---- particles in and out during a run (flow.c) --------------------------------------------- *
+ * Inserters add particles in a region (a box, or a disk/ball) at a rate or up to a count or a
+ * mass, with a size distribution and a velocity, at positions drawn from the inserter's own
+ * random stream (core/rng.h; serial, so the same seed gives the same bits for any thread count)
+ * and never overlapping a particle or a wall: each particle gets `attempts` positions; one that
+ * finds no free place is skipped and counted. Outflows remove the particles whose centre enters a
+ * box (fixed particles excepted), or that leave the domain through an open side (a side that is
+ * not periodic; without an outflow on it, a particle leaving the domain stops the run, as LAMMPS's
+ * "lost atoms"). Removed particles are counted, with their mass, per outflow. Ids (indices) of
+ * the particles after a removed one shift down by one; dem_tags gives each particle a number that
+ * never changes (the index it had when the first inserter or outflow was added, or the order of
+ * its creation after that). Both act between steps; a scene without them does no extra work. Not
+ * distributed: a run on more than one rank is refused. */
+typedef enum dem_size_law {
+    DEM_SIZE_CONSTANT, /* radius r0 */
+    DEM_SIZE_UNIFORM,  /* radius uniform in [r0, r1] */
+    DEM_SIZE_DISCRETE  /* radii[k] with probability weights[k] / sum(weights) */
+} dem_size_law;
+
+typedef struct dem_inserter_def {
+    int ball; /* 0: the box [lo, hi]; 1: the disk (2D) or ball (3D) center, extent */
+    double lo[3], hi[3];
+    double center[3], extent;
+    double rate; /* particles per second (0: everything due at the first event) */
+    long count;  /* total to insert (< 0: no limit; needs a rate or a mass) */
+    double mass; /* total mass to insert, kg (<= 0: no limit): stops once reached */
+    dem_size_law size;
+    double r0, r1;
+    size_t nsizes; /* DISCRETE: radii and weights (copied) */
+    const double *radii, *weights;
+    double velocity[3]; /* each particle: velocity + spread * uniform(-1, 1) per component */
+    double spread;
+    int material;
+    unsigned long long seed;
+    long every;   /* steps between insertion events (>= 1) */
+    int attempts; /* positions tried per particle (>= 1) */
+} dem_inserter_def;
+
+/* box of zero size, rate 0, count -1, no mass limit, constant radius 0, every 1, 50 attempts */
+dem_inserter_def dem_default_inserter_def(void);
+/* The inserter id (>= 0), or -1 with err filled. Its first event is at the next step boundary
+ * (the start of the next run); a rate counts from the scene's time now. */
+int dem_add_inserter(dem_scene *s, const dem_inserter_def *def, core_error *err);
+
+typedef struct dem_outflow_def {
+    int side; /* -1: the box [lo, hi]; else 2 axis + (0 lower, 1 upper side) */
+    double lo[3], hi[3];
+} dem_outflow_def;
+int dem_add_outflow(dem_scene *s, const dem_outflow_def *def, core_error *err);
+
+typedef struct dem_flow_counts {
+    long count;   /* inserted (inserters) or removed (outflows) so far */
+    double mass;  /* their mass, kg */
+    long skipped; /* inserters: particles due that found no free place */
+    long events;  /* inserters: insertion events that had particles due */
+} dem_flow_counts;
+int dem_inserter_count(const dem_scene *s);
+int dem_outflow_count(const dem_scene *s);
+core_status dem_inserter_counts(const dem_scene *s, int id, dem_flow_counts *out, core_error *err);
+core_status dem_outflow_counts(const dem_scene *s, int id, dem_flow_counts *out, core_error *err);
+/* Stable particle numbers (0-based), NULL until the first inserter or outflow. */
+const double *dem_tags(const dem_scene *s);
 
 #endif

@@ -104,6 +104,8 @@ struct dem_scene {
     long tt_phase;
 
     struct dem_boundary *bnd; /* boundary conditions (boundary.c); NULL when none */
+    struct dem_flow *flow;    /* inserters and outflows (flow.c); NULL when none */
+    double *tag;              /* stable particle numbers (flow.c); NULL until flow is used */
 
     /* Distributed runs (domain.c): NULL on one rank and whenever the scene is replicated. While
      * decomposed, the arrays above hold this rank's owned particles and its ghosts (copies of
@@ -150,7 +152,37 @@ size_t dem_domain_bundle(const dem_scene *s, size_t i, const uint32_t **gj, cons
 /* The global id (1-based in messages: + 1) of local particle i. */
 static inline size_t dem_gid(const dem_scene *s, size_t i) { return s->gid ? s->gid[i] : i; }
 
+/* Every per-particle array of s->cap entries the scene has now (domain.c): the table a
+ * migration, a gather and a removal (flow.c) go through. a[] needs dem_max_particle_arrays. */
+typedef struct dem_parray {
+    void **p;
+    size_t size;
+} dem_parray;
+int dem_particle_arrays(dem_scene *s, dem_parray *a);
+int dem_max_particle_arrays(const dem_scene *s);
+
+/* flow.c: inserters and outflows, between steps (dem_run calls dem_flow_step before the first
+ * step and after every step when s->flow is set): removal, then insertion, keeping every
+ * per-particle array, the pair list with its history and the integrators' state consistent. */
+typedef struct dem_flow dem_flow;
+/* step: the steps completed (the step is counted after the checks that follow this call). */
+core_status dem_flow_step(dem_scene *s, long step, core_error *err);
+/* What a run must refuse (more than one rank; removal with boundary conditions). */
+core_status dem_flow_check_run(const dem_scene *s, core_error *err);
+/* The scene may start a run without particles: an inserter will bring them. */
+int dem_flow_inserting(const dem_scene *s);
+/* The smallest particle inserter q can make (for the stable step): its k and gamma against
+ * itself and the effective mass; 0 when q does not exist. */
+int dem_flow_probe(dem_scene *s, int q, double *k, double *gamma, double *m_eff);
+void dem_flow_tag_new(dem_scene *s, size_t i); /* a particle was appended: its tag */
+void dem_flow_free(dem_scene *s);
+core_status dem_flow_save(const dem_scene *s, struct ckpt_writer *w, core_error *err);
+core_status dem_flow_load(dem_scene *s, struct ckpt_section *sec, core_error *err);
+
 /* neighbor.c */
+/* The law parameters of two particles of material mat, radius r and mass m each. */
+void dem_probe_parameters(const dem_scene *s, int mat, double r, double m, double *k,
+                          double *gamma);
 void dem_wrap_positions(dem_scene *s);
 /* After p->i, j and n are filled: p->start, jstart and jpair from them. */
 core_status dem_pairs_index(dem_scene *s, core_error *err);

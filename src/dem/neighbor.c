@@ -67,6 +67,13 @@ void dem_pair_parameters(dem_scene *s, size_t i, size_t j, double *k, double *ga
                    mu);
 }
 
+void dem_probe_parameters(const dem_scene *s, int mat, double r, double m, double *k, double *gamma)
+{
+    const dem_material *a = &s->mats[mat];
+    double mu;
+    law_parameters(s, a, a, 0.5 * r, 0.5 * m, a->friction, k, gamma, &mu);
+}
+
 void dem_wall_parameters(const dem_scene *s, const dem_wall *w, size_t i, double *k,
                          double *gamma, double *mu)
 {

@@ -99,6 +99,7 @@ void dem_destroy(dem_scene *s)
         return;
     dem_domain_free(s);
     dem_clear_boundary(s);
+    dem_flow_free(s);
     for (int d = 0; d < 3; d++) {
         free(s->x[d]), free(s->v[d]), free(s->f[d]), free(s->w[d]), free(s->tq[d]);
         free(s->x_build[d]), free(s->x_ref[d]), free(s->x_prev[d]), free(s->fext[d]);
@@ -263,6 +264,8 @@ static core_status grow(dem_scene *s, size_t need, core_error *err)
     }
     if (st == CORE_OK && s->angle)
         st = dem_alloc_array(&s->angle, cap, err);
+    if (st == CORE_OK && s->tag)
+        st = dem_alloc_array(&s->tag, cap, err);
     if (st == CORE_OK)
         st = dem_alloc_array(&s->r, cap, err);
     if (st == CORE_OK)
@@ -415,6 +418,8 @@ long dem_add_particle(dem_scene *s, const dem_particle_def *p, core_error *err)
     s->flags[i] = (unsigned char)p->flags;
     if (r > s->r_max)
         s->r_max = r;
+    if (s->tag)
+        dem_flow_tag_new(s, i);
     s->n++;
     dem_invalidate(s, 1);
     return (long)i;

@@ -1157,6 +1157,15 @@ static int l_particles(lua_State *L)
     static const char *const fs[3] = {"fx", "fy", "fz"};
     for (int d = 0; d < D && dem_forces(s, d); d++) /* the last force evaluation's */
         bind_push_array(L, dem_forces(s, d), n, fs[d]);
+    if (dem_tags(s)) { /* with inserters or outflows: numbers that survive removals */
+        const double *tag = dem_tags(s);
+        lua_createtable(L, (int)n, 0);
+        for (size_t i = 0; i < n; i++) {
+            lua_pushinteger(L, (lua_Integer)tag[i] + 1);
+            lua_rawseti(L, -2, (lua_Integer)i + 1);
+        }
+        lua_setfield(L, -2, "tag");
+    }
     lua_pushinteger(L, (lua_Integer)n);
     lua_setfield(L, -2, "count");
     return 1;
@@ -1369,6 +1378,229 @@ static int l_info(lua_State *L)
     return 1;
 }
 
+/* ---- particles in and out during a run (flow.c) --------------------------------------------- */
+static const char *const INSERTER_FIELDS[] = {
+    "box",     "center",   "extent", "rate",     "count", "mass",  "radius",   "radii",
+    "weights", "velocity", "spread", "material", "seed",  "every", "attempts", NULL};
+
+/* An array field of positive (radii) or non-negative (weights) finite numbers, n > 0 entries
+ * (n_want > 0: exactly that many); a new userdata-free buffer on the Lua stack holds them. */
+static double *number_list(lua_State *L, int arg, const char *call, const char *field,
+                           size_t n_want, int positive, size_t *n)
+{
+    lua_getfield(L, arg, field);
+    const char *expected = positive ? "non-empty array of positive numbers"
+                                    : "non-empty array of non-negative numbers";
+    if (!lua_istable(L, -1) || luaL_len(L, -1) < 1 ||
+        (n_want > 0 && (size_t)luaL_len(L, -1) != n_want))
+        bind_field_error(L, arg, call, field,
+                         n_want > 0 ? "array of one weight per entry of 'radii'" : expected);
+    *n = (size_t)luaL_len(L, -1);
+    double *v = lua_newuserdatauv(L, *n * sizeof *v, 0);
+    for (size_t k = 0; k < *n; k++) {
+        int t = lua_rawgeti(L, -2, (lua_Integer)k + 1);
+        v[k] = lua_tonumber(L, -1);
+        lua_pop(L, 1);
+        if (t != LUA_TNUMBER || !isfinite(v[k]) || (positive ? !(v[k] > 0) : !(v[k] >= 0))) {
+            lua_pop(L, 1); /* the buffer: the field's value on top for the message */
+            bind_field_error(L, arg, call, field, expected);
+        }
+    }
+    lua_remove(L, -2); /* keep the buffer, drop the field's value */
+    return v;
+}
+
+static int l_inserter(lua_State *L)
+{
+    const char *call = "inserter";
+    dem_scene *s = check_scene(L, 1);
+    bind_refuse_running(L, 1, call, "add inserters between runs");
+    bind_check_table(L, 2, call);
+    bind_check_fields(L, 2, call, INSERTER_FIELDS);
+    const int D = dem_dim(s);
+    dem_inserter_def d = dem_default_inserter_def();
+    int has_box = lua_getfield(L, 2, "box") != LUA_TNIL;
+    lua_pop(L, 1);
+    if (has_box) {
+        bind_field_box(L, 2, call, "box", D, d.lo, d.hi);
+        if (lua_getfield(L, 2, "center") != LUA_TNIL)
+            bind_field_error(L, 2, call, "center", "nil with a box (one region)");
+        if (lua_getfield(L, 2, "extent") != LUA_TNIL)
+            bind_field_error(L, 2, call, "extent", "nil with a box (one region)");
+        lua_pop(L, 2);
+    } else {
+        d.ball = 1;
+        if (!bind_field_vector(L, 2, call, "center", D, d.center, 0)) {
+            /* neither region: a disk/ball when an extent says so, else a box */
+            int ball = lua_getfield(L, 2, "extent") != LUA_TNIL;
+            lua_getfield(L, 2, ball ? "center" : "box");
+            bind_field_error(L, 2, call, ball ? "center" : "box",
+                             ball ? "a center with the extent"
+                                  : "a box, or a center and an extent");
+        }
+        d.extent = bind_field_number(L, 2, call, "extent", 0, BIND_REQUIRED | BIND_POSITIVE);
+    }
+    d.rate = bind_field_number(L, 2, call, "rate", 0, BIND_NONNEG);
+    d.count = (long)bind_field_integer(L, 2, call, "count", -1, 0, LONG_MAX, 0);
+    d.mass = bind_field_number(L, 2, call, "mass", 0, BIND_POSITIVE);
+    if (d.rate == 0 && d.count < 0 && d.mass == 0) {
+        lua_getfield(L, 2, "count");
+        bind_field_error(L, 2, call, "count", "a count, a rate or a mass (none given)");
+    }
+    double *radii = NULL, *weights = NULL;
+    int has_radii = lua_getfield(L, 2, "radii") != LUA_TNIL;
+    lua_pop(L, 1);
+    if (has_radii) { /* the list checked first, so that a bad one is named as such */
+        d.size = DEM_SIZE_DISCRETE;
+        radii = number_list(L, 2, call, "radii", 0, 1, &d.nsizes);
+    }
+    lua_getfield(L, 2, "radii");
+    int has_radius = lua_getfield(L, 2, "radius") != LUA_TNIL;
+    if (has_radii == has_radius)
+        bind_field_error(L, 2, call, "radius",
+                         has_radii ? "nil with radii"
+                                   : "a radius, {min, max}, or a field 'radii',");
+    if (has_radius && lua_istable(L, -1)) {
+        double r[2];
+        bind_field_vector(L, 2, call, "radius", 2, r, BIND_REQUIRED);
+        if (!(r[0] > 0 && r[1] >= r[0]))
+            bind_field_error(L, 2, call, "radius", "{min, max} with 0 < min <= max");
+        d.size = DEM_SIZE_UNIFORM;
+        d.r0 = r[0];
+        d.r1 = r[1];
+    } else if (has_radius) {
+        d.r0 = bind_field_number(L, 2, call, "radius", 0, BIND_REQUIRED | BIND_POSITIVE);
+    }
+    lua_pop(L, 2);
+    if (has_radii) {
+        if (lua_getfield(L, 2, "weights") != LUA_TNIL) {
+            size_t nw;
+            lua_pop(L, 1);
+            weights = number_list(L, 2, call, "weights", d.nsizes, 0, &nw);
+        } else {
+            lua_pop(L, 1);
+            weights = lua_newuserdatauv(L, d.nsizes * sizeof *weights, 0);
+            for (size_t k = 0; k < d.nsizes; k++)
+                weights[k] = 1;
+        }
+        d.radii = radii;
+        d.weights = weights;
+    } else if (lua_getfield(L, 2, "weights") != LUA_TNIL) {
+        bind_field_error(L, 2, call, "weights", "nil without radii");
+    } else {
+        lua_pop(L, 1);
+    }
+    bind_field_vector(L, 2, call, "velocity", D, d.velocity, 0);
+    d.spread = bind_field_number(L, 2, call, "spread", 0, BIND_NONNEG);
+    d.seed = (unsigned long long)bind_field_integer(L, 2, call, "seed", 1, 0, LUA_MAXINTEGER, 0);
+    d.every = (long)bind_field_integer(L, 2, call, "every", 1, 1, LONG_MAX, 0);
+    d.attempts = (int)bind_field_integer(L, 2, call, "attempts", 50, 1, 1000000, 0);
+    d.material = material_index(L, 1, 2, call, "material", 0);
+    core_error err;
+    int id = dem_add_inserter(s, &d, &err);
+    if (id < 0)
+        return bind_raise(L, call, &err);
+    lua_pushinteger(L, id + 1);
+    return 1;
+}
+
+static const char *const OUTFLOW_FIELDS[] = {"box", "side", NULL};
+static const char *const SIDE_NAMES[] = {"x-", "x+", "y-", "y+", "z-", "z+", NULL};
+
+static int l_outflow(lua_State *L)
+{
+    const char *call = "outflow";
+    dem_scene *s = check_scene(L, 1);
+    bind_refuse_running(L, 1, call, "add outflows between runs");
+    bind_check_table(L, 2, call);
+    bind_check_fields(L, 2, call, OUTFLOW_FIELDS);
+    const int D = dem_dim(s);
+    dem_outflow_def d;
+    memset(&d, 0, sizeof d);
+    int has_box = lua_getfield(L, 2, "box") != LUA_TNIL;
+    int has_side = lua_getfield(L, 2, "side") != LUA_TNIL;
+    lua_pop(L, 2);
+    d.side = -1;
+    if (has_side) { /* each value checked first, so that a bad one is named as such */
+        d.side = bind_field_option(L, 2, call, "side", SIDE_NAMES, 0, BIND_REQUIRED);
+        if (d.side >= 2 * D) {
+            lua_getfield(L, 2, "side");
+            bind_field_error(L, 2, call, "side",
+                             D == 2 ? "'x-', 'x+', 'y-' or 'y+' in 2D" : "a side name");
+        }
+    }
+    if (has_box)
+        bind_field_box(L, 2, call, "box", D, d.lo, d.hi);
+    if (has_box == has_side) {
+        lua_getfield(L, 2, "side");
+        bind_field_error(L, 2, call, "side",
+                         has_box ? "nil with a box (one region)" : "a side, or a field 'box',");
+    }
+    core_error err;
+    int id = dem_add_outflow(s, &d, &err);
+    if (id < 0)
+        return bind_raise(L, call, &err);
+    lua_pushinteger(L, id + 1);
+    return 1;
+}
+
+static void push_counts(lua_State *L, const dem_flow_counts *c, int inserter)
+{
+    lua_createtable(L, 0, 4);
+    lua_pushinteger(L, c->count);
+    lua_setfield(L, -2, inserter ? "inserted" : "removed");
+    lua_pushnumber(L, c->mass);
+    lua_setfield(L, -2, "mass");
+    if (inserter) {
+        lua_pushinteger(L, c->skipped);
+        lua_setfield(L, -2, "skipped");
+        lua_pushinteger(L, c->events);
+        lua_setfield(L, -2, "events");
+    }
+}
+
+static int l_flow(lua_State *L)
+{
+    dem_scene *s = check_scene(L, 1);
+    long ins = 0, skipped = 0, rem = 0;
+    double ins_m = 0, rem_m = 0;
+    dem_flow_counts c;
+    lua_createtable(L, 0, 10);
+    lua_createtable(L, dem_inserter_count(s), 0);
+    for (int q = 0; q < dem_inserter_count(s); q++) {
+        dem_inserter_counts(s, q, &c, NULL);
+        ins += c.count, ins_m += c.mass, skipped += c.skipped;
+        push_counts(L, &c, 1);
+        lua_rawseti(L, -2, q + 1);
+    }
+    lua_setfield(L, -2, "inserters");
+    lua_createtable(L, dem_outflow_count(s), 0);
+    for (int o = 0; o < dem_outflow_count(s); o++) {
+        dem_outflow_counts(s, o, &c, NULL);
+        rem += c.count, rem_m += c.mass;
+        push_counts(L, &c, 0);
+        lua_rawseti(L, -2, o + 1);
+    }
+    lua_setfield(L, -2, "outflows");
+    double present = 0;
+    const double *m = dem_masses(s);
+    for (size_t i = 0; i < dem_count(s); i++)
+        present += m[i];
+    const lua_Integer iv[4] = {ins, skipped, rem, (lua_Integer)dem_count(s)};
+    const char *in_[4] = {"inserted", "skipped", "removed", "count"};
+    for (int k = 0; k < 4; k++) {
+        lua_pushinteger(L, iv[k]);
+        lua_setfield(L, -2, in_[k]);
+    }
+    const double dv[4] = {ins_m, rem_m, present, dem_time(s)};
+    const char *dn[4] = {"inserted_mass", "removed_mass", "mass", "time"};
+    for (int k = 0; k < 4; k++) {
+        lua_pushnumber(L, dv[k]);
+        lua_setfield(L, -2, dn[k]);
+    }
+    return 1;
+}
+
 static int l_gc(lua_State *L)
 {
     lscene *u = luaL_checkudata(L, 1, SCENE);
@@ -1499,7 +1731,8 @@ void bind_open_dem(lua_State *L)
         {"particles", l_particles, "s:particles()",
          "Arrays x, y (z), vx, vy (vz), omega (2D) or wx, wy, wz (3D), angle (2D: the integrated "
          "rotation in rad), radius and mass; fx, fy (fz): the total force (N) of the last force "
-         "evaluation (zero before any run); count."},
+         "evaluation (zero before any run); count; tag (with inserters or outflows): a number "
+         "each particle keeps while ids shift on removals."},
         {"set_reference", l_set_reference, "s:set_reference()",
          "Remembers the current positions for displacement measurements."},
         {"scale_mass", l_scale_mass, "s:scale_mass(factor)",
@@ -1521,6 +1754,27 @@ void bind_open_dem(lua_State *L)
          "Padbidri's quasistatic coefficient phi (Eq. 2.13; 2D: m eps^2 N / (2 p R) from "
          "2.B1) and size coefficient psi (Eq. 2.14) of the scene; warns when phi > 0.01. Mass "
          "scaling (s:scale_mass) multiplies phi by its factor."},
+        {"inserter", l_inserter,
+         "s:inserter{ box = {lo, hi} | center = {...}, extent = R, rate =, count =, mass =, "
+         "radius = r | {min, max} | radii = {...}, weights = {...}, velocity = {...}, spread = 0, "
+         "material = m, seed = 1, every = 1, attempts = 50 }",
+         "Inserts particles during runs in a box, or a disk/ball of radius extent (each particle "
+         "wholly inside), never overlapping a particle or a wall: rate per second (counted from "
+         "now), or everything at once; count and mass cap the total. Radius constant, uniform in "
+         "{min, max}, or drawn from radii with weights. Velocity plus spread x uniform(-1, 1) per "
+         "component. Every `every` steps the particles due get `attempts` random positions each "
+         "(the inserter's own stream from seed): one that finds no place is skipped and counted. "
+         "Returns the inserter id; s:flow() gives the counts."},
+        {"outflow", l_outflow,
+         "s:outflow{ box = {lo, hi} } or s:outflow{ side = 'x-'|'x+'|'y-'|...}",
+         "Removes the particles whose centre enters the box (fixed ones excepted) after each "
+         "step, or that leave the domain through that side (not periodic; without an outflow a "
+         "particle leaving the domain stops the run). Ids after a removed particle shift down: "
+         "follow particles by s:particles().tag. Returns the outflow id."},
+        {"flow", l_flow, "s:flow()",
+         "Particles in and out: inserted, inserted_mass, skipped, removed, removed_mass, count "
+         "and mass (present), time; inserters[k] = {inserted, mass, skipped, events}, "
+         "outflows[k] = {removed, mass}."},
         {"info", l_info, "s:info()",
          "dim, box, gravity, count, time, steps, force_evaluations, the laws."},
         {NULL, NULL, NULL, NULL}};
@@ -1542,6 +1796,8 @@ void bind_open_dem(lua_State *L)
                                                 {"set_forces", NULL, FORCES_FIELDS},
                                                 {"quasistatic", NULL, QUASISTATIC_FIELDS},
                                                 {"damping_time", NULL, DAMPING_TIME_FIELDS},
+                                                {"inserter", NULL, INSERTER_FIELDS},
+                                                {"outflow", NULL, OUTFLOW_FIELDS},
                                                 {NULL, NULL, NULL}};
     bind_type_fields(L, SCENE, method_fields);
     static const bind_fn fns[] = {

@@ -15,6 +15,20 @@ else
   assert(tostring(err):find("do not yet run distributed", 1, true), err)
   assert(tostring(err):find("springs", 1, true), err)
 end
+
+-- Particles in and out (inserters, outflows) do not run distributed either: refused by name.
+local fl = dem.scene{ dim = 2, box = { { 0, 0 }, { 0.01, 0.01 } } }
+fl:add_disk{ pos = { 0.005, 0.005 }, radius = 0.0005, material = m }
+fl:inserter{ box = { { 0, 0.008 }, { 0.01, 0.01 } }, count = 3, radius = 0.0004, material = m }
+local okf, errf = pcall(fl.run, fl, { steps = 10, dt = 1e-7 })
+if ranks == 1 then
+  assert(okf, errf)
+  assert(fl:flow().inserted == 3, "one rank: inserted")
+else
+  assert(not okf, "a run with an inserter went ahead on " .. ranks .. " ranks")
+  assert(tostring(errf):find("particle insertion and removal", 1, true), errf)
+  assert(tostring(errf):find("do not yet run distributed", 1, true), errf)
+end
 print("ok")
 
 -- Walls beyond planes (a circle here) do not run distributed yet either: refused by name.
