@@ -79,6 +79,8 @@ static inline double regularized(const dem_contact_def *c, const dem_power *pw, 
     return x >= 1 ? mu * fn : mu * fn * dem_power_eval(pw, x); /* x^(1/c) */
 }
 
+#include "dem/rolling.inc"
+
 #define DIM 2
 #include "dem/forces_dim.inc"
 #undef DIM
