@@ -98,16 +98,8 @@ for name, v in pairs { young = young, dt_factor = dt_factor, aspect = aspect, v_
 end
 assert(dt_factor <= 1, "dt_factor must be <= 1 (dt above the stability limit)")
 assert(type(csv) == "string", "csv must be a path")
-local mus = { 0.1, 0.2, 0.3, 0.5, 0.8 }
-if params.mus then -- "0.1,0.8" or a single number
-  mus = {}
-  for v in tostring(params.mus):gmatch("[^,]+") do
-    local mu = tonumber(v)
-    assert(mu and mu >= 0, "mus must be a comma-separated list of non-negative numbers")
-    mus[#mus + 1] = mu
-  end
-  table.sort(mus)
-end
+local heap_box = dofile((arg[0]:match("^(.*)/") or ".") .. "/heap_box.lua")
+local mus = heap_box.mus(params.mus, { 0.1, 0.2, 0.3, 0.5, 0.8 })
 -- images/ only from the default run (docs/dem.md shows it); any other run writes to out/.
 local figures = require("grainlab.figures")
 local published = figures.published({ n = n, seed = seed, seeds = seeds, young = young, dt_factor = dt_factor,
@@ -117,169 +109,37 @@ local published = figures.published({ n = n, seed = seed, seeds = seeds, young =
                                       v_rest = 5e-3, T_max = 4, mus = "0.1,0.2,0.3,0.5,0.8" })
 local png = params.png or figures.path("repose.png", { published = published })
 
-local rmin, rmax = 0.5e-3, 1e-3
-local dmean = rmin + rmax          -- mean diameter
-local g, rho, nu = 9.81, 2650, 0.3
-local e_rest, v_e = 0.5, 1.0       -- Brilliantov damping: restitution e_rest at v_e
-local v_imp = 2.0                  -- m/s, the impact velocity the time step is chosen for
--- Area per disk in the packing: pi <r^2> / 0.82, <r^2> = (rmax^3 - rmin^3) / (3 (rmax - rmin)).
-local area = math.pi * (rmax ^ 3 - rmin ^ 3) / (3 * (rmax - rmin)) / 0.82
-local W = math.sqrt(n * area / aspect)
-local h0 = aspect * W
-local rf = rmin                    -- floor disks
-local depth, length = 0.6 * W, 3 * W
-local top = 1.6 * h0 + 4 * rmax
-local bw = 2 * rmax                -- surface bins
-local nb = math.floor(W / bw)
-
--- The fastest grain in the box (x < W, y > 0; the floor disks come first, nf of them) and the
--- number of grains there.
-local function box_state(s, nf)
-  local P = s:particles()
-  local vmax, count = 0, 0
-  for i = nf + 1, P.count do
-    if P.x[i] < W and P.y[i] > 0 then
-      vmax = math.max(vmax, math.sqrt(P.vx[i] ^ 2 + P.vy[i] ^ 2))
-      count = count + 1
-    end
-  end
-  return vmax, count
-end
-
--- Top of the highest grain in the box (y + r) per bin (0-based; nil where empty).
-local function surface(s, nf)
-  local P, tops = s:particles(), {}
-  for i = nf + 1, P.count do
-    if P.x[i] < W and P.y[i] > 0 then
-      local b = math.floor(P.x[i] / bw)
-      if b >= 0 and b < nb then
-        tops[b] = math.max(tops[b] or -math.huge, P.y[i] + P.radius[i])
-      end
-    end
-  end
-  return tops
-end
-
--- Least-squares line through the sloping part of the surface (see the header).
--- Returns theta_r (deg), rms residual (mean diameters), number of points.
-local function fit(tops, h_init)
-  local xs, ys = {}, {}
-  for b = 0, nb - 1 do
-    local x, h = (b + 0.5) * bw, tops[b]
-    if h and x >= 2 * bw and x <= W - 2 * bw and h > 2 * rmax and h < h_init - 2 * rmax then
-      xs[#xs + 1], ys[#ys + 1] = x, h
-    end
-  end
-  local k = #xs
-  if k < 5 then return 0 / 0, 0 / 0, k end
-  local sx, sy, sxx, sxy = 0, 0, 0, 0
-  for i = 1, k do
-    sx, sy = sx + xs[i], sy + ys[i]
-    sxx, sxy = sxx + xs[i] * xs[i], sxy + xs[i] * ys[i]
-  end
-  local b = (k * sxy - sx * sy) / (k * sxx - sx * sx)
-  local a = (sy - b * sx) / k
-  local ss = 0
-  for i = 1, k do ss = ss + (ys[i] - a - b * xs[i]) ^ 2 end
-  return math.deg(math.atan(-b)), math.sqrt(ss / k) / dmean, k
-end
-
--- One friction coefficient and packing: prepare, collapse, fit.
+-- One friction coefficient and packing: prepare, collapse, fit (scripts/heap_box.lua).
 local function run_one(mu, sd)
   local c0 = grainlab.clock()
-  local mat = grainlab.material{ density = rho, young = young, poisson = nu, friction = mu }
-  local s = dem.scene{ dim = 2, box = { { 0, -depth }, { length, top } }, gravity = { 0, -g } }
-  s:contact{ normal = "hertz", tangential = "spring" } -- for the deposit's own relaxation
-  s:add_wall{ point = { 0, 0 }, normal = { 1, 0 } }
-  local gate = s:add_wall{ point = { W, 0 }, normal = { -1, 0 } }
-  s:add_wall{ point = { 0, -depth }, normal = { 0, 1 } }
-  s:add_wall{ point = { length, 0 }, normal = { -1, 0 } }
-  local nf = 0
-  for k = 0, math.floor(W / (2 * rf)) - 1 do
-    s:add_disk{ pos = { rf + 2 * rf * k, -rf }, radius = rf, material = mat, fixed = true }
-    nf = nf + 1
-  end
-  grainlab.pack.deposit(s, { n = n, radius = { rmin, rmax }, seed = sd, material = mat,
-                             region = { { 0, -2 * rf }, { W, top - 2 * rmax } }, relax_steps = 0 })
-  s:contact{ normal = "hertz", damping = "brilliantov", restitution = e_rest, impact_velocity = v_e,
-             tangential = "spring" }
-  local dt = dt_factor * s:timestep{ impact_velocity = v_imp }.limit
-  local function advance(T) s:run{ time = T, dt = dt, impact_velocity = v_imp, progress = false } end
+  local b = heap_box.new{ n = n, mu = mu, seed = sd, young = young, aspect = aspect,
+                          dt_factor = dt_factor, v_rest = v_rest }
   local function say(fmt, ...)
     if verbose then
       io.stderr:write(string.format("mu %.2f seed %d: ", mu, sd) .. string.format(fmt, ...) ..
                       string.format(", wall %.1f s\n", grainlab.clock() - c0))
     end
   end
-
-  s:drag(20)
-  advance(0.1)
-  s:drag(0)
-  local t_relax = 0.1
-  repeat
-    advance(0.02)
-    t_relax = t_relax + 0.02
-  until box_state(s, nf) < v_rest or t_relax >= 0.6 - 1e-9
-  local h_init = 0
-  for _, h in pairs(surface(s, nf)) do h_init = math.max(h_init, h) end
-  say("relaxed in %.2f s (v_max %.3g m/s), top %.1f mm, dt %.3g s", t_relax, box_state(s, nf),
-      h_init * 1e3, dt)
-
-  s:remove_wall(gate)
-  local t, vmax, left = 0, math.huge, n
-  while t < T_max - 1e-9 do
-    advance(0.05)
-    t = t + 0.05
-    vmax, left = box_state(s, nf)
-    if verbose then
-      say("t %.2f s, v_max %.3g m/s, %d left, theta %.2f deg", t, vmax, left,
-          (fit(surface(s, nf), h_init)))
-    end
-    if t >= 0.3 - 1e-9 and vmax < v_rest then break end
-  end
-
-  -- The highest resting grain (< 5 cm/s: not one still falling off the edge) outside the box
-  -- region (x >= W or y <= 0): the basin heap must stay below the box floor.
-  local P = s:particles()
-  local basin_top = -depth
-  for i = nf + 1, P.count do
-    if (P.x[i] >= W or P.y[i] <= 0) and P.vx[i] ^ 2 + P.vy[i] ^ 2 < 0.05 ^ 2 then
-      basin_top = math.max(basin_top, P.y[i] + P.radius[i])
-    end
-  end
-  local tops = surface(s, nf)
-  local theta, rms, points = fit(tops, h_init)
-  return { theta = theta, rms = rms, points = points, left = left, vmax = vmax, t = t, tops = tops,
-           basin_top = basin_top, dt = dt, wall_s = grainlab.clock() - c0 }
+  say("relaxed in %.2f s (v_max %.3g m/s), top %.1f mm, dt %.3g s", b.t_relax, b:state(),
+      b.h_init * 1e3, b.dt)
+  local r = b:collapse(T_max, verbose and function(t, vmax, left)
+    say("t %.2f s, v_max %.3g m/s, %d left, theta %.2f deg", t, vmax, left, (b:fit(b:surface())))
+  end)
+  r.dt, r.wall_s, r.box = b.dt, grainlab.clock() - c0, b
+  return r
 end
 
+local geometry = heap_box.new{ n = n, mu = 0.5, seed = seed, young = young, aspect = aspect,
+                               geometry_only = true }
+local W, h0, rf, nb, bw = geometry.W, geometry.h0, geometry.rf, geometry.nb, geometry.bw
+local rmin, rmax, e_rest = geometry.rmin, geometry.rmax, geometry.e_rest
+local nu, rho = heap_box.poisson, heap_box.density
 print(string.format("repose: n = %d, box %.1f mm wide, filled to %.1f mm, E = %g Pa, "
                     .. "%d packing(s) per mu", n, W * 1e3, h0 * 1e3, young, seeds))
-local progress = grainlab.progress{ label = "repose", total = #mus * seeds, unit = "runs" }
-local results, done = {}, 0
-for i, mu in ipairs(mus) do
-  local runs = {}
-  for k = 1, seeds do
-    runs[k] = run_one(mu, seed + k - 1)
-    done = done + 1
-    progress:update(done)
-  end
-  local r = { mu = mu, runs = runs, theta = 0, left = 0, points = 0, rms = 0, vmax = 0, t = 0,
-              wall_s = 0, basin_top = -math.huge }
-  for _, x in ipairs(runs) do
-    r.theta = r.theta + x.theta / seeds
-    r.left, r.points = r.left + x.left / seeds, r.points + x.points / seeds
-    r.rms, r.vmax, r.t = math.max(r.rms, x.rms), math.max(r.vmax, x.vmax), math.max(r.t, x.t)
-    r.basin_top, r.wall_s = math.max(r.basin_top, x.basin_top), r.wall_s + x.wall_s
-    r.dt = x.dt
-    if x.rms ~= x.rms then r.rms = x.rms end -- a failed fit stays visible
-  end
-  local var = 0
-  for _, x in ipairs(runs) do var = var + (x.theta - r.theta) ^ 2 end
-  r.sd = seeds > 1 and math.sqrt(var / (seeds - 1)) or nil
-  results[i] = r
-end
-progress:finish()
+local results = heap_box.sweep{ label = "repose", mus = mus, seed = seed, seeds = seeds,
+                                run = run_one, mean = { "theta", "left", "points" },
+                                max = { "rms", "vmax", "t", "basin_top" }, sum = { "wall_s" } }
+for _, r in ipairs(results) do r.dt, r.sd = r.runs[#r.runs].dt, r.theta_sd end
 
 local metrics, checks = { dt_s = results[1].dt }, {}
 local rows = { "mu,atan_mu_deg,theta_r_deg,particles_left,fit_points" }

@@ -1,6 +1,7 @@
 /* Processes of a distributed run: a thin layer over MPI, as threads.c is over OpenMP. Only
- * comm.c includes mpi.h; a build without MPI (or a run started without mpirun) is one rank, and
- * every call below then works on that one rank with no MPI at all.
+ * comm.c includes mpi.h, compiled into the module grainlab-mpi.so that grainlab loads when
+ * mpirun started it; a run started without mpirun is one rank, and every call below then works
+ * on that one rank with no MPI loaded at all.
  *
  * Every collective call must be made by all ranks in the same order (SPMD, as the Lua script is
  * run by every rank). Byte counts are size_t; messages larger than INT_MAX bytes are split.
@@ -12,8 +13,9 @@
 #include <stdint.h>
 
 /* Starts MPI when the process was launched by mpirun (Open MPI's or PMIx's environment
- * variables are set); otherwise does nothing, so a plain run never loads MPI's runtime. Call
- * once, first thing in main. */
+ * variables are set): loads the module and calls MPI_Init, or exits with status 70 saying why it
+ * cannot (no module, a build without MPI). Otherwise does nothing, so a plain run never loads
+ * MPI's runtime. Call once, first thing in main. */
 void comm_init(int *argc, char ***argv);
 /* Ends MPI (no-op without it). Call once before exit; comm_abort instead when one rank fails. */
 void comm_finalize(void);
@@ -62,6 +64,11 @@ int comm_allgatherv(const void *buf, size_t bytes, void **out, size_t *out_bytes
  * memory (all ranks agree). */
 int comm_alltoallv(const void *send, const size_t *send_bytes, const size_t *send_off, void **recv,
                    size_t *recv_bytes, size_t *recv_off);
+/* The same, with a maximum over the ranks of nw words riding on the exchange of the sizes
+ * (words: this rank's in, the maximum out), so that a per-step flag (a failed step, an
+ * allocation) costs no collective of its own. Three collectives in all, one of them the data. */
+int comm_alltoallv_max(const void *send, const size_t *send_bytes, const size_t *send_off,
+                       void **recv, size_t *recv_bytes, size_t *recv_off, int64_t *words, int nw);
 
 /* Point-to-point exchange with a known set of peers (a halo whose sizes both sides know):
  * sends send_bytes[k] bytes from send[k] to peers[k] and receives recv_bytes[k] bytes from

@@ -244,6 +244,10 @@ core_status dem_scale_stiffness(dem_scene *s, double factor, core_error *err);
 core_status dem_set_drag(dem_scene *s, double rate, core_error *err);
 double dem_drag(const dem_scene *s);
 void dem_box(const dem_scene *s, double lo[3], double hi[3], double gravity[3]);
+/* Sets gravity (m/s^2; components beyond the scene's dimension must be 0): a tilted box is a
+ * rotated gravity. Takes effect at the next step; resets the energy watch's reference (the
+ * potential energy changes with it). */
+core_status dem_set_gravity(dem_scene *s, const double g[3], core_error *err);
 
 /* External forces on particles (N), added every step until changed or cleared; arrays are
  * allocated on first use. Used for pressure boundary conditions applied as particle forces. */

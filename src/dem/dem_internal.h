@@ -147,8 +147,6 @@ core_status dem_domain_deferred(dem_scene *s, core_error *err);
 core_status dem_domain_agree(dem_scene *s, core_status st, core_error *err);
 /* The same, and *flag becomes the or of every rank's *flag (one reduction for both). */
 core_status dem_domain_agree_flag(dem_scene *s, core_status st, int *flag, core_error *err);
-/* The largest squared displacement of an owned particle since the last build. */
-double dem_domain_displacement2(const dem_scene *s);
 void dem_domain_free(dem_scene *s);
 size_t dem_domain_count(const dem_scene *s); /* particles on all ranks */
 /* History of the pairs of local particle i as first index (sorted by the partner's global id),

@@ -675,22 +675,6 @@ core_status dem_domain_agree_flag(dem_scene *s, core_status st, int *flag, core_
     return e.status ? e.status : CORE_ERR_STATE;
 }
 
-double dem_domain_displacement2(const dem_scene *s)
-{
-    double m = 0;
-    for (size_t i = 0; i < s->n; i++) {
-        if (s->ghost[i])
-            continue;
-        double d2 = 0;
-        for (int d = 0; d < s->dim; d++) {
-            double dx = s->x[d][i] - s->x_build[d][i];
-            d2 += dx * dx;
-        }
-        m = d2 > m ? d2 : m;
-    }
-    return m;
-}
-
 /* ---- rebuild: migration, ghosts, history, list ---------------------------------------------- */
 typedef struct rec_ref {
     uint32_t gid, owned, nb;

@@ -173,8 +173,11 @@ static size_t check_domain(const dem_scene *s)
     return bad;
 }
 
-/* Largest squared displacement of a particle since the last list build. */
-static double max_displacement2(const dem_scene *s)
+/* Largest squared displacement of a particle since the last list build; distributed, of an
+ * owned particle (a ghost moves with its owner, which the rank holding it measures). gh: the
+ * ghost flags or NULL, a constant where this is inlined, so the one-rank loop has no mask. */
+static inline __attribute__((always_inline)) double
+displacement2_masked(const dem_scene *s, const unsigned char *restrict gh)
 {
     const long n = (long)s->n;
     double m = 0;
@@ -184,6 +187,8 @@ static double max_displacement2(const dem_scene *s)
 #pragma omp parallel for schedule(static) reduction(max : m) if (n > 4096)
         for (long i = 0; i < n; i++) {
             double dx = x[i] - xb[i], dy = y[i] - yb[i], d2 = dx * dx + dy * dy;
+            if (gh && gh[i])
+                d2 = 0;
             m = d2 > m ? d2 : m;
         }
     } else {
@@ -194,20 +199,27 @@ static double max_displacement2(const dem_scene *s)
                 double dx = s->x[d][i] - s->x_build[d][i];
                 d2 += dx * dx;
             }
+            if (gh && gh[i])
+                d2 = 0;
             m = d2 > m ? d2 : m;
         }
     }
     return m;
 }
 
+static double max_displacement2(const dem_scene *s)
+{
+    return s->ghost ? displacement2_masked(s, s->ghost) : displacement2_masked(s, NULL);
+}
+
 /* Forces at the current state; the list is rebuilt first when a particle moved more than half
  * the skin since the last build, or a wall did. disp2 < 0: not known, measure it. */
-static core_status forces_distributed(dem_scene *s, double dt, core_error *err);
+static core_status forces_distributed(dem_scene *s, double dt, double disp2, core_error *err);
 
 static core_status forces(dem_scene *s, double dt, double disp2, core_error *err)
 {
     if (s->dom)
-        return forces_distributed(s, dt, err);
+        return forces_distributed(s, dt, disp2, err);
     const double lim = 0.25 * s->skin * s->skin;
     if (!s->need_rebuild && s->pairs.start) {
         if (disp2 < 0)
@@ -263,11 +275,11 @@ static int walls_moved(const dem_scene *s, double lim)
     return 0;
 }
 
-static core_status forces_distributed(dem_scene *s, double dt, core_error *err)
+static core_status forces_distributed(dem_scene *s, double dt, double disp2, core_error *err)
 {
     const double lim = 0.25 * s->skin * s->skin;
     int need = s->need_rebuild || !s->pairs.start || walls_moved(s, lim) ||
-               dem_domain_displacement2(s) > lim;
+               (disp2 < 0 ? max_displacement2(s) : disp2) > lim;
     core_status st;
     if (comm_any(need)) {
         if ((st = dem_domain_rebuild(s, err))) {
@@ -359,32 +371,46 @@ static void advance_angles(dem_scene *s, double dt)
         a[i] += dt * w[i];
 }
 
+/* The fused 2D pass: kick, drift, domain flag, displacement since the build (of owned particles
+ * only when gh, the ghost flags, is given: a constant where this is inlined). */
+static inline __attribute__((always_inline)) double
+kick_drift_2d(dem_scene *s, double h, double dt, const unsigned char *restrict gh)
+{
+    const long n = (long)s->n;
+    const double *restrict im = s->inv_m;
+    int out = 0;
+    double *restrict x = s->x[0], *restrict y = s->x[1];
+    double *restrict vx = s->v[0], *restrict vy = s->v[1];
+    const double *restrict fx = s->f[0], *restrict fy = s->f[1];
+    const double *restrict xb = s->x_build[0], *restrict yb = s->x_build[1];
+    const double xlo = s->periodic[0] ? -DBL_MAX : s->lo[0];
+    const double xhi = s->periodic[0] ? DBL_MAX : s->hi[0];
+    const double ylo = s->periodic[1] ? -DBL_MAX : s->lo[1];
+    const double yhi = s->periodic[1] ? DBL_MAX : s->hi[1];
+    double m = 0;
+#pragma omp parallel for schedule(static) reduction(| : out) reduction(max : m) if (n > 4096)
+    for (long i = 0; i < n; i++) {
+        vx[i] += h * fx[i] * im[i];
+        vy[i] += h * fy[i] * im[i];
+        x[i] += dt * vx[i];
+        y[i] += dt * vy[i];
+        out |= (x[i] < xlo) | (x[i] > xhi) | (y[i] < ylo) | (y[i] > yhi);
+        double ex = x[i] - xb[i], ey = y[i] - yb[i], d2 = ex * ex + ey * ey;
+        if (gh && gh[i])
+            d2 = 0;
+        m = d2 > m ? d2 : m;
+    }
+    s->suspect |= out;
+    return m;
+}
+
 static double kick_drift(dem_scene *s, double h, double dt)
 {
     const long n = (long)s->n;
     const double *restrict im = s->inv_m;
     int out = 0;
-    if (s->dim == 2) { /* one fused pass: kick, drift, domain flag, displacement since the build */
-        double *restrict x = s->x[0], *restrict y = s->x[1];
-        double *restrict vx = s->v[0], *restrict vy = s->v[1];
-        const double *restrict fx = s->f[0], *restrict fy = s->f[1];
-        const double *restrict xb = s->x_build[0], *restrict yb = s->x_build[1];
-        const double xlo = s->periodic[0] ? -DBL_MAX : s->lo[0];
-        const double xhi = s->periodic[0] ? DBL_MAX : s->hi[0];
-        const double ylo = s->periodic[1] ? -DBL_MAX : s->lo[1];
-        const double yhi = s->periodic[1] ? DBL_MAX : s->hi[1];
-        double m = 0;
-#pragma omp parallel for schedule(static) reduction(| : out) reduction(max : m) if (n > 4096)
-        for (long i = 0; i < n; i++) {
-            vx[i] += h * fx[i] * im[i];
-            vy[i] += h * fy[i] * im[i];
-            x[i] += dt * vx[i];
-            y[i] += dt * vy[i];
-            out |= (x[i] < xlo) | (x[i] > xhi) | (y[i] < ylo) | (y[i] > yhi);
-            double ex = x[i] - xb[i], ey = y[i] - yb[i], d2 = ex * ex + ey * ey;
-            m = d2 > m ? d2 : m;
-        }
-        s->suspect |= out;
+    if (s->dim == 2) {
+        double m = s->ghost ? kick_drift_2d(s, h, dt, s->ghost) : kick_drift_2d(s, h, dt, NULL);
         if (s->rot) {
             kick_rotation(s, h);
             advance_angles(s, dt);
@@ -697,7 +723,11 @@ static core_status run_steps(dem_scene *s, const dem_run_def *run, core_error *e
                 if (err)
                     *err = derr;
             }
-            if (!st) {
+            /* the checks in full when this rank's kicks flagged something, as on one rank
+             * (each rank decides alone: they make no collective call) */
+            int full = s->suspect || run->integrator == DEM_POSITION_VERLET ||
+                       run->integrator == DEM_GEAR5 || done + advance >= run->steps;
+            if (!st && full) {
                 size_t bad = check_finite(s);
                 if (bad != (size_t)-1)
                     st = unstable(s, dem_gid(s, bad), "has a non-finite position or velocity", err);
@@ -718,7 +748,7 @@ static core_status run_steps(dem_scene *s, const dem_run_def *run, core_error *e
          * the other integrators are checked in full every step. */
         int full = s->suspect || run->integrator == DEM_POSITION_VERLET ||
                    run->integrator == DEM_GEAR5 || done + advance >= run->steps;
-        if (full) {
+        if (full && !s->dom) { /* distributed: checked and agreed above */
             s->suspect = 0;
             size_t bad = check_finite(s);
             if (bad != (size_t)-1)

@@ -648,6 +648,23 @@ core_status dem_scale_stiffness(dem_scene *s, double factor, core_error *err)
     return CORE_OK;
 }
 
+core_status dem_set_gravity(dem_scene *s, const double g[3], core_error *err)
+{
+    for (int d = 0; d < 3; d++) {
+        if (!isfinite(g[d]) || fabs(g[d]) > 1e100)
+            return core_fail(err, CORE_ERR_ARG,
+                             "gravity component %d must be finite and at most 1e100 in magnitude, "
+                             "got %g", d + 1, g[d]);
+        if (d >= s->dim && g[d] != 0)
+            return core_fail(err, CORE_ERR_ARG, "gravity component %d must be 0 in %dD, got %g",
+                             d + 1, s->dim, g[d]);
+    }
+    for (int d = 0; d < 3; d++)
+        s->gravity[d] = g[d];
+    dem_invalidate(s, 0);
+    return CORE_OK;
+}
+
 core_status dem_set_drag(dem_scene *s, double rate, core_error *err)
 {
     if (!(rate >= 0) || !isfinite(rate))

@@ -136,19 +136,32 @@ core_status dsmc_domain_split(dsmc_scene *s, core_error *err)
 
 /* Sends every particle whose cell another rank owns (by s->cuts) to that rank and appends what
  * arrives. bcount (may be NULL) follows them. */
-static core_status migrate(dsmc_scene *s, size_t *bcount, core_error *err)
+/* Sends the particles outside this rank's cells [cell_lo, cell_hi) to their owners and takes
+ * in those that entered them. *bad in: this rank's flight found a non-finite particle (it then
+ * sends nothing); out: some rank's did (the particles that moved are all stored, nothing is
+ * lost, the caller stops the run). One all-to-all with the flags on its size exchange: a step
+ * has no other synchronisation between its flight and its collisions. The leavers' slots are
+ * filled from the end of the arrays, so only O(leavers) particles move (the arrays' order does
+ * not matter: the collisions take each cell in identity order); a compaction that kept the
+ * order moved every particle after the first leaver, 5% of a rank's step on Fig. 2's gas.
+ * *lost: particles received but not stored (out of memory growing the arrays): the caller
+ * agrees on it at its next reduction and stops. */
+static core_status migrate(dsmc_scene *s, size_t *bcount, int *bad, int64_t *lost,
+                           core_error *err)
 {
     const int K = comm_size(), D = s->D;
     const int sh = dsmc_sort_shift(s->ncells);
     const uint32_t lo = (uint32_t)s->cell_lo, hi = (uint32_t)s->cell_hi;
     const size_t rec = 2 * (size_t)D * sizeof(double) + 2 * sizeof(uint32_t);
     size_t *sb = calloc(4 * (size_t)K, sizeof *sb);
-    size_t *so = NULL, *rb = NULL, *ro = NULL;
+    if (!sb) /* 4 K words: the process cannot go on */
+        comm_abort(70);
     char *send = NULL;
     void *recv = NULL;
     core_status st = CORE_OK;
     size_t nleave = 0;
-    if (sb) {
+    *lost = 0;
+    if (!*bad) {
         for (size_t i = 0; i < s->n; i++) {
             uint32_t c = s->cell[i];
             if (c < lo || c >= hi) {
@@ -156,16 +169,11 @@ static core_status migrate(dsmc_scene *s, size_t *bcount, core_error *err)
                 nleave++;
             }
         }
-        send = malloc(nleave ? nleave * rec : 1);
     }
-    if (!comm_all(sb && send)) {
-        st = core_fail(err, CORE_ERR_NOMEM, "out of memory migrating particles between ranks");
-        goto done;
-    }
-    so = sb + K;
-    rb = sb + 2 * K;
-    ro = sb + 3 * K;
-    {
+    send = malloc(nleave ? nleave * rec : 1);
+    int64_t words[2] = {*bad != 0, send == NULL};
+    size_t *so = sb + K, *rb = sb + 2 * K, *ro = sb + 3 * K;
+    if (send && !*bad) {
         size_t acc = 0;
         for (int r = 0; r < K; r++) {
             so[r] = acc;
@@ -173,19 +181,11 @@ static core_status migrate(dsmc_scene *s, size_t *bcount, core_error *err)
             ro[r] = so[r]; /* fill cursor */
             sb[r] *= rec;
         }
-        size_t keep = 0;
-        for (size_t i = 0; i < s->n; i++) {
+        size_t n = s->n;
+        for (size_t i = 0; i < n;) {
             uint32_t c = s->cell[i];
             if (c >= lo && c < hi) {
-                if (keep != i) {
-                    for (int k = 0; k < D; k++) {
-                        s->x[k][keep] = s->x[k][i];
-                        s->v[k][keep] = s->v[k][i];
-                    }
-                    s->cell[keep] = c;
-                    s->id[keep] = s->id[i];
-                }
-                keep++;
+                i++;
                 continue;
             }
             int r = owner_of(s, c);
@@ -201,10 +201,26 @@ static core_status migrate(dsmc_scene *s, size_t *bcount, core_error *err)
             memcpy(p + sizeof(uint32_t), &c, sizeof(uint32_t));
             if (bcount)
                 bcount[c >> sh]--;
+            n--; /* the last particle takes the slot, and is examined next */
+            if (i < n) {
+                for (int k = 0; k < D; k++) {
+                    s->x[k][i] = s->x[k][n];
+                    s->v[k][i] = s->v[k][n];
+                }
+                s->cell[i] = s->cell[n];
+                s->id[i] = s->id[n];
+            }
         }
-        s->n = keep;
+        s->n = n;
+    } else {
+        memset(sb, 0, 2 * (size_t)K * sizeof *sb); /* takes part, sending nothing */
     }
-    if (comm_alltoallv(send, sb, so, &recv, rb, ro)) {
+    if (comm_alltoallv_max(send, sb, so, &recv, rb, ro, words, 2)) {
+        st = core_fail(err, CORE_ERR_NOMEM, "out of memory migrating particles between ranks");
+        goto done;
+    }
+    *bad = words[0] != 0;
+    if (words[1]) {
         st = core_fail(err, CORE_ERR_NOMEM, "out of memory migrating particles between ranks");
         goto done;
     }
@@ -212,10 +228,8 @@ static core_status migrate(dsmc_scene *s, size_t *bcount, core_error *err)
         size_t nin = 0;
         for (int r = 0; r < K; r++)
             nin += rb[r] / rec;
-        st = dsmc_reserve(s, s->n + nin, err);
-        if (!comm_all(st == CORE_OK)) {
-            if (st == CORE_OK)
-                st = core_fail(err, CORE_ERR_NOMEM, "out of memory on another rank");
+        if (dsmc_reserve(s, s->n + nin, err) != CORE_OK) {
+            *lost = (int64_t)nin;
             goto done;
         }
         const char *p = recv;
@@ -242,11 +256,15 @@ done:
     return st;
 }
 
-core_status dsmc_domain_migrate(dsmc_scene *s, size_t *bcount, core_error *err)
+core_status dsmc_domain_migrate(dsmc_scene *s, size_t *bcount, int *bad, int64_t *lost,
+                                core_error *err)
 {
-    if (!s->distributed)
+    *lost = 0;
+    if (!s->distributed) {
+        *bad = comm_any(*bad);
         return CORE_OK;
-    return migrate(s, bcount, err);
+    }
+    return migrate(s, bcount, bad, lost, err);
 }
 
 core_status dsmc_domain_balance(dsmc_scene *s, int64_t nmax, core_error *err)
@@ -291,8 +309,15 @@ core_status dsmc_domain_balance(dsmc_scene *s, int64_t nmax, core_error *err)
     cuts = NULL;
     s->balance_best = best;
     set_range(s);
-    if ((st = migrate(s, NULL, err)) == CORE_OK)
+    int bad = 0;
+    int64_t lost = 0;
+    if ((st = migrate(s, NULL, &bad, &lost, err)) == CORE_OK) {
+        if (lost)
+            st = core_fail(err, CORE_ERR_NOMEM,
+                           "out of memory storing %lld particles migrated while rebalancing",
+                           (long long)lost);
         dsmc_sort(s);
+    }
 done:
     free(mine);
     free(cuts);

@@ -79,8 +79,12 @@ int dsmc_resize(dsmc_scene *s, size_t cap);
 /* Cuts the replicated scene by blocks of cells, balanced by particle count; keeps this rank's. */
 core_status dsmc_domain_split(dsmc_scene *s, core_error *err);
 /* After a flight: particles whose cell another rank owns go there (bcount, the particles per
- * sort range, follows the leavers and the arrivals). */
-core_status dsmc_domain_migrate(dsmc_scene *s, size_t *bcount, core_error *err);
+ * sort range, follows the leavers and the arrivals). *bad: in, this rank's flight met a
+ * non-finite particle; out, some rank's did (agreed on the way; also when not distributed).
+ * *lost: particles this rank received and could not store (out of memory): the caller agrees
+ * on it at its next reduction. */
+core_status dsmc_domain_migrate(dsmc_scene *s, size_t *bcount, int *bad, int64_t *lost,
+                                core_error *err);
 /* Between steps: cuts again when the particles per rank drifted apart (nmax: the largest count). */
 core_status dsmc_domain_balance(dsmc_scene *s, int64_t nmax, core_error *err);
 /* Sum over blocks of per-block values (nper values each, blocks [blk_lo, blk_hi) given here, in

@@ -36,10 +36,13 @@ dsmc_run_def dsmc_default_run_def(void)
  * started from, and so on the decomposition over ranks: the collisions index each cell's
  * particles in identity order through a small permutation (cell_perm) instead, and the arrays
  * are put in that order only between runs (dsmc_order_cells), for everything that reads them.
- * The price of that independence, measured by callgrind against the code before identities
- * (flight, sort and collisions): +28% of the instructions on the cooling benchmark (20 per
- * cell: sorting 20 keys per cell), +14% on Herrmann's Fig. 2 gas (0.7 per cell); ordering the
- * arrays themselves every step cost +33% on the former. */
+ * The price of that independence, one process, one thread, against the code before identities
+ * (callgrind instructions; speed from 3 alternating runs each on a quiet machine): the cooling
+ * benchmark (20 per cell) +18% (642 M against 542 M for 10^5 particles x 20 steps: the ranks
+ * 68 M, the indirection in the collisions 18 M, the identities carried by the sort 6 M) and
+ * 0.87x the speed; Herrmann's Fig. 2 gas (0.7 per cell) +8% and 0.87x (the identities add a
+ * tenth to the bytes the sort moves). Ranks by an insertion sort cost +28% and 0.70-0.80x on
+ * the former (3 times the mispredicted branches), ordering the arrays every step +33%. */
 
 static inline __attribute__((always_inline)) void swap_particles(dsmc_scene *s, size_t i,
                                                                   size_t j)
@@ -118,25 +121,77 @@ static int cmp_u64(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-/* The identity order of a cell's N particles: P[k] = the slot (from the cell's first) of the
- * k-th smallest identity. key: N scratch entries. */
-static void cell_perm(const uint32_t *id, size_t N, uint64_t *key, uint32_t *P)
+typedef int32_t v4i32 __attribute__((vector_size(16)));
+
+/* The ranks of N <= 4 NQ identities, 4 comparisons at a time with the counters in registers
+ * (NQ is a constant: the compiler unrolls the inner loop). sid: the identities as ordered
+ * signed values, padded with INT32_MAX, which is below none. */
+static inline __attribute__((always_inline)) void rank_small(const v4i32 *sid, size_t N,
+                                                             uint32_t *P, const int NQ)
 {
+    v4i32 r[8];
+    for (int q = 0; q < NQ; q++)
+        r[q] = (v4i32){0, 0, 0, 0};
+    const int32_t *sp = (const int32_t *)sid;
+    for (size_t j = 0; j < N; j++) {
+        const int32_t y = sp[j];
+        for (int q = 0; q < NQ; q++)
+            r[q] -= y < sid[q]; /* true is -1 */
+    }
+    const int32_t *rp = (const int32_t *)r;
     for (size_t k = 0; k < N; k++)
-        key[k] = (uint64_t)id[k] << 32 | (uint64_t)k;
-    if (N > 64) {
-        qsort(key, N, sizeof *key, cmp_u64);
-    } else { /* identities are unique: no ties */
-        for (size_t k = 1; k < N; k++) {
-            uint64_t x = key[k];
-            size_t j = k;
-            for (; j > 0 && key[j - 1] > x; j--)
-                key[j] = key[j - 1];
-            key[j] = x;
+        P[rp[k]] = (uint32_t)k;
+}
+
+/* The identity order of a cell's N particles: P[k] = the slot (from the cell's first) of the
+ * k-th smallest identity. key: N scratch entries (cells of more than 32 only). Identities are
+ * unique, so in a small cell each particle's rank is the number of smaller identities: N^2
+ * comparisons without a branch, 4 at a time (GCC's vector extension: SSE2 on x86-64, NEON on
+ * arm64; signed, as SSE2 has no unsigned comparison: the top bit flipped keeps the order).
+ * Sorting the keys instead (an insertion sort: N^2/4 moves and a mispredicted branch per
+ * particle) cost 118 instructions per particle on the cooling benchmark (20 per cell), more
+ * than the collisions themselves. */
+static void cell_perm_big(const uint32_t *id, size_t N, uint64_t *key, uint32_t *P)
+{
+    if (N <= 32) {
+        v4i32 sid[8];
+        int32_t *sp = (int32_t *)sid;
+        const size_t nq = (N + 3) / 4;
+        for (size_t k = 0; k < N; k++)
+            sp[k] = (int32_t)(id[k] ^ 0x80000000u);
+        for (size_t k = N; k < 4 * nq; k++)
+            sp[k] = INT32_MAX;
+        switch (nq) {
+        case 1: rank_small(sid, N, P, 1); return;
+        case 2: rank_small(sid, N, P, 2); return;
+        case 3: rank_small(sid, N, P, 3); return;
+        case 4: rank_small(sid, N, P, 4); return;
+        case 5: rank_small(sid, N, P, 5); return;
+        case 6: rank_small(sid, N, P, 6); return;
+        case 7: rank_small(sid, N, P, 7); return;
+        default: rank_small(sid, N, P, 8); return;
         }
     }
     for (size_t k = 0; k < N; k++)
+        key[k] = (uint64_t)id[k] << 32 | (uint64_t)k;
+    qsort(key, N, sizeof *key, cmp_u64);
+    for (size_t k = 0; k < N; k++)
         P[k] = (uint32_t)key[k];
+}
+
+static inline void cell_perm(const uint32_t *id, size_t N, uint64_t *key, uint32_t *P)
+{
+    if (N > 4) {
+        cell_perm_big(id, N, key, P);
+        return;
+    }
+    /* most cells of a dilute gas (Fig. 2's: 0.7 per cell): in place, without a call */
+    for (size_t k = 0; k < N; k++) {
+        uint32_t r = 0, x = id[k];
+        for (size_t j = 0; j < N; j++)
+            r += id[j] < x;
+        P[r] = (uint32_t)k;
+    }
 }
 
 /* Puts the particles [a, a + N) of one cell in identity order, through a buffer (an insertion
@@ -198,7 +253,9 @@ static void order_cell(dsmc_scene *s, size_t a, size_t N)
         memcpy(A, tmp, N * sizeof *tmp);
     }
     for (size_t k = 0; k < N; k++)
-        id[k] = (uint32_t)(key[k] >> 32);
+        key[k] = id[P[k]];
+    for (size_t k = 0; k < N; k++)
+        id[k] = (uint32_t)key[k];
     free(heap);
 }
 
@@ -375,7 +432,7 @@ flight_dim(dsmc_scene *s, const flight_consts *fc, size_t bcount[DSMC_SORT_BLOCK
             V[k][i] = v[k];
             chk += x[k] + v[k];
             double f = (x[k] - lo[k]) * ih[k];
-            int ci = f < 0 ? 0 : f >= nc[k] ? nc[k] - 1 : (int)f;
+            int ci = !(f >= 0) ? 0 : f >= nc[k] ? nc[k] - 1 : (int)f; /* NaN: 0 */
             c = c * (size_t)nc[k] + (size_t)ci;
         }
         bad |= !isfinite(chk);
@@ -415,6 +472,7 @@ static flight_totals flight(dsmc_scene *s, double dt, size_t bcount[DSMC_SORT_BL
 /* ---- collisions (Eq. 1) ----------------------------------------------------------------------- */
 typedef struct collide_totals {
     long attempts, collisions, raised, overpacked;
+    long overflow; /* cells whose number of candidates was not a number (speeds overflowed) */
 } collide_totals;
 
 /* Post-collision velocities: the normal component of g = v_i - v_j reversed and scaled by e, the
@@ -479,9 +537,9 @@ static collide_totals collide(dsmc_scene *s, double dt)
     const double vb = s->vpart, rcp = s->def.packing_limit;
     const dsmc_excluded excl = s->def.excluded;
     const uint64_t seed = s->def.seed, step = (uint64_t)s->steps;
-    long attempts = 0, collisions = 0, raised = 0, overpacked = 0;
+    long attempts = 0, collisions = 0, raised = 0, overpacked = 0, overflow = 0;
 #pragma omp parallel for schedule(dynamic, 64) \
-    reduction(+ : attempts, collisions, raised, overpacked) if (s->n >= DSMC_PARALLEL_MIN)
+    reduction(+ : attempts, collisions, raised, overpacked, overflow) if (s->n >= DSMC_PARALLEL_MIN)
     for (long c = c_lo; c < nc; c++) {
         size_t a = start[c], N = start[c + 1] - a;
         if (N < 2)
@@ -543,6 +601,11 @@ static collide_totals collide(dsmc_scene *s, double dt)
                          : (1 - nu / 2) / ((1 - nu) * (1 - nu) * (1 - nu));
         }
         double M = Nd * (Nd - 1) * base * vmax * chi / Veff + rem[c];
+        if (!(M < 1e15)) { /* speeds near the overflow (or not finite): the step fails */
+            overflow++;
+            free(heap);
+            continue;
+        }
         double Mi = floor(M);
         rem[c] = M - Mi;
         long m = (long)Mi;
@@ -595,10 +658,18 @@ static collide_totals collide(dsmc_scene *s, double dt)
         }
         free(heap);
     }
-    return (collide_totals){attempts, collisions, raised, overpacked};
+    return (collide_totals){attempts, collisions, raised, overpacked, overflow};
 }
 
 /* ---- the run ---------------------------------------------------------------------------------- */
+static core_status overflow_error(const dsmc_scene *s, core_error *err)
+{
+    return core_fail(err, CORE_ERR_UNSTABLE,
+                     "step %ld (t = %.6g s): a cell's number of collision candidates overflowed "
+                     "(relative speeds near the largest double): the time step or the speeds "
+                     "are out of range", s->steps - 1, s->t);
+}
+
 core_status dsmc_run(dsmc_scene *s, const dsmc_run_def *run, long *done, core_error *err)
 {
     *done = 0;
@@ -619,14 +690,28 @@ core_status dsmc_run(dsmc_scene *s, const dsmc_run_def *run, long *done, core_er
     long nsteps = 0;
     double tsum = 0;
     bool sorted = true;
+    int64_t lost = 0;     /* particles this rank could not store at the last migration */
+    int64_t overflow = 0; /* cells of the last step whose collision count overflowed */
     while (*done < run->steps) {
         if (run->time_end >= 0 && s->t >= run->time_end * (1 - 1e-14))
             break;
         int intr = interrupt_pending();
         if (multi) {
-            int64_t q[2] = {intr, (int64_t)s->n};
-            comm_max_i64(q, 2);
+            int64_t q[4] = {intr, (int64_t)s->n, lost, overflow};
+            comm_max_i64(q, 4);
             intr = q[0] != 0;
+            if (q[3]) {
+                st = overflow_error(s, err);
+                break;
+            }
+            if (q[2]) {
+                st = core_fail(err, CORE_ERR_NOMEM,
+                               "step %ld: out of memory on a rank storing %lld particles that "
+                               "migrated to it; the scene is incomplete", s->steps - 1,
+                               (long long)q[2]);
+                sorted = false;
+                break;
+            }
             if (!intr && (st = dsmc_domain_balance(s, q[1], err))) {
                 sorted = false; /* out of memory, maybe in the middle of a migration */
                 break;
@@ -644,20 +729,27 @@ core_status dsmc_run(dsmc_scene *s, const dsmc_run_def *run, long *done, core_er
         size_t bcount[DSMC_SORT_BLOCKS];
         flight_totals ft = flight(s, dt, bcount);
         sorted = false;
-        if (multi ? comm_any(ft.bad) : ft.bad) {
+        int bad = ft.bad;
+        /* one synchronisation between flight and collisions: the migration, with the verdict */
+        if (multi && (st = dsmc_domain_migrate(s, bcount, &bad, &lost, err)))
+            break;
+        if (bad) {
             st = core_fail(err, CORE_ERR_UNSTABLE,
                            "step %ld (t = %.6g s): a particle's position or velocity is not "
                            "finite", s->steps, s->t);
             break;
         }
-        if (multi && (st = dsmc_domain_migrate(s, bcount, err)))
-            break;
         dsmc_sort_counted(s, bcount);
         sorted = true;
         collide_totals ct = collide(s, dt);
         s->t += dt;
         s->steps++;
         ++*done;
+        overflow = ct.overflow; /* several ranks: agreed at the next reduction */
+        if (!multi && overflow) {
+            st = overflow_error(s, err);
+            break;
+        }
         nsteps++;
         tsum += dt;
         cnt[0] += (int64_t)s->n;
@@ -677,12 +769,19 @@ core_status dsmc_run(dsmc_scene *s, const dsmc_run_def *run, long *done, core_er
     /* summed: CPU of all ranks, bytes and messages they sent; the slowest: wall time, time in
      * communication, particles held (the imbalance) */
     double sum[3] = {cpu, cs1.bytes - cs0.bytes, cs1.messages - cs0.messages};
-    double most[3] = {wall, cs1.seconds - cs0.seconds, (double)s->n};
+    double most[5] = {wall, cs1.seconds - cs0.seconds, (double)s->n, (double)lost,
+                      (double)overflow};
     if (s->distributed) {
         comm_sum_i64(cnt, 6);
         comm_sum_double(sum, 3);
-        comm_max_double(most, 3);
+        comm_max_double(most, 5);
     }
+    if (s->distributed && st == CORE_OK && most[4] > 0) /* at the last step */
+        st = overflow_error(s, err);
+    if (most[3] > 0 && st == CORE_OK)
+        st = core_fail(err, CORE_ERR_NOMEM,
+                       "out of memory on a rank storing %.0f particles that migrated to it; "
+                       "the scene is incomplete", most[3]);
     cpu = sum[0];
     wall = most[0];
     s->stats.comm_bytes += sum[1];

@@ -942,6 +942,28 @@ static int l_drag(lua_State *L)
     return 1;
 }
 
+/* s:gravity([{gx, gy[, gz]}]): sets gravity when given; returns it. */
+static int l_gravity(lua_State *L)
+{
+    dem_scene *s = check_scene(L, 1);
+    const int D = dem_dim(s);
+    if (!lua_isnoneornil(L, 2)) {
+        double g[3] = {0, 0, 0};
+        bind_arg_vector(L, 2, "gravity", D, g);
+        core_error err;
+        if (dem_set_gravity(s, g, &err))
+            return bind_raise(L, "gravity", &err);
+    }
+    double lo[3], hi[3], g[3];
+    dem_box(s, lo, hi, g);
+    lua_createtable(L, D, 0);
+    for (int d = 0; d < D; d++) {
+        lua_pushnumber(L, g[d]);
+        lua_rawseti(L, -2, d + 1);
+    }
+    return 1;
+}
+
 /* s:set_forces{ ids = {...}, fx = {...}, fy = {...}[, fz = {...}] } */
 static const char *const FORCES_FIELDS[] = {"ids", "fx", "fy", "fz", NULL};
 
@@ -1200,6 +1222,9 @@ void bind_open_dem(lua_State *L)
         {"drag", l_drag, "s:drag([rate])",
          "Background drag -rate m v (and -rate I omega) on every particle, for settling samples; "
          "0 switches it off. Returns the rate."},
+        {"gravity", l_gravity, "s:gravity([{gx, gy}])",
+         "Sets gravity (m/s^2) when given, from the next step on: a tilted box is a rotated "
+         "gravity (scripts/marginal_stability.lua). Returns it."},
         {"set_forces", l_set_forces, "s:set_forces{ ids = {...}, fx = {...}, fy = {...} }",
          "External forces (N) on the listed particles, applied every step until changed or "
          "cleared (pressure boundary conditions applied as particle forces)."},

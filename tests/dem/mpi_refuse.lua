@@ -17,21 +17,33 @@ else
 end
 print("ok")
 
+-- A row of 20 disks on the floor of a 20 x 10 mm box with the walls given, disk `k` (0-based)
+-- launched along x at `speed`; the run must stop with an error containing `expect` at the same
+-- step on every rank. Returns the error and the step, as text (every rank checks rank 0's).
+local function stops(walls, k, speed, steps, expect)
+  local sc = dem.scene{ dim = 2, box = { { 0, 0 }, { 0.02, 0.01 } } }
+  for _, w in ipairs(walls) do sc:add_wall{ point = w[1], normal = w[2] } end
+  for q = 0, 19 do
+    sc:add_disk{ pos = { 0.0007 + q * 0.00095, 0.001 }, radius = 0.0004, material = m,
+                 vel = { q == k and speed or 0, 0 } }
+  end
+  local ok, err = pcall(sc.run, sc, { steps = steps, dt = 2e-7, force = true })
+  assert(not ok, "the run went ahead: " .. expect)
+  assert(tostring(err):find(expect, 1, true), err)
+  local mine = tostring(err) .. "\n" .. sc:info().steps .. "\n"
+  assert(grainlab.mpi.bcast(mine) == mine, "rank " .. grainlab.mpi.rank() .. " stopped otherwise than rank 0")
+  return mine
+end
+
 -- An instability found by one rank (a particle through a wall, checked by its owner only) stops
 -- every rank at the same step with the one-rank message, without a hang.
-local t = dem.scene{ dim = 2, box = { { 0, 0 }, { 0.02, 0.01 } } }
-t:add_wall{ point = { 0, 0 }, normal = { 0, 1 } }
-t:add_wall{ point = { 0.02, 0 }, normal = { -1, 0 } }
-t:add_wall{ point = { 0, 0 }, normal = { 1, 0 } }
-t:add_wall{ point = { 0, 0.01 }, normal = { 0, -1 } }
-for k = 0, 19 do
-  t:add_disk{ pos = { 0.0007 + k * 0.00095, 0.001 }, radius = 0.0004, material = m,
-              vel = { k == 17 and 400 or 0, 0 } }
-end
-local ok2, err2 = pcall(t.run, t, { steps = 200, dt = 2e-7, force = true })
-assert(not ok2, "the run through the wall went ahead")
-local mine = tostring(err2) .. "\n" .. t:info().steps .. "\n"
-assert(grainlab.mpi.bcast(mine) == mine, "rank " .. grainlab.mpi.rank() .. " stopped otherwise than rank 0")
+local mine = stops({ { { 0, 0 }, { 0, 1 } }, { { 0.02, 0 }, { -1, 0 } }, { { 0, 0 }, { 1, 0 } },
+                     { { 0, 0.01 }, { 0, -1 } } }, 17, 400, 200, "went through a wall")
+-- A particle leaving through a side with no wall (not periodic): its owner's kicks flag it, the
+-- full checks find it, and every rank stops at the one-rank step with the one-rank message (the
+-- checks run only on the rank whose kicks flagged something, as on one rank).
+local mine3 = stops({ { { 0, 0 }, { 0, 1 } }, { { 0, 0 }, { 1, 0 } } }, 18, 60, 400, "left the domain")
+
 local f = assert(io.open((params.out or "refuse") .. ".0", "w")) -- rank 0 writes it
-f:write(mine)
+f:write(mine .. mine3)
 f:close()

@@ -148,6 +148,7 @@ local calls = {
   ["dem.scene:info"] = { setup = scene2, self = self },
   ["dem.scene:scale_mass"] = { setup = scene2, self = self, args = function() return { 2 } end, pos = { {} } },
   ["dem.scene:scale_stiffness"] = { setup = scene2, self = self, args = function() return { 2 } end, pos = { {} } },
+  ["dem.scene:gravity"] = { setup = scene2, self = self, args = function() return { { 0, -9.81 } } end, pos = { { "nil" } } },
   ["dem.scene:drag"] = { setup = scene2, self = self, args = function() return { 1 } end, pos = { { "nil", "zero" } } },
   ["dem.scene:set_forces"] = {
     setup = scene2, self = self, opts = 1,

@@ -94,6 +94,16 @@ run 3 -e 'if grainlab.mpi.rank() == 1 then os.exit(0) end grainlab.mpi.barrier()
 [ "$rc" -ne 0 ] && [ "$rc" -ne 124 ] && ok || bad "lone os.exit: nonzero status, no timeout"
 count "grainlab: rank 1 ended alone" 1 lone-os.exit
 unset GRAINLAB_MPI_ERROR_WAIT
+# the MPI module cannot be loaded: the rank says which and why, status 70, no hang
+GRAINLAB_MPI_MODULE=/nonexistent/grainlab-mpi.so run 2 -e 'print("ran")'
+expect_rc 70 no-module; lacks ran no-module
+# (mpirun may end the second rank before it speaks: at least one says it)
+case "$err" in *"could not be loaded"*"/nonexistent/grainlab-mpi.so: cannot open"*) ok ;;
+  *) bad "no-module: the module and the reason named" ;; esac
+# a plain run does not load MPI at all (the module and libmpi stay out of the process)
+out=$("$G" -e 'local f = io.open("/proc/self/maps") local m = f:read("a") f:close()
+  print(m:find("libmpi", 1, true) and "mpi loaded" or "no mpi")' 2>&1); rc=$?
+case "$out" in "no mpi") ok ;; *) err=""; bad "plain run: $out" ;; esac
 # a failed report check: once
 run 2 -e 'grainlab.report{ scenario = "f", checks = { { name = "c", value = 2, limit = 1 } } }'
 expect_rc 1 report-check; count "1 report check failed" 1 report-check
