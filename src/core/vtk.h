@@ -30,6 +30,7 @@ typedef enum vtk_section {
 enum {
     VTK_CELL_VERTEX = 1,
     VTK_CELL_LINE = 3,
+    VTK_CELL_POLY_LINE = 4,
     VTK_CELL_TRIANGLE = 5,
     VTK_CELL_POLYGON = 7,
     VTK_CELL_QUAD = 9

@@ -307,6 +307,9 @@ core_status dem_tie_to_wall(dem_scene *s, size_t i, int wall, int axis, core_err
         return core_fail(err, CORE_ERR_ARG, "particle %zu does not exist (1..%zu)", i + 1, s->n);
     if (wall < 0 || wall >= s->nwalls || !s->walls[wall].active)
         return core_fail(err, CORE_ERR_ARG, "wall %d does not exist", wall + 1);
+    if (s->walls[wall].shape)
+        return core_fail(err, CORE_ERR_ARG, "wall %d is not a plane: ties follow planes only",
+                         wall + 1);
     if (axis < 0 || axis >= s->dim)
         return core_fail(err, CORE_ERR_ARG, "axis must be 1..%d, got %d", s->dim, axis + 1);
     core_status st = ensure(s, err);

@@ -202,6 +202,11 @@ static core_status write_scene(const dem_scene *s, ckpt_writer *w, core_error *e
     }
     if ((st = end(w, err)))
         return st;
+    int shaped = 0; /* walls beyond planes: their own section, absent from a scene without them */
+    for (int k = 0; k < s->nwalls; k++)
+        shaped |= s->walls[k].shape != NULL;
+    if (shaped && (st = dem_shapes_save(s, w, err)))
+        return st;
 
     /* The Verlet list as built, with what each pair carries between steps. */
     const dem_pairs *p = &s->pairs;
@@ -224,7 +229,9 @@ static core_status write_scene(const dem_scene *s, ckpt_writer *w, core_error *e
         return st;
     if (uses_rolling(s) && (st = write_rolling(s, w, err)))
         return st;
-    return s->bnd ? dem_boundary_save(s, w, err) : CORE_OK;
+    if (s->bnd && (st = dem_boundary_save(s, w, err)))
+        return st;
+    return s->flow ? dem_flow_save(s, w, err) : CORE_OK;
 }
 
 core_status dem_save(const dem_scene *s, const char *path, const char *version, core_error *err)
@@ -716,6 +723,11 @@ static void read_all(reader *r, ckpt_reader *ck, const dem_boundary_restorer *re
                 bad(r, "wall candidate out of range");
     }
     close_section(r);
+    if (!r->st && ckpt_has(ck, "wall_shapes")) {
+        open_section(r, ck, "wall_shapes");
+        if (!r->st)
+            r->st = dem_shapes_load(s, &r->sec, r->err);
+    }
 
     open_section(r, ck, "pairs");
     read_pairs(r, s);
@@ -734,6 +746,12 @@ static void read_all(reader *r, ckpt_reader *ck, const dem_boundary_restorer *re
         open_section(r, ck, "boundary_update");
         if (!r->st)
             r->st = dem_boundary_load_update(s, &r->sec, restorer, r->err);
+    }
+    if (!r->st && ckpt_has(ck, "flow")) { /* inserters and outflows (flow.c) */
+        open_section(r, ck, "flow");
+        if (!r->st)
+            r->st = dem_flow_load(s, &r->sec, r->err);
+        close_section(r);
     }
     const char *wrong = r->st ? NULL : inconsistent(s, gear_ready, prev_ready, need_rebuild);
     if (wrong)

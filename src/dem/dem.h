@@ -21,7 +21,7 @@ typedef struct dem_scene dem_scene;
 typedef struct dem_scene_def {
     int dim;              /* 2 (disks) or 3 (spheres) */
     double lo[3], hi[3];  /* the domain: a particle leaving it on an axis that is not periodic
-                           * stops the run with an error */
+                           * stops the run with an error (unless an outflow opens that side) */
     bool periodic[3];
     double gravity[3];    /* m/s^2 */
     /* 2D only: > 0 makes disks cylinders of this thickness (m = rho pi r^2 t, I = m r^2 / 2);
@@ -178,7 +178,8 @@ typedef struct dem_wall_def {
 int dem_add_wall(dem_scene *s, const dem_wall_def *w, core_error *err); /* wall id or -1 */
 core_status dem_remove_wall(dem_scene *s, int id, core_error *err);
 core_status dem_set_wall_velocity(dem_scene *s, int id, const double v[3], core_error *err);
-/* Wall slots (removed walls keep their id); geometry of wall id now, *active = 0 if removed. */
+/* Wall slots (removed walls keep their id); geometry of wall id now, *active = 0 if removed or
+ * not a plane (dem_wall_outline draws the others). */
 int dem_wall_count(const dem_scene *s);
 core_status dem_wall_geometry(const dem_scene *s, int id, double point[3], double normal[3],
                               int *active, core_error *err);
@@ -193,6 +194,59 @@ core_status dem_wall_force(const dem_scene *s, int id, double *fn, core_error *e
  * the mass filters the contact noise. mass = 0 switches it off (the wall keeps its velocity). */
 core_status dem_wall_servo(dem_scene *s, int id, double force, double mass, double rate,
                            core_error *err);
+
+/* ---- walls beyond planes (walls.c) --------------------------------------------------------- *
+ * Segments and polylines (2D), triangles and triangle meshes (3D), circles (2D) and cylinders (3D,
+ * infinite or finite along their axis, open at the ends), with the particles inside (a drum) or
+ * outside (a post). A particle's contact is at the closest point of the wall's surface, edges and
+ * end points included; on a polyline or mesh each element in contact gives a hit, and a hit whose
+ * closest point is an end point, vertex or edge is dropped when another element sharing that
+ * feature is as close (ties: the lower element index keeps it), so a particle on a shared vertex
+ * or edge feels one force, while one in a concave corner feels both faces. At most
+ * DEM_WALL_MAXHIT hits per particle and wall (the closest). Walls are two-sided except cylinders.
+ * The stiffness is the flat-wall one (R* = the particle radius) whatever the wall's curvature.
+ * Each such wall moves as a rigid body: its centre translates at `velocity` and it turns at
+ * `omega` about the centre (2D: omega[2]), constants or a piecewise-linear table of the scene time
+ * (held at the end values outside it), sampled by the step itself (no callback in the step). */
+enum { DEM_WALL_MAXHIT = 4 };
+
+typedef enum dem_wall_kind {
+    DEM_WALL_PLANE,     /* dem_add_wall */
+    DEM_WALL_SEGMENTS,  /* 2D: a polyline of n points (n - 1 segments; n with closed) */
+    DEM_WALL_TRIANGLES, /* 3D: n triangles (a mesh: vertices shared by equal coordinates) */
+    DEM_WALL_CYLINDER   /* 2D circle, 3D cylinder */
+} dem_wall_kind;
+
+typedef struct dem_shape_def {
+    dem_wall_kind kind;
+    size_t n;             /* SEGMENTS: points; TRIANGLES: triangles */
+    const double *points; /* SEGMENTS: 3 n (x, y, ignored); TRIANGLES: 9 n (three corners) */
+    int closed;           /* SEGMENTS: the last point joins the first */
+    int has_center;       /* 0: the mean of the points (SEGMENTS, TRIANGLES) */
+    double center[3];     /* centre of rotation, of the torque and (CYLINDER) of the cylinder */
+    double radius;        /* CYLINDER */
+    double axis[3];       /* CYLINDER, 3D */
+    double length;        /* CYLINDER, 3D: 0 = infinite */
+    int inside;           /* CYLINDER: the particles are inside (1) or outside (0) */
+    double velocity[3], omega[3]; /* constant motion (2D: omega[2] only) */
+    size_t nmotion;       /* > 0: the motion table instead, nmotion rows of 7: t, v[3], omega[3] */
+    const double *motion; /* times strictly increasing */
+    double friction;      /* < 0: the smaller of the particle's and the wall material's */
+    int material;         /* < 0: the particle's material */
+} dem_shape_def;
+
+dem_shape_def dem_default_shape_def(void); /* inside, no motion, no friction override */
+int dem_add_shape_wall(dem_scene *s, const dem_shape_def *def, core_error *err); /* id or -1 */
+dem_wall_kind dem_wall_kind_of(const dem_scene *s, int id); /* PLANE for a bad id */
+/* The force the particles exert on the wall (N, the reaction of the contact forces) and its
+ * torque about the wall's centre at the last force evaluation. Planes: the normal part only,
+ * -fn normal, and no torque (they have no centre). */
+core_status dem_wall_load(const dem_scene *s, int id, double force[3], double torque[3],
+                          core_error *err);
+/* The wall's surface now as line strips (2D: polylines; 3D: polygons): nv[k] points of strip k
+ * follow each other in pts (3 per point). Returns the number of strips, 0 for planes; NULL arrays
+ * just count (*npts gets the points). Cylinders: `segments` points around. */
+int dem_wall_outline(const dem_scene *s, int id, int segments, int *nv, double *pts, size_t *npts);
 
 /* ---- time stepping ------------------------------------------------------------------------- */
 typedef enum dem_integrator {
@@ -499,5 +553,68 @@ core_status dem_load_with(const char *path, const dem_boundary_restorer *restore
                           core_error *err);
 /* dem_load_with without a restorer. */
 core_status dem_load(const char *path, dem_scene **out, core_error *err);
+
+/* ---- particles in and out during a run (flow.c) --------------------------------------------- *
+ * Inserters add particles in a region (a box, or a disk/ball) at a rate or up to a count or a
+ * mass, with a size distribution and a velocity, at positions drawn from the inserter's own
+ * random stream (core/rng.h; serial, so the same seed gives the same bits for any thread count)
+ * and never overlapping a particle or a wall: each particle gets `attempts` positions; one that
+ * finds no free place is skipped and counted. Outflows remove the particles whose centre enters a
+ * box (fixed particles excepted), or that leave the domain through an open side (a side that is
+ * not periodic; without an outflow on it, a particle leaving the domain stops the run, as LAMMPS's
+ * "lost atoms"). Removed particles are counted, with their mass, per outflow. Ids (indices) of
+ * the particles after a removed one shift down by one; dem_tags gives each particle a number that
+ * never changes (the index it had when the first inserter or outflow was added, or the order of
+ * its creation after that). Both act between steps; a scene without them does no extra work. Not
+ * distributed: a run on more than one rank is refused. */
+typedef enum dem_size_law {
+    DEM_SIZE_CONSTANT, /* radius r0 */
+    DEM_SIZE_UNIFORM,  /* radius uniform in [r0, r1] */
+    DEM_SIZE_DISCRETE  /* radii[k] with probability weights[k] / sum(weights) */
+} dem_size_law;
+
+typedef struct dem_inserter_def {
+    int ball; /* 0: the box [lo, hi]; 1: the disk (2D) or ball (3D) center, extent */
+    double lo[3], hi[3];
+    double center[3], extent;
+    double rate; /* particles per second (0: everything due at the first event) */
+    long count;  /* total to insert (< 0: no limit; needs a rate or a mass) */
+    double mass; /* total mass to insert, kg (<= 0: no limit): stops once reached */
+    dem_size_law size;
+    double r0, r1;
+    size_t nsizes; /* DISCRETE: radii and weights (copied) */
+    const double *radii, *weights;
+    double velocity[3]; /* each particle: velocity + spread * uniform(-1, 1) per component */
+    double spread;
+    int material;
+    unsigned long long seed;
+    long every;   /* steps between insertion events (>= 1) */
+    int attempts; /* positions tried per particle (>= 1) */
+} dem_inserter_def;
+
+/* box of zero size, rate 0, count -1, no mass limit, constant radius 0, every 1, 50 attempts */
+dem_inserter_def dem_default_inserter_def(void);
+/* The inserter id (>= 0), or -1 with err filled. Its first event is at the next step boundary
+ * (the start of the next run); a rate counts from the scene's time now. */
+int dem_add_inserter(dem_scene *s, const dem_inserter_def *def, core_error *err);
+
+typedef struct dem_outflow_def {
+    int side; /* -1: the box [lo, hi]; else 2 axis + (0 lower, 1 upper side) */
+    double lo[3], hi[3];
+} dem_outflow_def;
+int dem_add_outflow(dem_scene *s, const dem_outflow_def *def, core_error *err);
+
+typedef struct dem_flow_counts {
+    long count;   /* inserted (inserters) or removed (outflows) so far */
+    double mass;  /* their mass, kg */
+    long skipped; /* inserters: particles due that found no free place */
+    long events;  /* inserters: insertion events that had particles due */
+} dem_flow_counts;
+int dem_inserter_count(const dem_scene *s);
+int dem_outflow_count(const dem_scene *s);
+core_status dem_inserter_counts(const dem_scene *s, int id, dem_flow_counts *out, core_error *err);
+core_status dem_outflow_counts(const dem_scene *s, int id, dem_flow_counts *out, core_error *err);
+/* Stable particle numbers (0-based), NULL until the first inserter or outflow. */
+const double *dem_tags(const dem_scene *s);
 
 #endif

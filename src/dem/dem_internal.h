@@ -17,6 +17,9 @@
 #define DEM_HIST 7
 #define DEM_HIST_ROLL 4
 
+typedef struct dem_shape dem_shape; /* walls beyond planes (walls.c) */
+enum { DEM_SHAPE_LOAD = 7 };        /* per candidate: force[3], torque[3], f_n */
+
 typedef struct dem_wall {
     int active;
     double point[3], normal[3], velocity[3];
@@ -30,6 +33,7 @@ typedef struct dem_wall {
     double fn;             /* normal force the wall exerts on the particles, last evaluation */
     int servo;             /* force-controlled: the wall is a damped body pushed with servo_force */
     double servo_force, servo_mass, servo_rate;
+    dem_shape *shape; /* NULL: a plane (point, normal); else its geometry and motion */
 } dem_wall;
 
 /* The Verlet list: pairs (i < j) closer than r_i + r_j + skin at the last build, sorted by i then
@@ -93,6 +97,7 @@ struct dem_scene {
 
     dem_wall *walls;
     int nwalls, cap_walls;
+    int nshaped; /* walls beyond planes (walls.c): 0 keeps every step on the planes' path */
 
     dem_pairs pairs;
     int need_rebuild;
@@ -109,6 +114,8 @@ struct dem_scene {
     long tt_phase;
 
     struct dem_boundary *bnd; /* boundary conditions (boundary.c); NULL when none */
+    struct dem_flow *flow;    /* inserters and outflows (flow.c); NULL when none */
+    double *tag;              /* stable particle numbers (flow.c); NULL until flow is used */
 
     /* Distributed runs (domain.c): NULL on one rank and whenever the scene is replicated. While
      * decomposed, the arrays above hold this rank's owned particles and its ghosts (copies of
@@ -156,7 +163,37 @@ size_t dem_domain_bundle(const dem_scene *s, size_t i, const uint32_t **gj, cons
 /* The global id (1-based in messages: + 1) of local particle i. */
 static inline size_t dem_gid(const dem_scene *s, size_t i) { return s->gid ? s->gid[i] : i; }
 
+/* Every per-particle array of s->cap entries the scene has now (domain.c): the table a
+ * migration, a gather and a removal (flow.c) go through. a[] needs dem_max_particle_arrays. */
+typedef struct dem_parray {
+    void **p;
+    size_t size;
+} dem_parray;
+int dem_particle_arrays(dem_scene *s, dem_parray *a);
+int dem_max_particle_arrays(const dem_scene *s);
+
+/* flow.c: inserters and outflows, between steps (dem_run calls dem_flow_step before the first
+ * step and after every step when s->flow is set): removal, then insertion, keeping every
+ * per-particle array, the pair list with its history and the integrators' state consistent. */
+typedef struct dem_flow dem_flow;
+/* step: the steps completed (the step is counted after the checks that follow this call). */
+core_status dem_flow_step(dem_scene *s, long step, core_error *err);
+/* What a run must refuse (more than one rank; removal with boundary conditions). */
+core_status dem_flow_check_run(const dem_scene *s, core_error *err);
+/* The scene may start a run without particles: an inserter will bring them. */
+int dem_flow_inserting(const dem_scene *s);
+/* The smallest particle inserter q can make (for the stable step): its k and gamma against
+ * itself and the effective mass; 0 when q does not exist. */
+int dem_flow_probe(dem_scene *s, int q, double *k, double *gamma, double *m_eff);
+void dem_flow_tag_new(dem_scene *s, size_t i); /* a particle was appended: its tag */
+void dem_flow_free(dem_scene *s);
+core_status dem_flow_save(const dem_scene *s, struct ckpt_writer *w, core_error *err);
+core_status dem_flow_load(dem_scene *s, struct ckpt_section *sec, core_error *err);
+
 /* neighbor.c */
+/* The law parameters of two particles of material mat, radius r and mass m each. */
+void dem_probe_parameters(const dem_scene *s, int mat, double r, double m, double *k,
+                          double *gamma);
 void dem_wrap_positions(dem_scene *s);
 /* After p->i, j and n are filled: p->start, jstart and jpair from them. */
 core_status dem_pairs_index(dem_scene *s, core_error *err);
@@ -165,6 +202,58 @@ void dem_free_pairs(dem_pairs *p);
 void dem_pair_parameters(dem_scene *s, size_t i, size_t j, double *k, double *gamma, double *mu);
 void dem_wall_parameters(const dem_scene *s, const dem_wall *w, size_t i, double *k,
                          double *gamma, double *mu);
+
+/* walls.c: walls beyond planes. The geometry is kept in the wall's body frame (relative to its
+ * centre, at orientation `rot`), so a turning wall costs one rotation of the particle's position
+ * per contact test, not a transform of its vertices per step. */
+struct dem_shape {
+    dem_wall_kind kind;
+    size_t nv, ne;
+    double *v;                    /* body-frame vertices, 3 each */
+    uint32_t *e;                  /* elements: 2 (segments) or 3 (triangles) vertex ids each */
+    double radius, axis[3], half; /* CYLINDER: half length (INFINITY: infinite) */
+    int inside;
+    double reach;            /* largest distance of a vertex (or rim) from the centre */
+    int spins_in_place;      /* a cylinder turning about its own axis: turning moves no surface */
+    double center[3];        /* now */
+    double angle;            /* 2D orientation */
+    double rot[9];           /* body to world, row-major (2D: from angle) */
+    double vel[3], omega[3]; /* now (at the time of the next force evaluation) */
+    size_t nt;               /* motion table rows (t, v[3], omega[3]); 0: constants */
+    double *tab;
+    double moved;               /* bound on any surface point's displacement since the list build */
+    double force[3], torque[3]; /* on the wall at the last evaluation */
+    uint32_t *cand;             /* particles within r + skin at the last list build (the wall's own
+                                 * ncand stays 0: the planes' loop passes over the wall) */
+    size_t ncand, cap_cand;
+    double *cload; /* per candidate: force, torque on the wall, f_n (DEM_SHAPE_LOAD), summed in
+                    * candidate order */
+};
+
+typedef struct dem_wall_hit {
+    double dist;     /* of the centre from the surface along n (< 0: through it) */
+    double n[3];     /* unit normal from the wall to the particle */
+    double point[3]; /* the contact point on the surface */
+    double vel[3];   /* the surface's velocity there: v + omega x (point - centre) */
+} dem_wall_hit;
+
+/* The hits of particle i (dist < r_i), closest first; 0 when none. */
+int dem_shape_hits(const dem_scene *s, const dem_wall *wl, size_t i, dem_wall_hit *hit);
+/* Smallest distance of x from the wall's surface (signed for cylinders). */
+double dem_shape_distance(const dem_scene *s, const dem_wall *wl, const double *x);
+/* Candidates of a shaped wall at a list build (within r + skin). */
+core_status dem_shape_candidates(dem_scene *s, dem_wall *wl, core_error *err);
+/* Moves every shaped wall by one step dt from time s->time; samples the motion at the new time. */
+void dem_shapes_move(dem_scene *s, double dt);
+/* A shaped wall's surface moved more than half the skin since the list build. */
+int dem_shapes_moved(const dem_scene *s);
+/* Samples the prescribed motion at time t into vel and omega. */
+void dem_shape_sample(dem_shape *sh, double t);
+void dem_shape_free(dem_shape *sh);
+/* Any shaped wall moving (or tabulated to move): the scene is driven. */
+int dem_shapes_driven(const dem_scene *s);
+core_status dem_shapes_save(const dem_scene *s, struct ckpt_writer *w, core_error *err);
+core_status dem_shapes_load(dem_scene *s, struct ckpt_section *sec, core_error *err);
 
 /* forces.c: the force evaluation, instantiated for 2D and 3D. dem_compute_forces fills f and tq
  * (pairs, walls, gravity) and returns the index of a particle that went through a wall, or

@@ -164,10 +164,7 @@ void dem_domain_free(dem_scene *s)
 /* ---- the per-particle arrays ---------------------------------------------------------------- *
  * Every array of s->cap entries the scene has now: what migrates with a particle and what the
  * gather puts back. A new per-particle array in dem_scene belongs here too. */
-typedef struct parray {
-    void **p;
-    size_t size;
-} parray;
+typedef dem_parray parray;
 
 static int particle_arrays(dem_scene *s, parray *a)
 {
@@ -199,6 +196,7 @@ static int particle_arrays(dem_scene *s, parray *a)
     ADD(s->angle, sizeof(double));
     ADD(s->mat, sizeof(int));
     ADD(s->flags, sizeof(unsigned char));
+    ADD(s->tag, sizeof(double));
     for (int w = 0; w < s->nwalls; w++)
         for (int k = 0; k < DEM_HIST; k++)
             ADD(s->walls[w].hist[k], sizeof(double));
@@ -206,7 +204,10 @@ static int particle_arrays(dem_scene *s, parray *a)
     return n;
 }
 
-static int max_arrays(const dem_scene *s) { return 3 * 21 + 7 + DEM_HIST * s->nwalls; }
+static int max_arrays(const dem_scene *s) { return 3 * 21 + 8 + DEM_HIST * s->nwalls; }
+
+int dem_particle_arrays(dem_scene *s, dem_parray *a) { return particle_arrays(s, a); }
+int dem_max_particle_arrays(const dem_scene *s) { return max_arrays(s); }
 
 static size_t record_bytes(const parray *a, int na)
 {

@@ -110,5 +110,9 @@ size_t dem_compute_forces(dem_scene *s, double dt)
             roll_gather(s);
         t = walls_3(s, dt);
     }
+    if (s->nshaped) { /* walls beyond planes: a scene of planes never comes here */
+        const size_t t2 = s->dim == 2 ? shape_walls_2(s, dt) : shape_walls_3(s, dt);
+        t = t2 < t ? t2 : t;
+    }
     return t;
 }

@@ -21,7 +21,7 @@ dem_run_def dem_default_run_def(void)
 static core_status prepare(dem_scene *s, const dem_run_def *run, core_error *err)
 {
     const int D = s->dim;
-    if (s->nmat == 0 || dem_domain_count(s) == 0)
+    if (s->nmat == 0 || (dem_domain_count(s) == 0 && !dem_flow_inserting(s)))
         return core_fail(err, CORE_ERR_STATE, "the scene has no particles: add some first");
     if (s->contact.tangential == DEM_TANGENT_SPRING) {
         for (int w = 0; w < s->nwalls; w++) {
@@ -101,6 +101,8 @@ static int driven(const dem_scene *s)
             (wl->servo || wl->velocity[0] != 0 || wl->velocity[1] != 0 || wl->velocity[2] != 0))
             return 1;
     }
+    if (s->nshaped && dem_shapes_driven(s))
+        return 1;
     int pres = 0;
     for (size_t i = 0; i < s->n && !pres; i++)
         pres = (s->flags[i] & DEM_PRESCRIBED) != 0;
@@ -234,6 +236,8 @@ static core_status forces(dem_scene *s, double dt, double disp2, core_error *err
             if (wl->active && d2 > lim)
                 s->need_rebuild = 1;
         }
+        if (s->nshaped && !s->need_rebuild && dem_shapes_moved(s)) /* turning walls */
+            s->need_rebuild = 1;
     } else {
         s->need_rebuild = 1;
     }
@@ -324,6 +328,8 @@ static void move_walls(dem_scene *s, double dt)
         for (int d = 0; d < s->dim; d++)
             wl->point[d] += dt * wl->velocity[d];
     }
+    if (s->nshaped) /* walls beyond planes, rigid bodies that also turn (walls.c) */
+        dem_shapes_move(s, dt);
 }
 
 static size_t check_finite(const dem_scene *s)
@@ -666,13 +672,27 @@ static core_status run_steps(dem_scene *s, const dem_run_def *run, core_error *e
         (run->tt_m < 1 || run->tt_n < 1 || run->tt_q < 0))
         return core_fail(err, CORE_ERR_ARG, "two timescales needs m >= 1, n >= 1, q >= 0 "
                          "(got %d, %d, %d)", run->tt_m, run->tt_n, run->tt_q);
+    core_status st0;
     if (comm_size() > 1 && s->bnd)
         return core_fail(err, CORE_ERR_STATE,
                          "boundary conditions (pressure tractions, the minimal boundary, springs, "
                          "ties to walls, prescribed spins) do not yet run distributed "
                          "(comm_size() > 1): run this scene on one rank");
+    for (int w = 0; w < s->nwalls && comm_size() > 1; w++)
+        if (s->walls[w].active && s->walls[w].shape)
+            return core_fail(err, CORE_ERR_STATE,
+                             "walls beyond planes (segments, polylines, triangles, circles, "
+                             "cylinders; wall %d) do not yet run distributed (comm_size() > 1): "
+                             "run this scene on one rank",
+                             w + 1);
+    if (s->flow && (st0 = dem_flow_check_run(s, err)))
+        return st0;
     core_status st = prepare(s, run, err);
     if (st)
+        return st;
+    /* Particles in and out (flow.c) at the step boundaries: before the first step, and after
+     * each one before the checks (a particle out through an open side is gone by then). */
+    if (s->flow && run->steps > 0 && (st = dem_flow_step(s, s->steps, err)))
         return st;
     if (run->steps > 0 && (st = dem_domain_start(s, err)))
         return st;
@@ -740,6 +760,8 @@ static core_status run_steps(dem_scene *s, const dem_run_def *run, core_error *e
             st = dem_domain_agree_flag(s, st, &intr, err);
             s->suspect = 0;
         }
+        if (!st && s->flow)
+            st = dem_flow_step(s, s->steps + 1, err);
         if (st) {
             dem_invalidate(s, 1);
             return st;
@@ -775,11 +797,28 @@ static double contact_integral(double p)
     return tgamma(1 / p) * tgamma(0.5) / tgamma(1 / p + 0.5) / p;
 }
 
+/* The contact time t and the damping rate b of a pair of stiffness k, damping gamma and
+ * effective mass m_eff at impact speed v. */
+static void contact_limits(const dem_scene *s, double k, double gamma, double m_eff, double v,
+                           double *t, double *b)
+{
+    double beta = s->contact.normal == DEM_NORMAL_LINEAR  ? 1
+                  : s->contact.normal == DEM_NORMAL_POWER ? s->contact.beta
+                                                          : 1.5;
+    double dmax = pow((beta + 1) * m_eff * v * v / (2 * k), 1 / (beta + 1));
+    *t = 2 * dmax / v * contact_integral(beta + 1);
+    if (beta == 1)
+        *t = DEM_PI * sqrt(m_eff / k); /* independent of speed */
+    *b = gamma / (2 * m_eff);
+    if (s->contact.damping == DEM_DAMPING_BRILLIANTOV) /* rate T k d^{1/2} / (2 m_eff) */
+        *b = gamma * k * sqrt(dmax) / (2 * m_eff);
+}
+
 core_status dem_timestep_info(const dem_scene *s, double v_imp, dem_timestep *out,
                               core_error *err)
 {
     const int D = s->dim;
-    if (dem_domain_count(s) == 0 || s->nmat == 0)
+    if ((dem_domain_count(s) == 0 && !dem_flow_inserting(s)) || s->nmat == 0)
         return core_fail(err, CORE_ERR_STATE, "the scene has no particles: add some first");
     if (!(v_imp > 0)) {
         double vmax2 = 0, h = 0, g = 0;
@@ -825,22 +864,20 @@ core_status dem_timestep_info(const dem_scene *s, double v_imp, dem_timestep *ou
         if (i != (size_t)-1) {
             double k, gamma, mu;
             dem_pair_parameters((dem_scene *)s, i, i, &k, &gamma, &mu);
-            double m_eff = 0.5 * s->m[i];
-            double beta = s->contact.normal == DEM_NORMAL_LINEAR  ? 1
-                          : s->contact.normal == DEM_NORMAL_POWER ? s->contact.beta
-                                                                  : 1.5;
-            double dmax = pow((beta + 1) * m_eff * v_imp * v_imp / (2 * k), 1 / (beta + 1));
-            t = 2 * dmax / v_imp * contact_integral(beta + 1);
-            if (beta == 1)
-                t = DEM_PI * sqrt(m_eff / k); /* independent of speed */
-            b = gamma / (2 * m_eff);
-            if (s->contact.damping == DEM_DAMPING_BRILLIANTOV) /* rate T k d^{1/2} / (2 m_eff) */
-                b = gamma * k * sqrt(dmax) / (2 * m_eff);
+            contact_limits(s, k, gamma, 0.5 * s->m[i], v_imp, &t, &b);
         }
         if (s->dom) { /* one rank computed them: min and max are its values, exactly */
             comm_min_double(&t, 1);
             comm_max_double(&b, 1);
         }
+        tc = fmin(tc, t);
+        bmax = fmax(bmax, b);
+    }
+    /* The smallest particle each inserter can bring (flow.c). */
+    double k, gamma, m_eff;
+    for (int q = 0; s->flow && dem_flow_probe((dem_scene *)s, q, &k, &gamma, &m_eff); q++) {
+        double t, b;
+        contact_limits(s, k, gamma, m_eff, v_imp, &t, &b);
         tc = fmin(tc, t);
         bmax = fmax(bmax, b);
     }

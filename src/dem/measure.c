@@ -23,6 +23,25 @@ static double pair_geometry(const dem_scene *s, size_t i, size_t j, double n[3],
     return s->r[i] + s->r[j] - *dist;
 }
 
+/* Contacts of particle i with wall w: a plane's one, or a shaped wall's hits (walls.c). */
+static int wall_hits(const dem_scene *s, const dem_wall *w, size_t i, dem_wall_hit *hit)
+{
+    if (w->shape)
+        return dem_shape_hits(s, w, i, hit);
+    double dist = 0;
+    for (int d = 0; d < s->dim; d++)
+        dist += (s->x[d][i] - w->point[d]) * w->normal[d];
+    if (!(dist < s->r[i]))
+        return 0;
+    hit->dist = dist;
+    for (int d = 0; d < 3; d++) {
+        hit->n[d] = d < s->dim ? w->normal[d] : 0;
+        hit->point[d] = d < s->dim ? s->x[d][i] - s->r[i] * w->normal[d] : 0;
+        hit->vel[d] = d < s->dim ? w->velocity[d] : 0;
+    }
+    return 1;
+}
+
 static double wall_overlap(const dem_scene *s, const dem_wall *w, size_t i)
 {
     double dist = 0;
@@ -85,6 +104,22 @@ void dem_measure_energy(dem_scene *s, dem_energy *e)
         if (!wl->active)
             continue;
         for (size_t i = 0; i < s->n; i++) {
+            if (wl->shape && !(gh && gh[i])) {
+                dem_wall_hit hit[DEM_WALL_MAXHIT];
+                const int nh = dem_shape_hits(s, wl, i, hit);
+                for (int h = 0; h < nh; h++) {
+                    double k, gamma, mu;
+                    dem_wall_parameters(s, wl, i, &k, &gamma, &mu);
+                    e->elastic += dem_elastic_energy(&s->contact, k, s->r[i] - hit[h].dist);
+                    if (wl->hist[0] && h == 0) {
+                        double f2 = 0;
+                        for (int d = 0; d < D; d++)
+                            f2 += wl->hist[d][i] * wl->hist[d][i];
+                        e->elastic += spring_energy(f2, wl->hist[3][i]);
+                    }
+                }
+                continue;
+            }
             double delta = wall_overlap(s, wl, i);
             if (delta <= 0 || (gh && gh[i]))
                 continue;
@@ -108,13 +143,13 @@ void dem_measure_energy(dem_scene *s, dem_energy *e)
 }
 
 /* |slip| of particle i's contact point on wall wl. */
-static double wall_slip(const dem_scene *s, const dem_wall *wl, size_t i)
+static double wall_slip(const dem_scene *s, const dem_wall_hit *hit, size_t i)
 {
     const int D = s->dim;
-    const double *n = wl->normal;
+    const double *n = hit->n;
     double vr[3] = {0, 0, 0}, vn = 0;
     for (int d = 0; d < D; d++) {
-        vr[d] = s->v[d][i] - wl->velocity[d];
+        vr[d] = s->v[d][i] - hit->vel[d];
         vn += vr[d] * n[d];
     }
     if (D == 2)
@@ -132,19 +167,19 @@ static double wall_slip(const dem_scene *s, const dem_wall *wl, size_t i)
 }
 
 /* The tangential force a wall contact carries now, without advancing the spring history. */
-static double wall_tangential(const dem_scene *s, const dem_wall *wl, size_t i, double fn,
-                              double k, double mu, double delta)
+static double wall_tangential(const dem_scene *s, const dem_wall *wl, const dem_wall_hit *hit,
+                              int first, size_t i, double fn, double k, double mu, double delta)
 {
     const dem_contact_def *c = &s->contact;
     switch (c->tangential) {
     case DEM_TANGENT_VISCOUS:
-        return c->gamma_t * wall_slip(s, wl, i);
+        return c->gamma_t * wall_slip(s, hit, i);
     case DEM_TANGENT_REGULARIZED: {
-        double x = wall_slip(s, wl, i) / c->v_r;
+        double x = wall_slip(s, hit, i) / c->v_r;
         return x >= 1 ? mu * fn : mu * fn * pow(x, 1 / c->exponent);
     }
     case DEM_TANGENT_SPRING: { /* the stored force (already capped at mu f_n) */
-        if (!wl->hist[0])
+        if (!wl->hist[0] || !first) /* further hits of a shaped wall carry no history */
             return 0;
         double f2 = 0;
         for (int d = 0; d < s->dim; d++)
@@ -190,23 +225,25 @@ void dem_each_contact(dem_scene *s, void (*visit)(const dem_contact_info *c, voi
         if (!wl->active)
             continue;
         for (size_t i = 0; i < s->n; i++) {
-            double delta = wall_overlap(s, wl, i);
-            if (delta <= 0)
-                continue;
-            dem_contact_info c = {.i = (long)i, .j = -(long)w - 1, .overlap = delta};
-            double k, gamma, mu, vn = 0;
-            dem_wall_parameters(s, wl, i, &k, &gamma, &mu);
-            for (int d = 0; d < 3; d++) {
-                c.normal[d] = d < D ? wl->normal[d] : 0;
-                c.point[d] = d < D ? s->x[d][i] - s->r[i] * wl->normal[d] : 0;
+            dem_wall_hit hit[DEM_WALL_MAXHIT];
+            const int nh = wall_hits(s, wl, i, hit);
+            for (int h = 0; h < nh; h++) {
+                double delta = s->r[i] - hit[h].dist;
+                dem_contact_info c = {.i = (long)i, .j = -(long)w - 1, .overlap = delta};
+                double k, gamma, mu, vn = 0;
+                dem_wall_parameters(s, wl, i, &k, &gamma, &mu);
+                for (int d = 0; d < 3; d++) {
+                    c.normal[d] = hit[h].n[d];
+                    c.point[d] = hit[h].point[d];
+                }
+                for (int d = 0; d < D; d++)
+                    vn += (s->v[d][i] - hit[h].vel[d]) * hit[h].n[d];
+                c.fn = dem_normal_force(&s->contact, k, gamma, delta, -vn);
+                c.ft = wall_tangential(s, wl, &hit[h], h == 0, i, c.fn, k, mu, delta);
+                for (int d = 0; d < D; d++)
+                    c.force[d] = c.fn * hit[h].n[d];
+                visit(&c, ctx);
             }
-            for (int d = 0; d < D; d++)
-                vn += (s->v[d][i] - wl->velocity[d]) * wl->normal[d];
-            c.fn = dem_normal_force(&s->contact, k, gamma, delta, -vn);
-            c.ft = wall_tangential(s, wl, i, c.fn, k, mu, delta);
-            for (int d = 0; d < D; d++)
-                c.force[d] = c.fn * wl->normal[d];
-            visit(&c, ctx);
         }
     }
 }
@@ -253,8 +290,10 @@ void dem_measure_coordination(dem_scene *s, double *z_all, double *z_no_rattlers
             z += pair_geometry(s, i, p->j[q], n, &dist) > 0;
         for (size_t e = p->jstart[i]; e < p->jstart[i + 1]; e++)
             z += pair_geometry(s, p->i[p->jpair[e]], i, n, &dist) > 0;
-        for (int w = 0; w < s->nwalls; w++)
-            z += s->walls[w].active && wall_overlap(s, &s->walls[w], i) > 0;
+        for (int w = 0; w < s->nwalls; w++) {
+            dem_wall_hit hit[DEM_WALL_MAXHIT];
+            z += s->walls[w].active ? wall_hits(s, &s->walls[w], i, hit) : 0;
+        }
         total += z;
         if (z >= 2) {
             kept += z;

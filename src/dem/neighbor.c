@@ -68,6 +68,13 @@ void dem_pair_parameters(dem_scene *s, size_t i, size_t j, double *k, double *ga
                    mu);
 }
 
+void dem_probe_parameters(const dem_scene *s, int mat, double r, double m, double *k, double *gamma)
+{
+    const dem_material *a = &s->mats[mat];
+    double mu;
+    law_parameters(s, a, a, 0.5 * r, 0.5 * m, a->friction, k, gamma, &mu);
+}
+
 void dem_wall_parameters(const dem_scene *s, const dem_wall *w, size_t i, double *k,
                          double *gamma, double *mu)
 {
@@ -466,6 +473,13 @@ core_status dem_build_pairs(dem_scene *s, core_error *err)
         dem_wall *wl = &s->walls[w];
         if (!wl->active)
             continue;
+        if (wl->shape) { /* beyond planes: distance to the surface (walls.c) */
+            if ((st = dem_shape_candidates(s, wl, err))) {
+                dem_free_pairs(&old);
+                return st;
+            }
+            continue;
+        }
         wl->ncand = 0;
         for (size_t i = 0; i < n; i++) {
             if (s->ghost && s->ghost[i])

@@ -104,6 +104,7 @@ void dem_destroy(dem_scene *s)
         return;
     dem_domain_free(s);
     dem_clear_boundary(s);
+    dem_flow_free(s);
     for (int d = 0; d < 3; d++) {
         free(s->x[d]), free(s->v[d]), free(s->f[d]), free(s->w[d]), free(s->tq[d]);
         free(s->x_build[d]), free(s->x_ref[d]), free(s->x_prev[d]), free(s->fext[d]);
@@ -116,6 +117,7 @@ void dem_destroy(dem_scene *s)
         for (int d = 0; d < DEM_HIST; d++)
             free(s->walls[w].hist[d]);
         free(s->walls[w].cand);
+        dem_shape_free(s->walls[w].shape);
     }
     free(s->walls), free(s->mats);
     dem_free_pairs(&s->pairs);
@@ -298,6 +300,8 @@ static core_status grow(dem_scene *s, size_t need, core_error *err)
     }
     if (st == CORE_OK && s->angle)
         st = dem_alloc_array(&s->angle, cap, err);
+    if (st == CORE_OK && s->tag)
+        st = dem_alloc_array(&s->tag, cap, err);
     if (st == CORE_OK)
         st = dem_alloc_array(&s->r, cap, err);
     if (st == CORE_OK)
@@ -394,8 +398,11 @@ long dem_add_particle(dem_scene *s, const dem_particle_def *p, core_error *err)
         if (!wl->active)
             continue;
         double dist = 0;
-        for (int d = 0; d < D; d++)
-            dist += (p->x[d] - wl->point[d]) * wl->normal[d];
+        if (wl->shape)
+            dist = dem_shape_distance(s, wl, p->x);
+        else
+            for (int d = 0; d < D; d++)
+                dist += (p->x[d] - wl->point[d]) * wl->normal[d];
         if (dist < p->radius * (1 - 1e-9)) /* touching is fine, up to rounding */
             return core_fail(err, CORE_ERR_ARG,
                              "particle at pos (%g, %g%s) overlaps wall %d: its centre is %g from "
@@ -445,6 +452,8 @@ long dem_add_particle(dem_scene *s, const dem_particle_def *p, core_error *err)
     s->flags[i] = (unsigned char)p->flags;
     if (r > s->r_max)
         s->r_max = r;
+    if (s->tag)
+        dem_flow_tag_new(s, i);
     s->n++;
     dem_invalidate(s, 1);
     return (long)i;
@@ -525,7 +534,7 @@ int dem_add_wall(dem_scene *s, const dem_wall_def *w, core_error *err)
     }
     for (int k = 0; k < s->nwalls; k++) {
         const dem_wall *o = &s->walls[k];
-        if (!o->active)
+        if (!o->active || o->shape)
             continue;
         double dot = 0, off = 0;
         for (int d = 0; d < D; d++) {
@@ -575,11 +584,15 @@ core_status dem_set_wall_velocity(dem_scene *s, int id, const double v[3], core_
     core_status st = check_wall(s, id, err);
     if (st != CORE_OK)
         return st;
+    dem_shape *sh = s->walls[id].shape;
+    if (sh && sh->nt)
+        return core_fail(err, CORE_ERR_ARG, "wall %d moves by its motion table", id + 1);
     for (int d = 0; d < s->dim; d++) {
         if (!isfinite(v[d]))
             return core_fail(err, CORE_ERR_ARG, "wall velocity must be finite");
-        s->walls[id].velocity[d] = v[d];
     }
+    for (int d = 0; d < s->dim; d++) /* a shaped wall's own (its plane velocity stays 0) */
+        *(sh ? &sh->vel[d] : &s->walls[id].velocity[d]) = v[d];
     dem_invalidate(s, 0); /* damping and friction see the wall's velocity */
     return CORE_OK;
 }
@@ -595,7 +608,7 @@ core_status dem_wall_geometry(const dem_scene *s, int id, double point[3], doubl
         point[d] = s->walls[id].point[d];
         normal[d] = s->walls[id].normal[d];
     }
-    *active = s->walls[id].active;
+    *active = s->walls[id].active && !s->walls[id].shape; /* planes only: see dem_wall_outline */
     return CORE_OK;
 }
 
@@ -620,6 +633,9 @@ core_status dem_wall_servo(dem_scene *s, int id, double force, double mass, doub
     if (!isfinite(rate) || rate < 0)
         return core_fail(err, CORE_ERR_ARG, "servo rate must be >= 0, got %g", rate);
     dem_wall *wl = &s->walls[id];
+    if (wl->shape)
+        return core_fail(err, CORE_ERR_ARG, "wall %d is not a plane: a servo moves planes only",
+                         id + 1);
     wl->servo = mass > 0;
     wl->servo_force = force;
     wl->servo_mass = mass;

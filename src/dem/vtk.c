@@ -259,65 +259,103 @@ static int clip_plane(int D, const double lo[3], const double hi[3], const doubl
     return m;
 }
 
-core_status dem_vtk_walls(const dem_scene *s, const char *path, core_error *err)
+/* Cells of the walls: a plane clipped to the box (a line in 2D, a polygon in 3D), a shaped
+ * wall's outline (dem_wall_outline: a polyline per polyline or circle, a triangle per mesh
+ * triangle, the two rims of a cylinder). Counts when the arrays are NULL. */
+enum { VTK_CIRCLE_SEGMENTS = 64 };
+static void wall_cells(const dem_scene *s, const double *lo, const double *hi, size_t *nc,
+                       size_t *np, int *types, int *nv, int *ids, double *pts)
 {
     const int D = dem_dim(s), nw = dem_wall_count(s);
-    double lo[3], hi[3], g[3];
-    dem_box(s, lo, hi, g);
-    double(*poly)[6][3] = malloc((size_t)(nw ? nw : 1) * sizeof *poly);
-    int *nv = malloc((size_t)(nw ? nw : 1) * sizeof *nv);
-    int *ids = malloc((size_t)(nw ? nw : 1) * sizeof *ids);
-    int *types = malloc((size_t)(nw ? nw : 1) * sizeof *types);
-    double(*normal)[3] = malloc((size_t)(nw ? nw : 1) * sizeof *normal);
-    if (!poly || !nv || !ids || !types || !normal) {
-        free(poly), free(nv), free(ids), free(types), free(normal);
-        return core_fail(err, CORE_ERR_NOMEM, "out of memory for the walls of '%s'", path);
-    }
-    size_t nc = 0, np = 0;
-    core_status st = CORE_OK;
-    for (int w = 0; w < nw && !st; w++) {
-        double p[3], n[3];
+    *nc = *np = 0;
+    for (int w = 0; w < nw; w++) {
+        double p[3], n[3], poly[6][3];
         int active;
-        if ((st = dem_wall_geometry(s, w, p, n, &active, err)) || !active)
+        if (dem_wall_kind_of(s, w) != DEM_WALL_PLANE) {
+            size_t q;
+            const int strips = dem_wall_outline(s, w, VTK_CIRCLE_SEGMENTS, nv ? nv + *nc : NULL,
+                                                pts ? pts + 3 * *np : NULL, &q);
+            for (int k = 0; k < strips; k++, (*nc)++) {
+                if (types)
+                    types[*nc] = D == 3 && dem_wall_kind_of(s, w) == DEM_WALL_TRIANGLES
+                                     ? VTK_CELL_TRIANGLE
+                                     : VTK_CELL_POLY_LINE;
+                if (ids)
+                    ids[*nc] = w;
+            }
+            *np += q;
             continue;
-        int m = clip_plane(D, lo, hi, p, n, poly[nc]);
+        }
+        if (dem_wall_geometry(s, w, p, n, &active, NULL) || !active)
+            continue;
+        int m = clip_plane(D, lo, hi, p, n, poly);
         if (m < D)
             continue; /* the wall has left the box */
-        nv[nc] = m;
-        types[nc] = D == 2 ? VTK_CELL_LINE
-                           : (m == 3   ? VTK_CELL_TRIANGLE
-                              : m == 4 ? VTK_CELL_QUAD
-                                       : VTK_CELL_POLYGON);
-        ids[nc] = w;
-        memcpy(normal[nc], n, sizeof n);
-        np += (size_t)m;
-        nc++;
+        if (types)
+            types[*nc] = D == 2 ? VTK_CELL_LINE
+                                : (m == 3   ? VTK_CELL_TRIANGLE
+                                   : m == 4 ? VTK_CELL_QUAD
+                                            : VTK_CELL_POLYGON);
+        if (nv)
+            nv[*nc] = m;
+        if (ids)
+            ids[*nc] = w;
+        if (pts)
+            memcpy(pts + 3 * *np, poly, (size_t)m * 3 * sizeof(double));
+        *np += (size_t)m;
+        (*nc)++;
     }
+}
+
+core_status dem_vtk_walls(const dem_scene *s, const char *path, core_error *err)
+{
+    double lo[3], hi[3], g[3];
+    dem_box(s, lo, hi, g);
+    size_t nc, np;
+    wall_cells(s, lo, hi, &nc, &np, NULL, NULL, NULL, NULL);
+    int *nv = malloc((nc ? nc : 1) * sizeof *nv);
+    int *ids = malloc((nc ? nc : 1) * sizeof *ids);
+    int *types = malloc((nc ? nc : 1) * sizeof *types);
+    double *pts = malloc((np ? np : 1) * 3 * sizeof *pts);
+    if (!pts || !nv || !ids || !types) {
+        free(pts), free(nv), free(ids), free(types);
+        return core_fail(err, CORE_ERR_NOMEM, "out of memory for the walls of '%s'", path);
+    }
+    wall_cells(s, lo, hi, &nc, &np, types, nv, ids, pts);
     vtk_file *f = NULL;
-    if (!st)
-        st = vtk_unstructured(np, nc, &f, err);
+    core_status st = vtk_unstructured(np, nc, &f, err);
     if (!st) {
         double *x = vtk_f64(f, VTK_POINTS, "Points", 3, np, err);
         int64_t *conn = x ? vtk_cells_mixed(f, types, nv, err) : NULL;
         int64_t *id = conn ? vtk_i64(f, VTK_CELL_DATA, "id", 1, nc, err) : NULL;
-        double *nn = id ? vtk_f64(f, VTK_CELL_DATA, "normal", 3, nc, err) : NULL;
+        int64_t *kind = id ? vtk_i64(f, VTK_CELL_DATA, "kind", 1, nc, err) : NULL;
+        double *nn = kind ? vtk_f64(f, VTK_CELL_DATA, "normal", 3, nc, err) : NULL;
         double *fn = nn ? vtk_f64(f, VTK_CELL_DATA, "force", 1, nc, err) : NULL;
-        if (!fn)
+        double *load = fn ? vtk_f64(f, VTK_CELL_DATA, "load", 3, nc, err) : NULL;
+        double *torque = load ? vtk_f64(f, VTK_CELL_DATA, "torque", 3, nc, err) : NULL;
+        if (!torque)
             st = err ? err->status : CORE_ERR_NOMEM;
-        size_t q = 0;
-        for (size_t c = 0; c < nc && !st; c++) {
-            for (int k = 0; k < nv[c]; k++, q++) {
+        if (!st) {
+            memcpy(x, pts, np * 3 * sizeof *pts);
+            for (size_t q = 0; q < np; q++)
                 conn[q] = (int64_t)q;
-                memcpy(x + 3 * q, poly[c][k], 3 * sizeof(double));
-            }
+        }
+        for (size_t c = 0; c < nc && !st; c++) {
+            double p[3];
+            int active;
             id[c] = ids[c] + 1;
-            memcpy(nn + 3 * c, normal[c], 3 * sizeof(double));
-            st = dem_wall_force(s, ids[c], &fn[c], err);
+            kind[c] = (int64_t)dem_wall_kind_of(s, ids[c]);
+            if (kind[c] == DEM_WALL_PLANE)
+                st = dem_wall_geometry(s, ids[c], p, nn + 3 * c, &active, err);
+            if (!st)
+                st = dem_wall_force(s, ids[c], &fn[c], err);
+            if (!st)
+                st = dem_wall_load(s, ids[c], load + 3 * c, torque + 3 * c, err);
         }
         if (!st)
             st = vtk_set_time(f, dem_time(s), dem_steps_done(s), err);
     }
-    free(poly), free(nv), free(ids), free(types), free(normal);
+    free(pts), free(nv), free(ids), free(types);
     if (!f)
         return st;
     return vtk_file_finish(f, path, st, err);

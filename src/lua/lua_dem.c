@@ -539,6 +539,316 @@ static int l_wall_point(lua_State *L)
     return 1;
 }
 
+/* ---- walls beyond planes --------------------------------------------------------------------- */
+/* The argument number the user sees (a method's self is not counted), as args.c says it. */
+static int shown_arg(lua_State *L, int arg)
+{
+    lua_Debug ar;
+    if (lua_getstack(L, 0, &ar) && lua_getinfo(L, "n", &ar) && ar.namewhat &&
+        strcmp(ar.namewhat, "method") == 0)
+        return arg - 1;
+    return arg;
+}
+
+/* A field holding an array of arrays of `per` finite numbers (points, motion rows), or for
+ * triangles (nest = 3) an array of arrays of 3 such arrays. Returns the number of outer entries;
+ * the numbers go into a userdata buffer left on the stack (freed by the GC, also on error).
+ * Absent: 0 and nothing pushed, or an error with `required`. */
+static size_t read_rows(lua_State *L, int arg, const char *call, const char *field, int per,
+                        int nest, int required, double **out)
+{
+    char expected[96];
+    if (nest > 1)
+        snprintf(expected, sizeof expected, "array of triangles (3 arrays of %d finite numbers)",
+                 per);
+    else
+        snprintf(expected, sizeof expected, "array of arrays of %d finite numbers", per);
+    int t = lua_getfield(L, arg, field);
+    if (t == LUA_TNIL && !required) {
+        lua_pop(L, 1);
+        return 0;
+    }
+    if (t != LUA_TTABLE || luaL_len(L, -1) < 1)
+        return (size_t)bind_field_error(L, arg, call, field, expected);
+    const lua_Integer n = luaL_len(L, -1);
+    if (n > (1 << 22))
+        return (size_t)bind_field_error(L, arg, call, field, "at most 4194304 entries");
+    const int vals = per * nest;
+    double *buf = lua_newuserdatauv(L, (size_t)n * (size_t)vals * sizeof *buf, 0);
+    lua_insert(L, -2); /* buffer below the table */
+    for (lua_Integer k = 1; k <= n; k++) {
+        lua_rawgeti(L, -1, k);
+        for (int m = 0; m < nest; m++) {
+            if (nest > 1) {
+                if (lua_type(L, -1) != LUA_TTABLE || luaL_len(L, -1) != nest)
+                    goto bad;
+                lua_rawgeti(L, -1, m + 1);
+            }
+            if (lua_type(L, -1) != LUA_TTABLE || luaL_len(L, -1) != per)
+                goto bad;
+            for (int d = 0; d < per; d++) {
+                lua_rawgeti(L, -1, d + 1);
+                int isnum;
+                double v = lua_tonumberx(L, -1, &isnum);
+                if (!isnum || lua_type(L, -1) != LUA_TNUMBER || !isfinite(v) || fabs(v) > 1e100)
+                    goto bad;
+                lua_pop(L, 1);
+                buf[((size_t)(k - 1) * (size_t)nest + (size_t)m) * (size_t)per + (size_t)d] = v;
+            }
+            if (nest > 1)
+                lua_pop(L, 1);
+        }
+        lua_pop(L, 1);
+        continue;
+    bad : {
+        char got[64];
+        bind_describe(L, -1, got, sizeof got);
+        return (size_t)luaL_error(L,
+                                  "bad field '%s' in argument #%d to '%s' (%s expected, got %s "
+                                  "in entry %d)",
+                                  field, shown_arg(L, arg), call, expected, got, (int)k);
+    }
+    }
+    lua_pop(L, 1); /* the table; the buffer stays */
+    *out = buf;
+    return (size_t)n;
+}
+
+/* The motion fields shared by the shaped walls: velocity, omega (2D: a number), and motion: a
+ * table of rows {t, velocity..., omega...} or a function(t) -> velocity, omega tabulated by this
+ * call from the scene's time every motion_step until motion_until (never called in a step). */
+static int read_motion(lua_State *L, int arg, const char *call, dem_scene *s, dem_shape_def *def)
+{
+    const int D = dem_dim(s), nw = D == 2 ? 1 : 3, per = 1 + D + nw;
+    bind_field_vector(L, arg, call, "velocity", D, def->velocity, 0);
+    if (D == 2)
+        def->omega[2] = bind_field_number(L, arg, call, "omega", 0, 0);
+    else
+        bind_field_vector(L, arg, call, "omega", 3, def->omega, 0);
+    const int t = lua_getfield(L, arg, "motion");
+    lua_pop(L, 1);
+    const int has_step = lua_getfield(L, arg, "motion_step") != LUA_TNIL;
+    lua_pop(L, 1);
+    const int has_until = lua_getfield(L, arg, "motion_until") != LUA_TNIL;
+    lua_pop(L, 1);
+    /* the messages of a mismatch name both fields: either may be the mistake */
+    if (t != LUA_TFUNCTION && (has_step || has_until)) {
+        lua_getfield(L, arg, has_step ? "motion_step" : "motion_until");
+        return bind_field_error(L, arg, call, has_step ? "motion_step" : "motion_until",
+                                "nil ('motion' is not a function)");
+    }
+    if (t == LUA_TFUNCTION && !(has_step && has_until)) {
+        lua_getfield(L, arg, has_step ? "motion_until" : "motion_step");
+        return bind_field_error(L, arg, call, has_step ? "motion_until" : "motion_step",
+                                "number (with a function as 'motion')");
+    }
+    double *rows = NULL;
+    size_t n = 0;
+    if (t == LUA_TFUNCTION) {
+        const double step =
+            bind_field_number(L, arg, call, "motion_step", 0, BIND_REQUIRED | BIND_POSITIVE);
+        const double until = bind_field_number(L, arg, call, "motion_until", 0, BIND_REQUIRED);
+        const double t0 = dem_time(s);
+        if (!(until > t0)) {
+            lua_getfield(L, arg, "motion_until");
+            return bind_field_error(L, arg, call, "motion_until", "time after the scene's time");
+        }
+        /* rows at t0 + k step while before `until`, then `until` itself */
+        while (n < 1000000 && t0 + (double)n * step < until)
+            n++;
+        if (n == 1000000) {
+            lua_getfield(L, arg, "motion_step");
+            return bind_field_error(L, arg, call, "motion_step", "step giving at most 1e6 rows");
+        }
+        n++;
+        rows = lua_newuserdatauv(L, n * 7 * sizeof *rows, 0);
+        for (size_t k = 0; k < n; k++) {
+            const double tk = k + 1 == n ? until : t0 + (double)k * step;
+            lua_getfield(L, arg, "motion");
+            lua_pushnumber(L, tk);
+            lua_call(L, 1, 2); /* here, before any step: never inside one */
+            double *r = rows + 7 * k;
+            memset(r, 0, 7 * sizeof *r);
+            r[0] = tk;
+            int ok = lua_type(L, -2) == LUA_TTABLE && luaL_len(L, -2) == D;
+            for (int d = 0; ok && d < D; d++) {
+                lua_rawgeti(L, -2, d + 1);
+                r[1 + d] = lua_tonumber(L, -1);
+                ok = lua_type(L, -1) == LUA_TNUMBER && isfinite(r[1 + d]);
+                lua_pop(L, 1);
+            }
+            if (ok && D == 2) {
+                r[6] = lua_tonumber(L, -1);
+                ok = (lua_type(L, -1) == LUA_TNUMBER && isfinite(r[6])) || lua_isnil(L, -1);
+            } else if (ok && !lua_isnil(L, -1)) {
+                ok = lua_type(L, -1) == LUA_TTABLE && luaL_len(L, -1) == 3;
+                for (int d = 0; ok && d < 3; d++) {
+                    lua_rawgeti(L, -1, d + 1);
+                    r[4 + d] = lua_tonumber(L, -1);
+                    ok = lua_type(L, -1) == LUA_TNUMBER && isfinite(r[4 + d]);
+                    lua_pop(L, 1);
+                }
+            }
+            lua_pop(L, 2);
+            if (!ok) {
+                char tb[64];
+                snprintf(tb, sizeof tb, "%.17g", tk);
+                return luaL_error(L,
+                                  "bad field 'motion' in argument #%d to '%s' (function "
+                                  "returning velocity {%d numbers}, omega (%s) expected "
+                                  "at t = %s)",
+                                  shown_arg(L, arg), call, D, D == 2 ? "a number" : "{3 numbers}",
+                                  tb);
+            }
+        }
+    } else if (t != LUA_TNIL) {
+        double *raw = NULL;
+        if (t != LUA_TTABLE) {
+            lua_getfield(L, arg, "motion");
+            return bind_field_error(L, arg, call, "motion",
+                                    "table of rows {t, velocity, omega} or function");
+        }
+        n = read_rows(L, arg, call, "motion", per, 1, 1, &raw);
+        rows = lua_newuserdatauv(L, n * 7 * sizeof *rows, 0);
+        for (size_t k = 0; k < n; k++) {
+            double *r = rows + 7 * k;
+            memset(r, 0, 7 * sizeof *r);
+            r[0] = raw[per * k];
+            for (int d = 0; d < D; d++)
+                r[1 + d] = raw[per * k + 1 + (size_t)d];
+            for (int d = 0; d < nw; d++)
+                r[(D == 2 ? 6 : 4) + d] = raw[per * k + 1 + (size_t)D + (size_t)d];
+        }
+    }
+    /* a constant besides a (valid) motion: the constant is the mistake */
+    const char *konst[2] = {"velocity", "omega"};
+    for (int k = 0; k < 2 && t != LUA_TNIL; k++) {
+        if (lua_getfield(L, arg, konst[k]) != LUA_TNIL)
+            return bind_field_error(L, arg, call, konst[k], "nil (a motion is given)");
+        lua_pop(L, 1);
+    }
+    def->nmotion = n;
+    def->motion = rows; /* on the stack until the call returns */
+    return 0;
+}
+
+/* The fields every shaped wall takes, after its own. */
+#define SHAPE_COMMON_FIELDS                                                                        \
+    "center", "velocity", "omega", "motion", "motion_step", "motion_until", "friction", "material"
+
+/* The shaped-wall calls' common part: the centre, motion, friction and material, then the wall. */
+static int shape_wall(lua_State *L, const char *call, dem_shape_def *def)
+{
+    dem_scene *s = check_scene(L, 1);
+    const int D = dem_dim(s);
+    if (!def->has_center)
+        def->has_center = bind_field_vector(L, 2, call, "center", D, def->center, 0);
+    read_motion(L, 2, call, s, def);
+    def->friction = bind_field_number(L, 2, call, "friction", -1, 0);
+    if (def->friction < 0 && lua_getfield(L, 2, "friction") != LUA_TNIL)
+        return bind_field_error(L, 2, call, "friction", "non-negative number");
+    def->material = material_index(L, 1, 2, call, "material", -1);
+    core_error err;
+    int id = dem_add_shape_wall(s, def, &err);
+    if (id < 0)
+        return bind_raise(L, call, &err);
+    lua_pushinteger(L, id + 1);
+    return 1;
+}
+
+static void check_shape_fields(lua_State *L, const char *call, const char *const fields[])
+{
+    bind_check_table(L, 2, call);
+    bind_check_fields(L, 2, call, fields);
+}
+
+static const char *const POLYLINE_FIELDS[] = {"points", "closed", SHAPE_COMMON_FIELDS, NULL};
+
+static int l_add_polyline(lua_State *L)
+{
+    dem_scene *s = check_scene(L, 1);
+    check_shape_fields(L, "add_polyline", POLYLINE_FIELDS);
+    if (dem_dim(s) != 2)
+        return luaL_error(L, "bad argument #1 to 'add_polyline' (2D scene expected, got a 3D "
+                             "one: use add_mesh)");
+    dem_shape_def def = dem_default_shape_def();
+    def.kind = DEM_WALL_SEGMENTS;
+    double *pts2 = NULL;
+    size_t n = read_rows(L, 2, "add_polyline", "points", 2, 1, 1, &pts2);
+    double *pts = lua_newuserdatauv(L, 3 * n * sizeof *pts, 0);
+    for (size_t k = 0; k < n; k++)
+        pts[3 * k] = pts2[2 * k], pts[3 * k + 1] = pts2[2 * k + 1], pts[3 * k + 2] = 0;
+    def.n = n;
+    def.points = pts;
+    def.closed = bind_field_boolean(L, 2, "add_polyline", "closed", 0);
+    return shape_wall(L, "add_polyline", &def);
+}
+
+static const char *const MESH_FIELDS[] = {"triangles", SHAPE_COMMON_FIELDS, NULL};
+
+static int l_add_mesh(lua_State *L)
+{
+    dem_scene *s = check_scene(L, 1);
+    check_shape_fields(L, "add_mesh", MESH_FIELDS);
+    if (dem_dim(s) != 3)
+        return luaL_error(L, "bad argument #1 to 'add_mesh' (3D scene expected, got a 2D one: "
+                             "use add_polyline)");
+    dem_shape_def def = dem_default_shape_def();
+    def.kind = DEM_WALL_TRIANGLES;
+    double *pts = NULL;
+    def.n = read_rows(L, 2, "add_mesh", "triangles", 3, 3, 1, &pts);
+    def.points = pts;
+    return shape_wall(L, "add_mesh", &def);
+}
+
+static const char *const CYLINDER_FIELDS[] = {
+    "radius", "axis", "length", "inside", SHAPE_COMMON_FIELDS, NULL};
+
+static int l_add_cylinder(lua_State *L)
+{
+    dem_scene *s = check_scene(L, 1);
+    const int D = dem_dim(s);
+    check_shape_fields(L, "add_cylinder", CYLINDER_FIELDS);
+    dem_shape_def def = dem_default_shape_def();
+    def.kind = DEM_WALL_CYLINDER;
+    bind_field_vector(L, 2, "add_cylinder", "center", D, def.center, BIND_REQUIRED);
+    def.has_center = 1;
+    def.radius =
+        bind_field_number(L, 2, "add_cylinder", "radius", 0, BIND_REQUIRED | BIND_POSITIVE);
+    if (D == 3) {
+        bind_field_vector(L, 2, "add_cylinder", "axis", 3, def.axis, BIND_REQUIRED);
+        def.length = bind_field_number(L, 2, "add_cylinder", "length", 0, BIND_NONNEG);
+    } else {
+        const char *f3[] = {"axis", "length"};
+        for (int k = 0; k < 2; k++)
+            if (lua_getfield(L, 2, f3[k]) != LUA_TNIL)
+                return bind_field_error(L, 2, "add_cylinder", f3[k], "nil (a 2D circle)");
+            else
+                lua_pop(L, 1);
+    }
+    def.inside = bind_field_boolean(L, 2, "add_cylinder", "inside", 1);
+    return shape_wall(L, "add_cylinder", &def);
+}
+
+/* s:wall_load(id) -> force on the wall {fx, fy[, fz]}, torque about its centre (2D: a number). */
+static int l_wall_load(lua_State *L)
+{
+    dem_scene *s = check_scene_local(L, 1);
+    core_error serr;
+    if (dem_sync_walls(s, &serr) != CORE_OK)
+        return bind_raise(L, "wall_load", &serr);
+    double f[3], t[3];
+    core_error err;
+    if (dem_wall_load(s, wall_arg(L, 2, "wall_load"), f, t, &err))
+        return bind_raise(L, "wall_load", &err);
+    push_vector(L, f, dem_dim(s));
+    if (dem_dim(s) == 2)
+        lua_pushnumber(L, t[2]);
+    else
+        push_vector(L, t, 3);
+    return 2;
+}
+
 /* ---- time stepping -------------------------------------------------------------------------- */
 static void push_timestep(lua_State *L, const dem_timestep *t)
 {
@@ -889,6 +1199,15 @@ static int l_particles(lua_State *L)
     static const char *const fs[3] = {"fx", "fy", "fz"};
     for (int d = 0; d < D && dem_forces(s, d); d++) /* the last force evaluation's */
         bind_push_array(L, dem_forces(s, d), n, fs[d]);
+    if (dem_tags(s)) { /* with inserters or outflows: numbers that survive removals */
+        const double *tag = dem_tags(s);
+        lua_createtable(L, (int)n, 0);
+        for (size_t i = 0; i < n; i++) {
+            lua_pushinteger(L, (lua_Integer)tag[i] + 1);
+            lua_rawseti(L, -2, (lua_Integer)i + 1);
+        }
+        lua_setfield(L, -2, "tag");
+    }
     lua_pushinteger(L, (lua_Integer)n);
     lua_setfield(L, -2, "count");
     return 1;
@@ -1103,6 +1422,229 @@ static int l_info(lua_State *L)
     return 1;
 }
 
+/* ---- particles in and out during a run (flow.c) --------------------------------------------- */
+static const char *const INSERTER_FIELDS[] = {
+    "box",     "center",   "extent", "rate",     "count", "mass",  "radius",   "radii",
+    "weights", "velocity", "spread", "material", "seed",  "every", "attempts", NULL};
+
+/* An array field of positive (radii) or non-negative (weights) finite numbers, n > 0 entries
+ * (n_want > 0: exactly that many); a new userdata-free buffer on the Lua stack holds them. */
+static double *number_list(lua_State *L, int arg, const char *call, const char *field,
+                           size_t n_want, int positive, size_t *n)
+{
+    lua_getfield(L, arg, field);
+    const char *expected = positive ? "non-empty array of positive numbers"
+                                    : "non-empty array of non-negative numbers";
+    if (!lua_istable(L, -1) || luaL_len(L, -1) < 1 ||
+        (n_want > 0 && (size_t)luaL_len(L, -1) != n_want))
+        bind_field_error(L, arg, call, field,
+                         n_want > 0 ? "array of one weight per entry of 'radii'" : expected);
+    *n = (size_t)luaL_len(L, -1);
+    double *v = lua_newuserdatauv(L, *n * sizeof *v, 0);
+    for (size_t k = 0; k < *n; k++) {
+        int t = lua_rawgeti(L, -2, (lua_Integer)k + 1);
+        v[k] = lua_tonumber(L, -1);
+        lua_pop(L, 1);
+        if (t != LUA_TNUMBER || !isfinite(v[k]) || (positive ? !(v[k] > 0) : !(v[k] >= 0))) {
+            lua_pop(L, 1); /* the buffer: the field's value on top for the message */
+            bind_field_error(L, arg, call, field, expected);
+        }
+    }
+    lua_remove(L, -2); /* keep the buffer, drop the field's value */
+    return v;
+}
+
+static int l_inserter(lua_State *L)
+{
+    const char *call = "inserter";
+    dem_scene *s = check_scene(L, 1);
+    bind_refuse_running(L, 1, call, "add inserters between runs");
+    bind_check_table(L, 2, call);
+    bind_check_fields(L, 2, call, INSERTER_FIELDS);
+    const int D = dem_dim(s);
+    dem_inserter_def d = dem_default_inserter_def();
+    int has_box = lua_getfield(L, 2, "box") != LUA_TNIL;
+    lua_pop(L, 1);
+    if (has_box) {
+        bind_field_box(L, 2, call, "box", D, d.lo, d.hi);
+        if (lua_getfield(L, 2, "center") != LUA_TNIL)
+            bind_field_error(L, 2, call, "center", "nil with a box (one region)");
+        if (lua_getfield(L, 2, "extent") != LUA_TNIL)
+            bind_field_error(L, 2, call, "extent", "nil with a box (one region)");
+        lua_pop(L, 2);
+    } else {
+        d.ball = 1;
+        if (!bind_field_vector(L, 2, call, "center", D, d.center, 0)) {
+            /* neither region: a disk/ball when an extent says so, else a box */
+            int ball = lua_getfield(L, 2, "extent") != LUA_TNIL;
+            lua_getfield(L, 2, ball ? "center" : "box");
+            bind_field_error(L, 2, call, ball ? "center" : "box",
+                             ball ? "a center with the extent"
+                                  : "a box, or a center and an extent");
+        }
+        d.extent = bind_field_number(L, 2, call, "extent", 0, BIND_REQUIRED | BIND_POSITIVE);
+    }
+    d.rate = bind_field_number(L, 2, call, "rate", 0, BIND_NONNEG);
+    d.count = (long)bind_field_integer(L, 2, call, "count", -1, 0, LONG_MAX, 0);
+    d.mass = bind_field_number(L, 2, call, "mass", 0, BIND_POSITIVE);
+    if (d.rate == 0 && d.count < 0 && d.mass == 0) {
+        lua_getfield(L, 2, "count");
+        bind_field_error(L, 2, call, "count", "a count, a rate or a mass (none given)");
+    }
+    double *radii = NULL, *weights = NULL;
+    int has_radii = lua_getfield(L, 2, "radii") != LUA_TNIL;
+    lua_pop(L, 1);
+    if (has_radii) { /* the list checked first, so that a bad one is named as such */
+        d.size = DEM_SIZE_DISCRETE;
+        radii = number_list(L, 2, call, "radii", 0, 1, &d.nsizes);
+    }
+    lua_getfield(L, 2, "radii");
+    int has_radius = lua_getfield(L, 2, "radius") != LUA_TNIL;
+    if (has_radii == has_radius)
+        bind_field_error(L, 2, call, "radius",
+                         has_radii ? "nil with radii"
+                                   : "a radius, {min, max}, or a field 'radii',");
+    if (has_radius && lua_istable(L, -1)) {
+        double r[2];
+        bind_field_vector(L, 2, call, "radius", 2, r, BIND_REQUIRED);
+        if (!(r[0] > 0 && r[1] >= r[0]))
+            bind_field_error(L, 2, call, "radius", "{min, max} with 0 < min <= max");
+        d.size = DEM_SIZE_UNIFORM;
+        d.r0 = r[0];
+        d.r1 = r[1];
+    } else if (has_radius) {
+        d.r0 = bind_field_number(L, 2, call, "radius", 0, BIND_REQUIRED | BIND_POSITIVE);
+    }
+    lua_pop(L, 2);
+    if (has_radii) {
+        if (lua_getfield(L, 2, "weights") != LUA_TNIL) {
+            size_t nw;
+            lua_pop(L, 1);
+            weights = number_list(L, 2, call, "weights", d.nsizes, 0, &nw);
+        } else {
+            lua_pop(L, 1);
+            weights = lua_newuserdatauv(L, d.nsizes * sizeof *weights, 0);
+            for (size_t k = 0; k < d.nsizes; k++)
+                weights[k] = 1;
+        }
+        d.radii = radii;
+        d.weights = weights;
+    } else if (lua_getfield(L, 2, "weights") != LUA_TNIL) {
+        bind_field_error(L, 2, call, "weights", "nil without radii");
+    } else {
+        lua_pop(L, 1);
+    }
+    bind_field_vector(L, 2, call, "velocity", D, d.velocity, 0);
+    d.spread = bind_field_number(L, 2, call, "spread", 0, BIND_NONNEG);
+    d.seed = (unsigned long long)bind_field_integer(L, 2, call, "seed", 1, 0, LUA_MAXINTEGER, 0);
+    d.every = (long)bind_field_integer(L, 2, call, "every", 1, 1, LONG_MAX, 0);
+    d.attempts = (int)bind_field_integer(L, 2, call, "attempts", 50, 1, 1000000, 0);
+    d.material = material_index(L, 1, 2, call, "material", 0);
+    core_error err;
+    int id = dem_add_inserter(s, &d, &err);
+    if (id < 0)
+        return bind_raise(L, call, &err);
+    lua_pushinteger(L, id + 1);
+    return 1;
+}
+
+static const char *const OUTFLOW_FIELDS[] = {"box", "side", NULL};
+static const char *const SIDE_NAMES[] = {"x-", "x+", "y-", "y+", "z-", "z+", NULL};
+
+static int l_outflow(lua_State *L)
+{
+    const char *call = "outflow";
+    dem_scene *s = check_scene(L, 1);
+    bind_refuse_running(L, 1, call, "add outflows between runs");
+    bind_check_table(L, 2, call);
+    bind_check_fields(L, 2, call, OUTFLOW_FIELDS);
+    const int D = dem_dim(s);
+    dem_outflow_def d;
+    memset(&d, 0, sizeof d);
+    int has_box = lua_getfield(L, 2, "box") != LUA_TNIL;
+    int has_side = lua_getfield(L, 2, "side") != LUA_TNIL;
+    lua_pop(L, 2);
+    d.side = -1;
+    if (has_side) { /* each value checked first, so that a bad one is named as such */
+        d.side = bind_field_option(L, 2, call, "side", SIDE_NAMES, 0, BIND_REQUIRED);
+        if (d.side >= 2 * D) {
+            lua_getfield(L, 2, "side");
+            bind_field_error(L, 2, call, "side",
+                             D == 2 ? "'x-', 'x+', 'y-' or 'y+' in 2D" : "a side name");
+        }
+    }
+    if (has_box)
+        bind_field_box(L, 2, call, "box", D, d.lo, d.hi);
+    if (has_box == has_side) {
+        lua_getfield(L, 2, "side");
+        bind_field_error(L, 2, call, "side",
+                         has_box ? "nil with a box (one region)" : "a side, or a field 'box',");
+    }
+    core_error err;
+    int id = dem_add_outflow(s, &d, &err);
+    if (id < 0)
+        return bind_raise(L, call, &err);
+    lua_pushinteger(L, id + 1);
+    return 1;
+}
+
+static void push_counts(lua_State *L, const dem_flow_counts *c, int inserter)
+{
+    lua_createtable(L, 0, 4);
+    lua_pushinteger(L, c->count);
+    lua_setfield(L, -2, inserter ? "inserted" : "removed");
+    lua_pushnumber(L, c->mass);
+    lua_setfield(L, -2, "mass");
+    if (inserter) {
+        lua_pushinteger(L, c->skipped);
+        lua_setfield(L, -2, "skipped");
+        lua_pushinteger(L, c->events);
+        lua_setfield(L, -2, "events");
+    }
+}
+
+static int l_flow(lua_State *L)
+{
+    dem_scene *s = check_scene(L, 1);
+    long ins = 0, skipped = 0, rem = 0;
+    double ins_m = 0, rem_m = 0;
+    dem_flow_counts c;
+    lua_createtable(L, 0, 10);
+    lua_createtable(L, dem_inserter_count(s), 0);
+    for (int q = 0; q < dem_inserter_count(s); q++) {
+        dem_inserter_counts(s, q, &c, NULL);
+        ins += c.count, ins_m += c.mass, skipped += c.skipped;
+        push_counts(L, &c, 1);
+        lua_rawseti(L, -2, q + 1);
+    }
+    lua_setfield(L, -2, "inserters");
+    lua_createtable(L, dem_outflow_count(s), 0);
+    for (int o = 0; o < dem_outflow_count(s); o++) {
+        dem_outflow_counts(s, o, &c, NULL);
+        rem += c.count, rem_m += c.mass;
+        push_counts(L, &c, 0);
+        lua_rawseti(L, -2, o + 1);
+    }
+    lua_setfield(L, -2, "outflows");
+    double present = 0;
+    const double *m = dem_masses(s);
+    for (size_t i = 0; i < dem_count(s); i++)
+        present += m[i];
+    const lua_Integer iv[4] = {ins, skipped, rem, (lua_Integer)dem_count(s)};
+    const char *in_[4] = {"inserted", "skipped", "removed", "count"};
+    for (int k = 0; k < 4; k++) {
+        lua_pushinteger(L, iv[k]);
+        lua_setfield(L, -2, in_[k]);
+    }
+    const double dv[4] = {ins_m, rem_m, present, dem_time(s)};
+    const char *dn[4] = {"inserted_mass", "removed_mass", "mass", "time"};
+    for (int k = 0; k < 4; k++) {
+        lua_pushnumber(L, dv[k]);
+        lua_setfield(L, -2, dn[k]);
+    }
+    return 1;
+}
+
 static int l_gc(lua_State *L)
 {
     lscene *u = luaL_checkudata(L, 1, SCENE);
@@ -1166,6 +1708,36 @@ void bind_open_dem(lua_State *L)
          "}",
          "Adds a planar wall (normal into the domain), optionally moving and with its own "
          "friction; returns the wall id."},
+        {"add_polyline", l_add_polyline,
+         "s:add_polyline{ points = {{x, y}, ...}, closed = false, center = {x, y}, velocity = "
+         "{vx, vy}, omega = w, motion = rows or function, motion_step =, motion_until =, "
+         "friction = mu, material = m }",
+         "Adds a 2D wall made of segments joining the points (a single segment: two points; "
+         "closed joins the last to the first). Contact at the closest point, end points "
+         "included; a particle on a shared vertex feels one force. The wall moves as a rigid "
+         "body: its centre (default the mean of the points) at velocity, turning at omega "
+         "(rad/s) about it; or motion = {{t, vx, vy, w}, ...} piecewise linear in the scene "
+         "time, or motion = function(t) return {vx, vy}, w end tabulated now every "
+         "motion_step until motion_until (never called during a step). Returns the wall id."},
+        {"add_mesh", l_add_mesh,
+         "s:add_mesh{ triangles = {{{x,y,z}, {x,y,z}, {x,y,z}}, ...}, center =, velocity =, "
+         "omega = {wx, wy, wz}, motion =, motion_step =, motion_until =, friction =, material = }",
+         "Adds a 3D wall of triangles (a mesh: corners with equal coordinates are shared). "
+         "Contact at the closest point, edges and corners included, one force per shared "
+         "feature. Motion as add_polyline (rows {t, vx, vy, vz, wx, wy, wz}). Returns the wall "
+         "id."},
+        {"add_cylinder", l_add_cylinder,
+         "s:add_cylinder{ center = {...}, radius = R, axis = {ax, ay, az}, length = 0, inside = "
+         "true, velocity =, omega =, motion =, motion_step =, motion_until =, friction =, "
+         "material = }",
+         "Adds a circle (2D) or a cylinder (3D, along axis; length 0 = infinite, else open at "
+         "its ends) with the particles inside (a drum) or outside (a post). It turns about its "
+         "centre at omega: a rotating drum drags the particles by friction. Returns the wall "
+         "id."},
+        {"wall_load", l_wall_load, "s:wall_load(id)",
+         "The force the particles exert on the wall ({fx, fy[, fz]}, N) and its torque about "
+         "the wall's centre (2D: a number, N m) at the last force evaluation; for a plane the "
+         "normal part only and no torque."},
         {"remove_wall", l_remove_wall, "s:remove_wall(id)", "Removes a wall during a run."},
         {"wall_velocity", l_wall_velocity, "s:wall_velocity(id, {vx, vy})",
          "Sets a wall's velocity."},
@@ -1211,7 +1783,8 @@ void bind_open_dem(lua_State *L)
         {"particles", l_particles, "s:particles()",
          "Arrays x, y (z), vx, vy (vz), omega (2D) or wx, wy, wz (3D), angle (2D: the integrated "
          "rotation in rad), radius and mass; fx, fy (fz): the total force (N) of the last force "
-         "evaluation (zero before any run); count."},
+         "evaluation (zero before any run); count; tag (with inserters or outflows): a number "
+         "each particle keeps while ids shift on removals."},
         {"set_reference", l_set_reference, "s:set_reference()",
          "Remembers the current positions for displacement measurements."},
         {"scale_mass", l_scale_mass, "s:scale_mass(factor)",
@@ -1233,6 +1806,27 @@ void bind_open_dem(lua_State *L)
          "Padbidri's quasistatic coefficient phi (Eq. 2.13; 2D: m eps^2 N / (2 p R) from "
          "2.B1) and size coefficient psi (Eq. 2.14) of the scene; warns when phi > 0.01. Mass "
          "scaling (s:scale_mass) multiplies phi by its factor."},
+        {"inserter", l_inserter,
+         "s:inserter{ box = {lo, hi} | center = {...}, extent = R, rate =, count =, mass =, "
+         "radius = r | {min, max} | radii = {...}, weights = {...}, velocity = {...}, spread = 0, "
+         "material = m, seed = 1, every = 1, attempts = 50 }",
+         "Inserts particles during runs in a box, or a disk/ball of radius extent (each particle "
+         "wholly inside), never overlapping a particle or a wall: rate per second (counted from "
+         "now), or everything at once; count and mass cap the total. Radius constant, uniform in "
+         "{min, max}, or drawn from radii with weights. Velocity plus spread x uniform(-1, 1) per "
+         "component. Every `every` steps the particles due get `attempts` random positions each "
+         "(the inserter's own stream from seed): one that finds no place is skipped and counted. "
+         "Returns the inserter id; s:flow() gives the counts."},
+        {"outflow", l_outflow,
+         "s:outflow{ box = {lo, hi} } or s:outflow{ side = 'x-'|'x+'|'y-'|...}",
+         "Removes the particles whose centre enters the box (fixed ones excepted) after each "
+         "step, or that leave the domain through that side (not periodic; without an outflow a "
+         "particle leaving the domain stops the run). Ids after a removed particle shift down: "
+         "follow particles by s:particles().tag. Returns the outflow id."},
+        {"flow", l_flow, "s:flow()",
+         "Particles in and out: inserted, inserted_mass, skipped, removed, removed_mass, count "
+         "and mass (present), time; inserters[k] = {inserted, mass, skipped, events}, "
+         "outflows[k] = {removed, mass}."},
         {"info", l_info, "s:info()",
          "dim, box, gravity, count, time, steps, force_evaluations, the laws."},
         {NULL, NULL, NULL, NULL}};
@@ -1243,6 +1837,9 @@ void bind_open_dem(lua_State *L)
                                                 {"add_disk", NULL, PARTICLE_FIELDS},
                                                 {"add_sphere", NULL, PARTICLE_FIELDS},
                                                 {"add_wall", NULL, WALL_FIELDS},
+                                                {"add_polyline", NULL, POLYLINE_FIELDS},
+                                                {"add_mesh", NULL, MESH_FIELDS},
+                                                {"add_cylinder", NULL, CYLINDER_FIELDS},
                                                 {"wall_servo", NULL, SERVO_FIELDS},
                                                 {"timestep", NULL, TIMESTEP_FIELDS},
                                                 {"run", NULL, RUN_FIELDS},
@@ -1251,6 +1848,8 @@ void bind_open_dem(lua_State *L)
                                                 {"set_forces", NULL, FORCES_FIELDS},
                                                 {"quasistatic", NULL, QUASISTATIC_FIELDS},
                                                 {"damping_time", NULL, DAMPING_TIME_FIELDS},
+                                                {"inserter", NULL, INSERTER_FIELDS},
+                                                {"outflow", NULL, OUTFLOW_FIELDS},
                                                 {NULL, NULL, NULL}};
     bind_type_fields(L, SCENE, method_fields);
     static const bind_fn fns[] = {

@@ -1,4 +1,4 @@
--- Boundary conditions (here springs) do not run distributed yet: under mpirun -np K > 1 the run
+-- Boundary conditions (here springs) and walls beyond planes do not run distributed yet: under mpirun -np K > 1 the run
 -- must stop with an error that names them on every rank; on one rank the run works.
 local s = dem.scene{ dim = 2, box = { { 0, 0 }, { 0.01, 0.01 } } }
 local m = grainlab.material{ name = "quartz", density = 2650, young = 1e8, poisson = 0.3,
@@ -14,6 +14,35 @@ else
   assert(not ok, "a run with springs went ahead on " .. ranks .. " ranks")
   assert(tostring(err):find("do not yet run distributed", 1, true), err)
   assert(tostring(err):find("springs", 1, true), err)
+end
+
+-- Particles in and out (inserters, outflows) do not run distributed either: refused by name.
+local fl = dem.scene{ dim = 2, box = { { 0, 0 }, { 0.01, 0.01 } } }
+fl:add_disk{ pos = { 0.005, 0.005 }, radius = 0.0005, material = m }
+fl:inserter{ box = { { 0, 0.008 }, { 0.01, 0.01 } }, count = 3, radius = 0.0004, material = m }
+local okf, errf = pcall(fl.run, fl, { steps = 10, dt = 1e-7 })
+if ranks == 1 then
+  assert(okf, errf)
+  assert(fl:flow().inserted == 3, "one rank: inserted")
+else
+  assert(not okf, "a run with an inserter went ahead on " .. ranks .. " ranks")
+  assert(tostring(errf):find("particle insertion and removal", 1, true), errf)
+  assert(tostring(errf):find("do not yet run distributed", 1, true), errf)
+end
+print("ok")
+
+-- Walls beyond planes (a circle here) do not run distributed yet either: refused by name.
+local d = dem.scene{ dim = 2, box = { { 0, 0 }, { 0.01, 0.01 } }, gravity = { 0, -9.81 } }
+d:add_disk{ pos = { 0.005, 0.003 }, radius = 0.0005, material = m }
+d:add_cylinder{ center = { 0.005, 0.005 }, radius = 0.004 }
+local okd, errd = pcall(d.run, d, { steps = 10, dt = 1e-7 })
+if ranks == 1 then
+  assert(okd, errd)
+else
+  assert(not okd, "a run with a circle wall went ahead on " .. ranks .. " ranks")
+  assert(tostring(errd):find("do not yet run distributed", 1, true), errd)
+  assert(tostring(errd):find("walls beyond planes", 1, true), errd)
+  assert(tostring(errd):find("circles", 1, true), errd)
 end
 print("ok")
 

@@ -305,6 +305,44 @@ local ds = grainlab.vtk.series(P("gas.pvd"))
 ds:add(d, 0)
 expect("pvd gas_cells.pvd 1 0 gas_cells_0001.vti")
 
+-- ---- walls beyond planes: a polyline and a circle (2D; polylines), a mesh (triangles) and a
+-- finite cylinder (its two rims) in 3D, with their id, kind, load and torque ----------------------
+do
+  local s = dem.scene{ dim = 2, box = { { -1, -1 }, { 1, 1 } }, gravity = { 0, -9.81 } }
+  s:add_disk{ pos = { 0, -0.45 }, radius = 0.05 }
+  s:add_wall{ point = { 0, -0.9 }, normal = { 0, 1 } }
+  s:add_polyline{ points = { { -0.5, 0.5 }, { 0, 0.6 }, { 0.5, 0.5 } } }
+  local c = s:add_cylinder{ center = { 0, 0 }, radius = 0.5, omega = 2 }
+  s:run{ steps = 2000 }
+  s:write_vtk(P("shapes2.vtu"))
+  expect("open shapes2_walls.vtu vtu %d 3", 2 + 3 + 65)
+  expect("celltype shapes2_walls.vtu 0 3")
+  expect("celltype shapes2_walls.vtu 1 4")
+  expect("celltype shapes2_walls.vtu 2 4")
+  expect("cellpoints shapes2_walls.vtu 1 2 3 4")
+  expect("coord shapes2_walls.vtu 3 1 0.59999999999999998")
+  for k, v in ipairs{ 0, 1, 3 } do expect("cell shapes2_walls.vtu kind %d 0 %d", k - 1, v) end
+  expect("cell shapes2_walls.vtu id 2 0 3")
+  local f, t = s:wall_load(c)
+  expect("cell shapes2_walls.vtu load 2 1 %s", g17(f[2]))
+  expect("cell shapes2_walls.vtu torque 2 2 %s", g17(t))
+  local s3 = dem.scene{ dim = 3, box = { { -1, -1, -1 }, { 1, 1, 1 } } }
+  s3:add_sphere{ pos = { 0, 0, 0.5 }, radius = 0.05 }
+  s3:add_mesh{ triangles = { { { 0, 0, 0 }, { 1, 0, 0 }, { 0, 1, 0 } }, { { 1, 0, 0 }, { 1, 1, 0 }, { 0, 1, 0 } } } }
+  s3:add_cylinder{ center = { 0, 0, 0 }, radius = 0.8, axis = { 0, 0, 1 }, length = 1 }
+  s3:write_vtk(P("shapes3.vtu"))
+  expect("open shapes3_walls.vtu vtu %d 4", 6 + 2 * 65)
+  expect("celltype shapes3_walls.vtu 0 5")
+  expect("celltype shapes3_walls.vtu 1 5")
+  expect("celltype shapes3_walls.vtu 2 4")
+  expect("celltype shapes3_walls.vtu 3 4")
+  expect("coord shapes3_walls.vtu 4 0 1")
+  expect("coord shapes3_walls.vtu 4 1 1")
+  expect("near coord shapes3_walls.vtu 6 2 -0.5 1e-15") -- the lower rim at z = -length/2
+  expect("near coord shapes3_walls.vtu 71 2 0.5 1e-15")
+  expect("cell shapes3_walls.vtu kind 3 0 3")
+end
+
 -- ---- VTK reads it all --------------------------------------------------------------------------
 local ef = assert(io.open(P("expect.txt"), "w"))
 ef:write(table.concat(lines, "\n"), "\n")
