@@ -1,5 +1,5 @@
 -- grainlab.material{…}: a validated, read-only description of a grain material, shared by the
--- methods (DEM reads density, young, poisson, friction, restitution).
+-- methods (DEM reads density, young, poisson, friction, restitution, rolling_friction).
 local FIELDS = {
   name        = { kind = "string" },
   density     = { kind = "positive", required = true },  -- kg/m^3
@@ -7,6 +7,7 @@ local FIELDS = {
   poisson     = { kind = "range", lo = 0, hi = 0.5, open_hi = true, default = 0.3 },
   friction    = { kind = "nonneg", default = 0 },         -- Coulomb coefficient
   restitution = { kind = "range", lo = 0, hi = 1, open_lo = true, default = 1 },
+  rolling_friction = { kind = "nonneg", default = 0 },    -- rolling resistance mu_r (DEM)
 }
 
 local function describe(v)
@@ -44,7 +45,7 @@ local function material(t)
   end
   for k in pairs(t) do
     if not FIELDS[k] then
-      error(string.format("bad argument #1 to 'material' (unknown field %s; valid fields: density, friction, name, poisson, restitution, young)",
+      error(string.format("bad argument #1 to 'material' (unknown field %s; valid fields: density, friction, name, poisson, restitution, rolling_friction, young)",
                           describe(k)), 2)
     end
   end
@@ -81,8 +82,9 @@ local field_names = {}
 for name in pairs(FIELDS) do field_names[#field_names + 1] = name end
 table.sort(field_names)
 grainlab.doc(material, { name = "grainlab.material", fields = field_names,
-  usage = "grainlab.material{ density = 2650, young = 30e9, poisson = 0.3, friction = 0.45, restitution = 0.5, name = 'quartz' }",
+  usage = "grainlab.material{ density = 2650, young = 30e9, poisson = 0.3, friction = 0.45, restitution = 0.5, rolling_friction = 0, name = 'quartz' }",
   doc = [[A read-only grain material. density (kg/m^3) and young (Pa) are required; poisson defaults
-to 0.3, friction (Coulomb mu) to 0, restitution to 1 (elastic). A DEM pair uses the smaller
-friction and restitution of its two materials and the effective modulus of both.]] })
+to 0.3, friction (Coulomb mu) to 0, restitution to 1 (elastic), rolling_friction (the rolling
+resistance mu_r of a DEM contact law with rolling_resistance) to 0. A DEM pair uses the smaller
+friction, restitution and rolling_friction of its two materials and the effective modulus of both.]] })
 return material

@@ -50,6 +50,41 @@ static void put_contact(ckpt_writer *w, const dem_contact_def *c)
     ckpt_put_u32(w, c->rolling);
 }
 
+/* Rolling resistance (rolling.inc) has its own section, written only by a scene that uses it (a
+ * rolling law, or a material with a rolling friction): a file without it loads as before, and a
+ * grainlab without rolling resistance refuses a file with it by the section's name. It holds the
+ * law, the materials' mu_r, and the rolling spring's history of the pairs and walls. */
+static int uses_rolling(const dem_scene *s)
+{
+    int used = s->contact.rolling_law != DEM_ROLLING_NONE;
+    for (int k = 0; k < s->nmat; k++)
+        used |= s->mats[k].rolling_friction != 0;
+    return used;
+}
+
+static core_status write_rolling(const dem_scene *s, ckpt_writer *w, core_error *err)
+{
+    core_status st;
+    if ((st = ckpt_section_begin(w, "rolling", CKPT_REQUIRED, err)))
+        return st;
+    const dem_contact_def *c = &s->contact;
+    ckpt_put_u32(w, (uint32_t)c->rolling_law);
+    ckpt_put_f64(w, c->rolling_friction);
+    ckpt_put_f64(w, c->rolling_stiffness);
+    ckpt_put_f64(w, c->rolling_damping);
+    ckpt_put_f64(w, c->rolling_rate);
+    ckpt_put_u64(w, (uint64_t)s->nmat);
+    for (int k = 0; k < s->nmat; k++)
+        ckpt_put_f64(w, s->mats[k].rolling_friction);
+    for (int d = 0; d < 3; d++)
+        put_opt(w, s->pairs.hist[DEM_HIST_ROLL + d], s->pairs.n);
+    ckpt_put_u64(w, (uint64_t)s->nwalls);
+    for (int k = 0; k < s->nwalls; k++)
+        for (int d = 0; d < 3; d++)
+            put_opt(w, s->walls[k].hist[DEM_HIST_ROLL + d], s->n);
+    return end(w, err);
+}
+
 static core_status write_scene(const dem_scene *s, ckpt_writer *w, core_error *err)
 {
     const size_t n = s->n;
@@ -191,6 +226,8 @@ static core_status write_scene(const dem_scene *s, ckpt_writer *w, core_error *e
     for (int d = 0; d < 4; d++)
         put_opt(w, p->hist[d], p->n);
     if ((st = end(w, err)))
+        return st;
+    if (uses_rolling(s) && (st = write_rolling(s, w, err)))
         return st;
     if (s->bnd && (st = dem_boundary_save(s, w, err)))
         return st;
@@ -421,6 +458,41 @@ static void read_pairs(reader *r, dem_scene *s)
         r->st = index_pairs(p, r->err);
 }
 
+static void read_rolling(reader *r, dem_scene *s)
+{
+    dem_contact_def *c = &s->contact;
+    uint32_t law = u32(r);
+    if (law > DEM_ROLLING_CONSTANT)
+        bad(r, "unknown rolling law");
+    c->rolling_law = (dem_rolling_law)law;
+    c->rolling_friction = f64(r);
+    c->rolling_stiffness = f64(r);
+    c->rolling_damping = f64(r);
+    c->rolling_rate = f64(r);
+    if (u64(r) != (uint64_t)s->nmat)
+        bad(r, "material count");
+    for (int k = 0; k < s->nmat && !r->st; k++) {
+        s->mats[k].rolling_friction = f64(r);
+        if (!(s->mats[k].rolling_friction >= 0))
+            bad(r, "negative rolling friction");
+    }
+    dem_pairs *p = &s->pairs;
+    for (int d = 0; d < 3; d++)
+        get_opt(r, &p->hist[DEM_HIST_ROLL + d], p->n, p->n);
+    if (u64(r) != (uint64_t)s->nwalls)
+        bad(r, "wall count");
+    const size_t n = s->n;
+    for (int k = 0; k < s->nwalls && !r->st; k++)
+        for (int d = 0; d < 3; d++)
+            get_opt(r, &s->walls[k].hist[DEM_HIST_ROLL + d], n, n ? n : 1);
+    /* the torques are scratch of each evaluation: allocated as the list build does */
+    for (int d = s->dim == 2 ? 2 : 0; d < 3 && !r->st && c->rolling_law && p->start; d++) {
+        free(p->rt[d]);
+        if (!(p->rt[d] = calloc(p->n ? p->n : 1, sizeof(double))))
+            r->st = core_fail(r->err, CORE_ERR_NOMEM, "out of memory loading a checkpoint");
+    }
+}
+
 /* A file that passed the checksum but was not written by dem_save (forged, or a bug) must not
  * make a step read arrays that are not there: the kernels allocate their state in whole sets,
  * and a list in use covers every particle. Returns what is wrong, or NULL. */
@@ -440,6 +512,11 @@ static const char *inconsistent(const dem_scene *s, int gear_ready, int prev_rea
         for (int d = 1; d < 4; d++)
             if ((d < D || d == 3) && !s->walls[w].hist[d] != !s->walls[w].hist[0])
                 return "incomplete wall history";
+    for (int w = 0; w < s->nwalls; w++)
+        for (int d = 1; d < 3; d++)
+            if ((D == 3) &&
+                !s->walls[w].hist[DEM_HIST_ROLL + d] != !s->walls[w].hist[DEM_HIST_ROLL])
+                return "incomplete wall rolling history";
     const dem_pairs *p = &s->pairs;
     if (!need_rebuild) {
         if (!p->start || p->np != s->n)
@@ -454,6 +531,11 @@ static const char *inconsistent(const dem_scene *s, int gear_ready, int prev_rea
         }
         if (s->contact.tangential == DEM_TANGENT_SPRING && p->n > 0 && !p->hist[3])
             return "contact history missing";
+        for (int d = 0; d < dem_rolling_slots(s) && p->n > 0; d++)
+            if (!p->hist[DEM_HIST_ROLL + d])
+                return "rolling history missing";
+        if (s->contact.rolling_law && !p->rt[2])
+            return "rolling torques missing";
     }
     return NULL;
 }
@@ -534,7 +616,7 @@ static void read_all(reader *r, ckpt_reader *ck, const dem_boundary_restorer *re
         double v[5];
         if ((r->st = ckpt_get_f64s(&r->sec, v, 5, r->err)))
             break;
-        s->mats[k] = (dem_material){v[0], v[1], v[2], v[3], v[4]};
+        s->mats[k] = (dem_material){v[0], v[1], v[2], v[3], v[4], 0}; /* rolling: its section */
     }
     close_section(r);
 
@@ -650,6 +732,11 @@ static void read_all(reader *r, ckpt_reader *ck, const dem_boundary_restorer *re
     open_section(r, ck, "pairs");
     read_pairs(r, s);
     close_section(r);
+    if (!r->st && ckpt_has(ck, "rolling")) {
+        open_section(r, ck, "rolling");
+        read_rolling(r, s);
+        close_section(r);
+    }
     if (!r->st && ckpt_has(ck, "boundary")) {
         open_section(r, ck, "boundary");
         if (!r->st)

@@ -69,6 +69,8 @@ typedef struct dem_material {
     double poisson;      /* [0, 0.5) */
     double friction;     /* Coulomb mu >= 0; a pair uses the smaller of its two */
     double restitution;  /* (0, 1]: sets the linear law's damping; 1 = none */
+    double rolling_friction; /* rolling resistance mu_r >= 0 (the torque limit is mu_r R_eff
+                              * F_n); a pair uses the smaller of its two; 0 (default) = none */
 } dem_material;
 
 dem_material dem_default_material(void); /* quartz: 2650, 30 GPa, 0.3, 0.45, 0.5 */
@@ -96,6 +98,17 @@ typedef enum dem_tangential_law {
     DEM_TANGENT_REGULARIZED  /* |f_t| = mu f_n min(1, (s/v_R)^{1/c}) (Padbidri Eq. 1.3, 2.18) */
 } dem_tangential_law;
 
+/* Rolling resistance (rolling.inc): a torque against the relative rolling of the two surfaces,
+ * at most mu_r R_eff F_n (R_eff = r_i r_j / (r_i + r_j); against a wall R_eff = r_i). */
+typedef enum dem_rolling_law {
+    DEM_ROLLING_NONE,
+    DEM_ROLLING_EPSD,    /* Ai, Chen, Rotter & Ooi (2011) type C: elastic-plastic spring-dashpot,
+                          * an incremental spring k_r per contact (history), capped at the limit,
+                          * a viscous part of damping ratio eta_r below it */
+    DEM_ROLLING_CONSTANT /* Ai et al. type A: M = -mu_r R_eff F_n w_rel / |w_rel|, linear below
+                          * a rate w_c so that a grain at rest does not chatter */
+} dem_rolling_law;
+
 typedef struct dem_contact_def {
     dem_normal_law normal;
     double stiffness;        /* k for LINEAR / POWER, N/m^beta */
@@ -113,6 +126,14 @@ typedef struct dem_contact_def {
     double exponent;         /* REGULARIZED c (large) */
     bool clip;               /* no attractive normal force (default true) */
     bool rolling;            /* allocate rotations even without a tangential law */
+    dem_rolling_law rolling_law; /* rolling resistance (allocates rotations); NONE default */
+    double rolling_friction;     /* mu_r of every pair and wall; < 0 (default) = the materials' */
+    double rolling_stiffness;    /* EPSD k_r, N m/rad; < 0 (default) = k_t R_eff^2, with k_t the
+                                  * tangential spring stiffness (kt, or 2/7 of the normal one) */
+    double rolling_damping; /* EPSD damping ratio eta_r in [0, 1]: C_r = 2 eta_r sqrt(I_r k_r) */
+    double rolling_rate;    /* CONSTANT w_c, rad/s; 0 (default) = automatic: the rate below
+                             * which the full torque would stop the relative rotation of the
+                             * contact within 10 steps (rolling.inc) */
 } dem_contact_def;
 
 dem_contact_def dem_default_contact_def(void); /* Hertz, no damping, no friction, clip */

@@ -11,6 +11,12 @@
 
 #define DEM_PI 3.14159265358979323846
 
+/* Contact history slots (pairs and walls): [0..2] the tangential spring force and [3] its last
+ * stiffness (SPRING law), [4..6] the rolling spring torque (rolling EPSD; 2D: [4] only, the z
+ * component). Slots a scene's laws do not use stay NULL. */
+#define DEM_HIST 7
+#define DEM_HIST_ROLL 4
+
 typedef struct dem_shape dem_shape; /* walls beyond planes (walls.c) */
 enum { DEM_SHAPE_LOAD = 7 };        /* per candidate: force[3], torque[3], f_n */
 
@@ -19,7 +25,7 @@ typedef struct dem_wall {
     double point[3], normal[3], velocity[3];
     double friction;
     int material;
-    double *hist[4];       /* SPRING law, per particle: see dem_pairs.hist */
+    double *hist[DEM_HIST]; /* per particle: see DEM_HIST */
     uint32_t *cand;        /* particles within r + skin of the wall at the last list build */
     double *cand_fn;       /* distributed runs: each candidate's normal force (domain.c) */
     size_t ncand, cap_cand;
@@ -38,8 +44,12 @@ typedef struct dem_pairs {
     double *k;        /* normal stiffness (k or K) of the pair */
     double *gamma;    /* viscous normal damping of the pair, N s/m */
     double *mu;       /* friction of the pair */
-    double *hist[4];  /* SPRING law: the tangential force on i ([0..2]; 2D: [0] along t) and
-                       * [3] the spring stiffness of the last step (for the unloading rescale) */
+    double *hist[DEM_HIST]; /* SPRING law: the tangential force on i ([0..2]; 2D: [0] along t)
+                             * and [3] the spring stiffness of the last step (for the unloading
+                             * rescale); rolling EPSD: [4..6] the rolling spring torque on i */
+    double *rt[3];          /* rolling resistance: the rolling torque on i of the evaluation
+                             * (j gets the opposite; 2D: rt[2] only), scratch between the pair
+                             * kernel and the gather; NULL without a rolling law */
     double *f[3];     /* force on i of the last evaluation (j gets the opposite) */
     double *c[3];     /* n x f_t: torque on i is -r_i c, on j -r_j c (2D: c[2] only) */
     size_t np;        /* particles when the list was built */
@@ -147,7 +157,8 @@ core_status dem_domain_agree_flag(dem_scene *s, core_status st, int *flag, core_
 void dem_domain_free(dem_scene *s);
 size_t dem_domain_count(const dem_scene *s); /* particles on all ranks */
 /* History of the pairs of local particle i as first index (sorted by the partner's global id),
- * carried to its new rank by the last rebuild: n entries, partner ids and 4 values each. */
+ * carried to its new rank by the last rebuild: n entries, partner ids and dem_hist_width(s)
+ * values each. */
 size_t dem_domain_bundle(const dem_scene *s, size_t i, const uint32_t **gj, const double **h);
 /* The global id (1-based in messages: + 1) of local particle i. */
 static inline size_t dem_gid(const dem_scene *s, size_t i) { return s->gid ? s->gid[i] : i; }
@@ -251,6 +262,15 @@ size_t dem_compute_forces(dem_scene *s, double dt);
 double dem_normal_force(const dem_contact_def *c, double k, double gamma, double delta,
                         double ddelta);
 double dem_elastic_energy(const dem_contact_def *c, double k, double delta);
+
+/* rolling.inc: the history slots the laws of s use (DEM_HIST_ROLL + d for d < this), and the
+ * values per history entry moved between ranks (domain.c bundles): the tangential 4, and the
+ * rolling 3 only with a rolling history (a scene without it sends what it sent before). */
+static inline int dem_rolling_slots(const dem_scene *s)
+{
+    return s->contact.rolling_law == DEM_ROLLING_EPSD ? (s->dim == 2 ? 1 : 3) : 0;
+}
+static inline int dem_hist_width(const dem_scene *s) { return dem_rolling_slots(s) ? DEM_HIST : 4; }
 
 /* scene.c */
 /* The scene changed outside a step: forces, integrator state and (if `list`) the pair list

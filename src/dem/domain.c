@@ -124,7 +124,7 @@ size_t dem_domain_bundle(const dem_scene *s, size_t i, const uint32_t **gj, cons
         return 0;
     }
     *gj = dm->hb_j + dm->hb_start[i];
-    *h = dm->hb_h + 4 * dm->hb_start[i];
+    *h = dm->hb_h + (size_t)dem_hist_width(s) * dm->hb_start[i];
     return dm->hb_start[i + 1] - dm->hb_start[i];
 }
 
@@ -198,13 +198,13 @@ static int particle_arrays(dem_scene *s, parray *a)
     ADD(s->flags, sizeof(unsigned char));
     ADD(s->tag, sizeof(double));
     for (int w = 0; w < s->nwalls; w++)
-        for (int k = 0; k < 4; k++)
+        for (int k = 0; k < DEM_HIST; k++)
             ADD(s->walls[w].hist[k], sizeof(double));
 #undef ADD
     return n;
 }
 
-static int max_arrays(const dem_scene *s) { return 3 * 21 + 8 + 4 * s->nwalls; }
+static int max_arrays(const dem_scene *s) { return 3 * 21 + 8 + DEM_HIST * s->nwalls; }
 
 int dem_particle_arrays(dem_scene *s, dem_parray *a) { return particle_arrays(s, a); }
 int dem_max_particle_arrays(const dem_scene *s) { return max_arrays(s); }
@@ -603,7 +603,7 @@ core_status dem_domain_start(dem_scene *s, core_error *err)
                     continue;
                 p->i[m] = i, p->j[m] = j, p->k[m] = p->k[q], p->gamma[m] = p->gamma[q];
                 p->mu[m] = p->mu[q];
-                for (int d = 0; d < 4; d++)
+                for (int d = 0; d < DEM_HIST; d++)
                     if (p->hist[d])
                         p->hist[d][m] = p->hist[d][q];
                 for (int d = 0; d < 3; d++) {
@@ -688,7 +688,7 @@ static int cmp_ref(const void *pa, const void *pb)
     return (a->gid > b->gid) - (a->gid < b->gid);
 }
 
-enum { HDR = 3 * sizeof(uint32_t), BENTRY = sizeof(uint32_t) + 4 * sizeof(double) };
+enum { HDR = 3 * sizeof(uint32_t) };
 
 /* Rebalance when the load is off: every rank's owned positions to every rank, new regions. */
 static core_status rebalance(dem_scene *s, core_error *err)
@@ -744,7 +744,10 @@ core_status dem_domain_rebuild(dem_scene *s, core_error *err)
     int na = particle_arrays(s, a);
     const size_t rb = record_bytes(a, na);
     const dem_pairs *p = &s->pairs;
-    const int hist = p->hist[0] && p->start && p->np == s->n;
+    const int hist = (p->hist[0] || p->hist[DEM_HIST_ROLL]) && p->start && p->np == s->n;
+    /* a history entry: the partner's id and hw values (dem_hist_width) */
+    const int hw = dem_hist_width(s);
+    const size_t bentry = sizeof(uint32_t) + (size_t)hw * sizeof(double);
     /* Bundle sizes: the pairs of each owned particle as i whose history is not all zero bits. */
     size_t *nb = calloc(s->n ? s->n : 1, sizeof *nb);
     size_t *sbytes = calloc((size_t)P * 3, sizeof *sbytes);
@@ -756,16 +759,16 @@ core_status dem_domain_rebuild(dem_scene *s, core_error *err)
     }
     size_t *soff = sbytes + P, *fill = sbytes + 2 * P;
     long migrated = 0;
-    static const double zero4[4] = {0, 0, 0, 0};
+    static const double zeros[DEM_HIST] = {0};
     for (size_t i = 0; i < s->n; i++) {
         if (s->ghost[i])
             continue;
         if (hist)
             for (size_t q = p->start[i]; q < p->start[i + 1]; q++) {
-                double h[4];
-                for (int d = 0; d < 4; d++)
+                double h[DEM_HIST];
+                for (int d = 0; d < hw; d++)
                     h[d] = p->hist[d] ? p->hist[d][q] : 0;
-                nb[i] += memcmp(h, zero4, sizeof h) != 0;
+                nb[i] += memcmp(h, zeros, (size_t)hw * sizeof *h) != 0;
             }
         double c[3];
         position(s, s->x, i, c);
@@ -773,7 +776,7 @@ core_status dem_domain_rebuild(dem_scene *s, core_error *err)
         migrated += o != dm->me;
         for (int r = 0; r < P; r++)
             if (r == o || near_region(s, dm, r, c))
-                sbytes[r] += HDR + rb + nb[i] * BENTRY;
+                sbytes[r] += HDR + rb + nb[i] * bentry;
     }
     size_t total = 0;
     for (int r = 0; r < P; r++)
@@ -799,15 +802,15 @@ core_status dem_domain_rebuild(dem_scene *s, core_error *err)
             b = pack_particle(b + HDR, a, na, i);
             if (nb[i])
                 for (size_t q = p->start[i]; q < p->start[i + 1]; q++) {
-                    double h[4];
-                    for (int d = 0; d < 4; d++)
+                    double h[DEM_HIST];
+                    for (int d = 0; d < hw; d++)
                         h[d] = p->hist[d] ? p->hist[d][q] : 0;
-                    if (!memcmp(h, zero4, sizeof h))
+                    if (!memcmp(h, zeros, (size_t)hw * sizeof *h))
                         continue;
                     uint32_t gj = s->gid[p->j[q]];
                     memcpy(b, &gj, sizeof gj);
-                    memcpy(b + sizeof gj, h, sizeof h);
-                    b += BENTRY;
+                    memcpy(b + sizeof gj, h, (size_t)hw * sizeof *h);
+                    b += bentry;
                 }
             fill[r] = (size_t)(b - sbuf);
         }
@@ -832,7 +835,7 @@ core_status dem_domain_rebuild(dem_scene *s, core_error *err)
     for (size_t off = 0; off < rtotal; nrec++) {
         uint32_t hdr[3];
         memcpy(hdr, (char *)recv + off, HDR);
-        off += HDR + rb + hdr[2] * BENTRY;
+        off += HDR + rb + hdr[2] * bentry;
         nent += hdr[2];
     }
     rec_ref *ref = malloc((nrec ? nrec : 1) * sizeof *ref);
@@ -845,14 +848,14 @@ core_status dem_domain_rebuild(dem_scene *s, core_error *err)
         uint32_t hdr[3];
         memcpy(hdr, (char *)recv + off, HDR);
         ref[k] = (rec_ref){hdr[0], hdr[1], hdr[2], (char *)recv + off + HDR};
-        off += HDR + rb + hdr[2] * BENTRY;
+        off += HDR + rb + hdr[2] * bentry;
     }
     qsort(ref, nrec, sizeof *ref, cmp_ref);
     st = resize(s, a, na, nrec, 1, err);
     free_bundles(dm);
     dm->hb_start = malloc((nrec + 1) * sizeof *dm->hb_start);
     dm->hb_j = malloc((nent ? nent : 1) * sizeof *dm->hb_j);
-    dm->hb_h = malloc((nent ? nent : 1) * 4 * sizeof *dm->hb_h);
+    dm->hb_h = malloc((nent ? nent : 1) * (size_t)hw * sizeof *dm->hb_h);
     if (!st && (!dm->hb_start || !dm->hb_j || !dm->hb_h))
         st = core_fail(err, CORE_ERR_NOMEM, "cannot allocate the contact history");
     if (!st) {
@@ -864,8 +867,9 @@ core_status dem_domain_rebuild(dem_scene *s, core_error *err)
             s->ghost[k] = !ref[k].owned;
             for (uint32_t q = 0; q < ref[k].nb; q++, e++) {
                 memcpy(&dm->hb_j[e], b, sizeof(uint32_t));
-                memcpy(&dm->hb_h[4 * e], b + sizeof(uint32_t), 4 * sizeof(double));
-                b += BENTRY;
+                memcpy(&dm->hb_h[(size_t)hw * e], b + sizeof(uint32_t),
+                       (size_t)hw * sizeof(double));
+                b += bentry;
             }
             dm->hb_start[k + 1] = e;
         }
@@ -986,7 +990,7 @@ static core_status wall_sums(dem_scene *s, core_error *err)
  */
 typedef struct pair_rec {
     uint32_t i, j;
-    double v[14]; /* k, gamma, mu, hist[4], f[3], c[3], pad */
+    double v[16]; /* k, gamma, mu, f[3], c[3], hist[DEM_HIST] */
 } pair_rec;
 
 static int cmp_pair(const void *pa, const void *pb)
@@ -1044,12 +1048,12 @@ core_status dem_replicate(dem_scene *s, core_error *err)
             pair_rec *r = &pr[npr++];
             r->i = s->gid[p->i[q]], r->j = s->gid[p->j[q]];
             r->v[0] = p->k[q], r->v[1] = p->gamma[q], r->v[2] = p->mu[q];
-            for (int d = 0; d < 4; d++)
-                r->v[3 + d] = p->hist[d] ? p->hist[d][q] : 0;
             for (int d = 0; d < 3; d++) {
-                r->v[7 + d] = p->f[d] ? p->f[d][q] : 0;
-                r->v[10 + d] = p->c[d] ? p->c[d][q] : 0;
+                r->v[3 + d] = p->f[d] ? p->f[d][q] : 0;
+                r->v[6 + d] = p->c[d] ? p->c[d][q] : 0;
             }
+            for (int d = 0; d < DEM_HIST; d++)
+                r->v[9 + d] = p->hist[d] ? p->hist[d][q] : 0;
         }
     ncw = 0;
     for (int w = 0; w < s->nwalls; w++)
@@ -1103,6 +1107,10 @@ core_status dem_replicate(dem_scene *s, core_error *err)
         }
         if (s->contact.tangential == DEM_TANGENT_SPRING)
             ok &= (p->hist[3] = malloc(cap * sizeof(double))) != NULL;
+        for (int d = s->dim == 2 ? 2 : 0; d < 3 && s->contact.rolling_law; d++)
+            ok &= (p->rt[d] = malloc(cap * sizeof(double))) != NULL;
+        for (int d = 0; d < dem_rolling_slots(s); d++)
+            ok &= (p->hist[DEM_HIST_ROLL + d] = malloc(cap * sizeof(double))) != NULL;
         p->cap = cap;
         p->n = np;
         if (!ok)
@@ -1110,15 +1118,17 @@ core_status dem_replicate(dem_scene *s, core_error *err)
         for (size_t q = 0; q < np && !st; q++) {
             p->i[q] = ap[q].i, p->j[q] = ap[q].j;
             p->k[q] = ap[q].v[0], p->gamma[q] = ap[q].v[1], p->mu[q] = ap[q].v[2];
-            for (int d = 0; d < 4; d++)
-                if (p->hist[d])
-                    p->hist[d][q] = ap[q].v[3 + d];
             for (int d = 0; d < 3; d++) {
                 if (p->f[d])
-                    p->f[d][q] = ap[q].v[7 + d];
+                    p->f[d][q] = ap[q].v[3 + d];
                 if (p->c[d])
-                    p->c[d][q] = ap[q].v[10 + d];
+                    p->c[d][q] = ap[q].v[6 + d];
+                if (p->rt[d]) /* scratch of the next evaluation */
+                    p->rt[d][q] = 0;
             }
+            for (int d = 0; d < DEM_HIST; d++)
+                if (p->hist[d])
+                    p->hist[d][q] = ap[q].v[9 + d];
         }
         if (!st)
             st = dem_pairs_index(s, err);

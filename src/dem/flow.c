@@ -382,7 +382,7 @@ static core_status compact(dem_scene *s, const unsigned char *gone, core_error *
             p->k[w] = p->k[q];
             p->gamma[w] = p->gamma[q];
             p->mu[w] = p->mu[q];
-            for (int d = 0; d < 4; d++)
+            for (int d = 0; d < DEM_HIST; d++) /* tangential and rolling (rolling.inc) */
                 if (p->hist[d])
                     p->hist[d][w] = p->hist[d][q];
             for (int d = 0; d < 3; d++) {

@@ -79,6 +79,8 @@ static inline double regularized(const dem_contact_def *c, const dem_power *pw, 
     return x >= 1 ? mu * fn : mu * fn * dem_power_eval(pw, x); /* x^(1/c) */
 }
 
+#include "dem/rolling.inc"
+
 #define DIM 2
 #include "dem/forces_dim.inc"
 #undef DIM
@@ -90,13 +92,22 @@ size_t dem_compute_forces(dem_scene *s, double dt)
 {
     s->force_evals++;
     size_t t;
+    const int roll = s->contact.rolling_law != DEM_ROLLING_NONE; /* rolling.inc */
     if (s->dim == 2) {
         pair_forces_2(s, dt);
+        if (roll)
+            roll_pairs(s, dt);
         gather_2(s);
+        if (roll)
+            roll_gather(s);
         t = walls_2(s, dt);
     } else {
         pair_forces_3(s, dt);
+        if (roll)
+            roll_pairs(s, dt);
         gather_3(s);
+        if (roll)
+            roll_gather(s);
         t = walls_3(s, dt);
     }
     if (s->nshaped) { /* walls beyond planes: a scene of planes never comes here */

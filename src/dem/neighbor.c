@@ -12,8 +12,9 @@ void dem_free_pairs(dem_pairs *p)
 {
     free(p->i), free(p->j), free(p->k), free(p->gamma), free(p->mu);
     for (int d = 0; d < 3; d++)
-        free(p->hist[d]), free(p->f[d]), free(p->c[d]);
-    free(p->hist[3]);
+        free(p->f[d]), free(p->c[d]), free(p->rt[d]);
+    for (int d = 0; d < DEM_HIST; d++)
+        free(p->hist[d]);
     free(p->start), free(p->jstart), free(p->jpair);
     memset(p, 0, sizeof *p);
 }
@@ -130,6 +131,11 @@ static core_status reserve_pairs(dem_scene *s, size_t n, core_error *err)
     }
     if (!st && s->contact.tangential == DEM_TANGENT_SPRING)
         st = dem_alloc_array(&p->hist[3], cap, err);
+    /* rolling resistance: the torques (rotations are on), the EPSD spring's history */
+    for (int d = s->dim == 2 ? 2 : 0; d < 3 && !st && s->contact.rolling_law; d++)
+        st = dem_alloc_array(&p->rt[d], cap, err);
+    for (int d = 0; d < dem_rolling_slots(s) && !st; d++)
+        st = dem_alloc_array(&p->hist[DEM_HIST_ROLL + d], cap, err);
     if (!st)
         p->cap = cap;
     return st;
@@ -381,7 +387,7 @@ core_status dem_build_pairs(dem_scene *s, core_error *err)
 
     /* Keep the old list to carry the contact history over. */
     dem_pairs old = *p;
-    int carry = s->contact.tangential == DEM_TANGENT_SPRING && old.hist[0] && old.start;
+    int carry = (old.hist[0] || old.hist[DEM_HIST_ROLL]) && old.start;
     memset(p, 0, sizeof *p);
     if ((st = reserve_pairs(s, npairs, err))) {
         free(start);
@@ -414,8 +420,10 @@ core_status dem_build_pairs(dem_scene *s, core_error *err)
             s->need_rebuild = 1;
             return bad;
         }
-    if (p->hist[0] && s->dom) {
+    const int any_hist = p->hist[0] || p->hist[DEM_HIST_ROLL];
+    if (any_hist && s->dom) {
         /* Distributed: the history came with each first particle (its bundle, domain.c). */
+        const int hw = dem_hist_width(s);
 #pragma omp parallel for schedule(static) if (n > 4096)
         for (size_t i = 0; i < n; i++) {
             const uint32_t *gj;
@@ -426,12 +434,12 @@ core_status dem_build_pairs(dem_scene *s, core_error *err)
                 while (o < nb && gj[o] < g)
                     o++;
                 int same = o < nb && gj[o] == g;
-                for (int d = 0; d < D; d++)
-                    p->hist[d][q] = same ? h[4 * o + d] : 0;
-                p->hist[3][q] = same ? h[4 * o + 3] : 0;
+                for (int d = 0; d < hw; d++)
+                    if (p->hist[d])
+                        p->hist[d][q] = same ? h[(size_t)hw * o + d] : 0;
             }
         }
-    } else if (p->hist[0]) {
+    } else if (any_hist) {
         size_t old_np = carry ? (old.np < n ? old.np : n) : 0;
 #pragma omp parallel for schedule(static) if (n > 4096)
         for (size_t i = 0; i < n; i++) {
@@ -441,9 +449,9 @@ core_status dem_build_pairs(dem_scene *s, core_error *err)
                 while (o < oe && old.j[o] < p->j[q])
                     o++;
                 int same = o < oe && old.j[o] == p->j[q];
-                for (int d = 0; d < D; d++)
-                    p->hist[d][q] = same ? old.hist[d][o] : 0;
-                p->hist[3][q] = same ? old.hist[3][o] : 0;
+                for (int d = 0; d < DEM_HIST; d++)
+                    if (p->hist[d])
+                        p->hist[d][q] = same && old.hist[d] ? old.hist[d][o] : 0;
             }
         }
     }

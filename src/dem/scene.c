@@ -36,7 +36,12 @@ dem_contact_def dem_default_contact_def(void)
                              .v_r = 1e-3,
                              .exponent = 10,
                              .clip = true,
-                             .rolling = false};
+                             .rolling = false,
+                             .rolling_law = DEM_ROLLING_NONE,
+                             .rolling_friction = -1,
+                             .rolling_stiffness = -1,
+                             .rolling_damping = 0,
+                             .rolling_rate = 0};
 }
 
 void dem_invalidate(dem_scene *s, int list)
@@ -109,7 +114,7 @@ void dem_destroy(dem_scene *s)
     free(s->r), free(s->m), free(s->inv_m), free(s->inv_inertia), free(s->mat), free(s->flags);
     free(s->angle);
     for (int w = 0; w < s->nwalls; w++) {
-        for (int d = 0; d < 4; d++)
+        for (int d = 0; d < DEM_HIST; d++)
             free(s->walls[w].hist[d]);
         free(s->walls[w].cand);
         dem_shape_free(s->walls[w].shape);
@@ -136,6 +141,10 @@ int dem_add_material(dem_scene *s, const dem_material *m, core_error *err)
     if (!(m->restitution > 0 && m->restitution <= 1))
         return core_fail(err, CORE_ERR_ARG, "restitution must be in (0, 1], got %g",
                          m->restitution), -1;
+    if (!(m->rolling_friction >= 0) || !isfinite(m->rolling_friction))
+        return core_fail(err, CORE_ERR_ARG, "rolling_friction must be >= 0, got %g",
+                         m->rolling_friction),
+               -1;
     if (s->nmat == s->cap_mat) {
         int cap = s->cap_mat ? 2 * s->cap_mat : 4;
         dem_material *p = realloc(s->mats, (size_t)cap * sizeof *p);
@@ -184,6 +193,20 @@ core_status dem_set_contact(dem_scene *s, const dem_contact_def *c, core_error *
         return core_fail(err, CORE_ERR_ARG, "gamma_t must be >= 0, got %g", c->gamma_t);
     if (c->tangential == DEM_TANGENT_SPRING && !(c->kt < 0 || (c->kt > 0 && isfinite(c->kt))))
         return core_fail(err, CORE_ERR_ARG, "kt must be > 0, got %g", c->kt);
+    if (c->rolling_law < DEM_ROLLING_NONE || c->rolling_law > DEM_ROLLING_CONSTANT)
+        return core_fail(err, CORE_ERR_ARG, "unknown rolling resistance law %d",
+                         (int)c->rolling_law);
+    if (!(c->rolling_friction < 0 || isfinite(c->rolling_friction)))
+        return core_fail(err, CORE_ERR_ARG, "rolling_friction must be finite, got %g",
+                         c->rolling_friction);
+    if (!(c->rolling_stiffness < 0 || (c->rolling_stiffness > 0 && isfinite(c->rolling_stiffness))))
+        return core_fail(err, CORE_ERR_ARG, "rolling_stiffness must be > 0, got %g",
+                         c->rolling_stiffness);
+    if (!(c->rolling_damping >= 0 && c->rolling_damping <= 1))
+        return core_fail(err, CORE_ERR_ARG, "rolling_damping must be in [0, 1], got %g",
+                         c->rolling_damping);
+    if (!(c->rolling_rate >= 0 && isfinite(c->rolling_rate)))
+        return core_fail(err, CORE_ERR_ARG, "rolling_rate must be >= 0, got %g", c->rolling_rate);
     if (c->tangential == DEM_TANGENT_REGULARIZED) {
         if (!(c->v_r > 0) || !isfinite(c->v_r))
             return core_fail(err, CORE_ERR_ARG, "v_r must be > 0, got %g", c->v_r);
@@ -191,10 +214,11 @@ core_status dem_set_contact(dem_scene *s, const dem_contact_def *c, core_error *
             return core_fail(err, CORE_ERR_ARG, "exponent must be >= 1, got %g", c->exponent);
     }
     int spring_before = s->contact.tangential == DEM_TANGENT_SPRING;
+    int roll_before = s->contact.rolling_law;
     s->contact = *c;
     s->brill_c = brill_c;
     dem_power_init(&s->slip_pow, c->tangential == DEM_TANGENT_REGULARIZED ? 1 / c->exponent : 0);
-    if (c->tangential != DEM_TANGENT_NONE || c->rolling) {
+    if (c->tangential != DEM_TANGENT_NONE || c->rolling || c->rolling_law != DEM_ROLLING_NONE) {
         core_status st = dem_ensure_rotation(s, err);
         if (st != CORE_OK)
             return st;
@@ -209,6 +233,17 @@ core_status dem_set_contact(dem_scene *s, const dem_contact_def *c, core_error *
             }
         }
     }
+    if (roll_before != (int)c->rolling_law) /* the same for the rolling history and torques */
+        for (int d = 0; d < 3; d++) {
+            free(s->pairs.hist[DEM_HIST_ROLL + d]);
+            s->pairs.hist[DEM_HIST_ROLL + d] = NULL;
+            free(s->pairs.rt[d]);
+            s->pairs.rt[d] = NULL;
+            for (int w = 0; w < s->nwalls; w++) {
+                free(s->walls[w].hist[DEM_HIST_ROLL + d]);
+                s->walls[w].hist[DEM_HIST_ROLL + d] = NULL;
+            }
+        }
     dem_invalidate(s, 1);
     return CORE_OK;
 }
@@ -255,8 +290,9 @@ static core_status grow(dem_scene *s, size_t need, core_error *err)
             if (s->gear_w[k][d])
                 st = dem_alloc_array(&s->gear_w[k][d], cap, err);
         for (int w = 0; w < s->nwalls && st == CORE_OK; w++)
-            for (int k = d; k < 4; k += 3) /* components d, and [3] once (with d = 0) */
-                if (s->walls[w].hist[k] && (k < 3 || d == 0)) {
+            for (int k = d; k < DEM_HIST; k += 3) /* components d (tangential, rolling), and
+                                                   * [3] once (with d = 0) */
+                if (s->walls[w].hist[k] && (k != 3 || d == 0)) {
                     st = dem_alloc_array(&s->walls[w].hist[k], cap, err);
                     if (st == CORE_OK)
                         memset(s->walls[w].hist[k] + s->cap, 0, (cap - s->cap) * sizeof(double));
@@ -399,13 +435,11 @@ long dem_add_particle(dem_scene *s, const dem_particle_def *p, core_error *err)
             s->w[d][i] = (p->flags & DEM_FIXED) ? 0 : p->omega[d];
         if (s->tq[d])
             s->tq[d][i] = 0;
-        for (int w = 0; w < s->nwalls; w++)
-            if (s->walls[w].hist[d])
-                s->walls[w].hist[d][i] = 0;
     }
     for (int w = 0; w < s->nwalls; w++)
-        if (s->walls[w].hist[3])
-            s->walls[w].hist[3][i] = 0;
+        for (int k = 0; k < DEM_HIST; k++)
+            if (s->walls[w].hist[k])
+                s->walls[w].hist[k][i] = 0;
     if (s->angle)
         s->angle[i] = 0;
     s->r[i] = r;
@@ -536,7 +570,7 @@ core_status dem_remove_wall(dem_scene *s, int id, core_error *err)
     core_status st = check_wall(s, id, err);
     if (st == CORE_OK) {
         s->walls[id].active = 0;
-        for (int d = 0; d < 4; d++) {
+        for (int d = 0; d < DEM_HIST; d++) {
             free(s->walls[id].hist[d]);
             s->walls[id].hist[d] = NULL;
         }

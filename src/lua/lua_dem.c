@@ -138,7 +138,9 @@ static int material_index(lua_State *L, int scene, int arg, const char *call, co
         m.friction = lua_tonumber(L, -1);
         lua_getfield(L, -6, "restitution");
         m.restitution = lua_tonumber(L, -1);
-        lua_pop(L, 5);
+        lua_getfield(L, -7, "rolling_friction");
+        m.rolling_friction = lua_tonumber(L, -1);
+        lua_pop(L, 6);
     }
     core_error err;
     int idx = dem_add_material(s, &m, &err);
@@ -156,11 +158,29 @@ static const char *const NORMAL_NAMES[] = {"linear", "power", "hertz", NULL};
 static const char *const DAMPING_NAMES[] = {"none", "viscous", "brilliantov", NULL};
 static const char *const TANGENT_NAMES[] = {"none", "viscous", "spring", "coulomb_regularized",
                                             NULL};
+static const char *const ROLLING_NAMES[] = {"none", "epsd", "constant", NULL};
 
-static const char *const CONTACT_FIELDS[] = {
-    "normal",          "stiffness",  "beta",    "damping", "gamma_n", "damping_time", "restitution",
-    "impact_velocity", "tangential", "gamma_t", "kt",      "v_r",     "exponent",     "clip",
-    "rolling",         NULL};
+static const char *const CONTACT_FIELDS[] = {"normal",
+                                             "stiffness",
+                                             "beta",
+                                             "damping",
+                                             "gamma_n",
+                                             "damping_time",
+                                             "restitution",
+                                             "impact_velocity",
+                                             "tangential",
+                                             "gamma_t",
+                                             "kt",
+                                             "v_r",
+                                             "exponent",
+                                             "clip",
+                                             "rolling",
+                                             "rolling_resistance",
+                                             "rolling_friction",
+                                             "rolling_stiffness",
+                                             "rolling_damping",
+                                             "rolling_rate",
+                                             NULL};
 
 /* A field given although the chosen law ignores it is refused: a typo'd law must not leave the
  * user believing a value took effect. `why` names the field and value that give it meaning. */
@@ -245,6 +265,28 @@ static int l_contact(lua_State *L)
     c.exponent = bind_field_number(L, 2, "contact", "exponent", c.exponent, BIND_POSITIVE);
     c.clip = bind_field_boolean(L, 2, "contact", "clip", 1);
     c.rolling = bind_field_boolean(L, 2, "contact", "rolling", 0);
+    /* Rolling resistance (dem.h, rolling.inc) */
+    c.rolling_law = (dem_rolling_law)bind_field_option(L, 2, "contact", "rolling_resistance",
+                                                       ROLLING_NAMES, DEM_ROLLING_NONE, 0);
+    lua_settop(L, 2);
+    const int roll = c.rolling_law != DEM_ROLLING_NONE;
+    only_with(L, "rolling_friction", roll, "'rolling_resistance' is 'epsd' or 'constant'");
+    only_with(L, "rolling_stiffness", c.rolling_law == DEM_ROLLING_EPSD,
+              "'rolling_resistance' is 'epsd'");
+    only_with(L, "rolling_damping", c.rolling_law == DEM_ROLLING_EPSD,
+              "'rolling_resistance' is 'epsd'");
+    only_with(L, "rolling_rate", c.rolling_law == DEM_ROLLING_CONSTANT,
+              "'rolling_resistance' is 'constant'");
+    /* absent: -1, the materials' mu_r and k_t R_eff^2 (dem.h) */
+    c.rolling_friction = bind_field_number(L, 2, "contact", "rolling_friction", -1, BIND_NONNEG);
+    c.rolling_stiffness =
+        bind_field_number(L, 2, "contact", "rolling_stiffness", -1, BIND_POSITIVE);
+    c.rolling_damping = bind_field_number(L, 2, "contact", "rolling_damping", 0, BIND_NONNEG);
+    if (c.rolling_damping > 1) {
+        lua_getfield(L, 2, "rolling_damping");
+        return bind_field_error(L, 2, "contact", "rolling_damping", "number in [0, 1]");
+    }
+    c.rolling_rate = bind_field_number(L, 2, "contact", "rolling_rate", 0, BIND_POSITIVE);
     if (c.damping == DEM_DAMPING_BRILLIANTOV) {
         if (c.damping_time < 0 && e < 0)
             return luaL_error(L, "bad argument #1 to 'contact' (damping = 'brilliantov' needs "
@@ -1351,6 +1393,8 @@ static int l_info(lua_State *L)
     lua_setfield(L, -2, "damping");
     lua_pushstring(L, TANGENT_NAMES[c->tangential]);
     lua_setfield(L, -2, "tangential");
+    lua_pushstring(L, ROLLING_NAMES[c->rolling_law]);
+    lua_setfield(L, -2, "rolling_resistance");
     lua_pushnumber(L, c->damping_time);
     lua_setfield(L, -2, "damping_time");
     dem_domain_stats ds;
@@ -1628,7 +1672,9 @@ void bind_open_dem(lua_State *L)
          "s:contact{ normal = 'hertz'|'linear'|'power', stiffness =, beta =, damping = "
          "'none'|'viscous'|'brilliantov', gamma_n =, damping_time =, restitution =, "
          "impact_velocity =, tangential = 'none'|'viscous'|'spring'|'coulomb_regularized', "
-         "gamma_t =, kt =, v_r =, exponent =, clip = true, rolling = false }",
+         "gamma_t =, kt =, v_r =, exponent =, clip = true, rolling = false, rolling_resistance = "
+         "'none'|'epsd'|'constant', rolling_friction =, rolling_stiffness =, rolling_damping = 0, "
+         "rolling_rate = }",
          "Sets the contact law of the scene. Normal: linear f = k d (Herrmann Eq. 1a, beta = 1), "
          "power f = k d^beta (beta 1, 1.5 or 2), hertz f = 4/3 E* sqrt(R) d^1.5 (Padbidri Eq. "
          "1.1). Damping: viscous gamma_n d' (Eq. 1b; gamma_n per pair from the materials' "
@@ -1640,9 +1686,15 @@ void bind_open_dem(lua_State *L)
          "s:damping_time(i, j) gives a pair's T. Tangential: "
          "viscous -gamma_t s (Eq. 2a), spring (Cundall-Strack, Eq. 2b; kt defaults to 2/7 of "
          "the normal tangent stiffness), coulomb_regularized mu f_n min(1, (s/v_r)^(1/exponent)) "
-         "(Eq. 2.18). clip = true forbids attractive normal forces. Returns damping_time when one "
-         "is "
-         "given, else nothing."},
+         "(Eq. 2.18). clip = true forbids attractive normal forces; rolling = true allocates "
+         "rotations without a tangential law. Rolling resistance (Ai et al. 2011; a torque "
+         "against the relative rolling w_i - w_j, or w_i on a wall, at most mu_r R_eff |F_n|): "
+         "epsd, type C, an elastic-plastic spring k_r (rolling_stiffness, N m/rad; default "
+         "k_t R_eff^2) with a dashpot of damping ratio rolling_damping in [0, 1] below the "
+         "limit; constant, type A, the limit torque against w, linear below rolling_rate w_c "
+         "(rad/s; default: the rate that stops a contact's relative rotation in ten steps). "
+         "mu_r: rolling_friction, or the smaller of the two materials' rolling_friction. Returns "
+         "damping_time when one is given, else nothing."},
         {"add_disk", l_add_disk,
          "s:add_disk{ pos = {x, y}, radius = r, material = m, vel = {vx, vy}, omega = w, "
          "fixed = false, prescribed = false }",

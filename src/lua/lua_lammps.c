@@ -51,9 +51,11 @@ static dem_material material_of(lua_State *L, int idx)
 {
     idx = lua_absindex(L, idx);
     dem_material m = dem_default_material();
-    static const char *const f[] = {"density", "young", "poisson", "friction", "restitution"};
-    double *dst[] = {&m.density, &m.young, &m.poisson, &m.friction, &m.restitution};
-    for (int k = 0; k < 5; k++) {
+    static const char *const f[] = {"density",  "young",       "poisson",
+                                    "friction", "restitution", "rolling_friction"};
+    double *dst[] = {&m.density,  &m.young,       &m.poisson,
+                     &m.friction, &m.restitution, &m.rolling_friction};
+    for (int k = 0; k < 6; k++) {
         lua_getfield(L, idx, f[k]);
         *dst[k] = lua_tonumber(L, -1);
         lua_pop(L, 1);

@@ -5,6 +5,7 @@
 -- same bits.
 --   grainlab tests/dem/mpi_case.lua dim=2 integrator=velocity_verlet spring=1 walls=1
 --            periodic=0 servo=0 gravity=1 n=150 steps=300 out=PREFIX fast=0 dt=5e-7|auto chunks=1
+--            rolling=0|1|2
 local P = params
 local dim = P.dim or 2
 local n = P.n or 150
@@ -21,10 +22,14 @@ local g = (P.gravity or 1) == 1 and -9.81 * (P.gscale or 1) or 0
 local grav = dim == 2 and { 0, g } or { 0, g, 0 }
 local s = dem.scene{ dim = dim, box = box, gravity = grav, periodic = periodic,
                      skin = P.skin }
+-- rolling=1: rolling resistance EPSD (its history migrates with the tangential one), 2: constant
+local rolling = ({ "epsd", "constant" })[P.rolling or 0]
 local quartz = grainlab.material{ name = "quartz", density = 2650, young = 1e8, poisson = 0.3,
-                                  friction = 0.45, restitution = 0.9 }
+                                  friction = 0.45, restitution = 0.9,
+                                  rolling_friction = rolling and 0.2 or 0 }
 s:contact{ normal = "hertz", damping = "viscous",
-           tangential = (P.spring or 1) == 1 and "spring" or "none" }
+           tangential = (P.spring or 1) == 1 and "spring" or "none", rolling_resistance = rolling,
+           rolling_damping = rolling == "epsd" and 0.3 or nil }
 -- a deterministic generator (the same on every rank, without grainlab's streams)
 local seed = 12345
 local function rnd()

@@ -9,15 +9,20 @@ local M = {}
 M.integrators = { "velocity_verlet", "position_verlet", "gear", "two_timescales" }
 M.dt = { [2] = 2e-5, [3] = 2e-5 }
 
-function M.build(dim)
-  local soft = grainlab.material{ density = 1000, young = 2e6, poisson = 0.3, friction = 0.5 }
-  local hard = grainlab.material{ density = 2000, young = 5e6, poisson = 0.25, friction = 0.3 }
+-- rolling: nil, or a rolling resistance law ("epsd" with its damping, "constant"): the
+-- materials get rolling frictions 0.2 and 0.1, the walls take the particles' own.
+function M.build(dim, rolling)
+  local soft = grainlab.material{ density = 1000, young = 2e6, poisson = 0.3, friction = 0.5,
+                                  rolling_friction = rolling and 0.2 or 0 }
+  local hard = grainlab.material{ density = 2000, young = 5e6, poisson = 0.25, friction = 0.3,
+                                  rolling_friction = rolling and 0.1 or 0 }
   local L = 0.02
   local box = dim == 2 and { { 0, 0 }, { L, 2 * L } } or { { 0, 0, 0 }, { L, L, 2 * L } }
   local g = dim == 2 and { 0, -9.81 } or { 0, 0, -9.81 }
   local s = dem.scene{ dim = dim, box = box, gravity = g }
   s:contact{ normal = "hertz", damping = "brilliantov", restitution = 0.6, impact_velocity = 0.5,
-             tangential = "spring" }
+             tangential = "spring", rolling_resistance = rolling,
+             rolling_damping = rolling == "epsd" and 0.3 or nil }
   local up = dim == 2 and 2 or 3
   local function vec(x, y, z) if dim == 2 then return { x, y } else return { x, y, z } end end
   -- floor, left wall moving right slowly, a servo lid pushing down, fixed side walls

@@ -62,6 +62,29 @@ for _, dim in ipairs({ 2, 3 }) do
   end
 end
 
+-- ---- rolling resistance: the EPSD spring's history of pairs and walls is carried (the constant
+-- torque has none), in 2D and 3D; a run without the load differs (the history matters) -----------
+for _, dim in ipairs({ 2, 3 }) do
+  for _, law in ipairs({ "epsd", "constant" }) do
+    for _, integ in ipairs({ "velocity_verlet", "gear" }) do
+      local what = string.format("%dD rolling %s, %s", dim, law, integ)
+      local a = C.build(dim, law)
+      C.run(a, integ, N + M)
+      local b = C.build(dim, law)
+      C.run(b, integ, N)
+      b:save(path("rolling.ckpt"))
+      local c = dem.load(path("rolling.ckpt"))
+      check.eq(c:info().rolling_resistance, law, what .. ": the law is loaded")
+      same_bits(C.dump(b), C.dump(c), what .. ": the loaded scene is the saved one")
+      C.run(c, integ, M)
+      same_bits(C.dump(a), C.dump(c), what .. ": N + M against N, save, load, M")
+      local plain = C.build(dim)
+      C.run(plain, integ, N + M)
+      check.is_true(C.dump(plain) ~= C.dump(a), what .. ": rolling resistance changes the run")
+    end
+  end
+end
+
 -- ---- boundary conditions: pressure loop, minimal-boundary penalty and its integral, springs,
 -- a tie, a spin (ckpt_dem_case.lua) ------------------------------------------------------------
 for _, integ in ipairs(C.integrators) do
@@ -167,11 +190,14 @@ do
 end
 
 -- ---- 1 thread saves, 2 threads load: a scene above the threads' 4096 particles ------------------
-do
+-- (also with rolling resistance: its pair torques and EPSD history under the threads)
+for _, law in ipairs({ false, "epsd", "constant" }) do
   local function big()
     local s = dem.scene{ box = { { 0, 0 }, { 0.14, 0.14 } }, gravity = { 0, -9.81 } }
-    local soft = grainlab.material{ density = 1000, young = 2e6, friction = 0.5 }
-    s:contact{ normal = "hertz", damping = "brilliantov", restitution = 0.6, tangential = "spring" }
+    local soft = grainlab.material{ density = 1000, young = 2e6, friction = 0.5,
+                                    rolling_friction = 0.2 }
+    s:contact{ normal = "hertz", damping = "brilliantov", restitution = 0.6, tangential = "spring",
+               rolling_resistance = law or nil }
     s:add_wall{ point = { 0, 0 }, normal = { 0, 1 } }
     for a = 0, 69 do
       for b = 0, 64 do
@@ -195,7 +221,8 @@ do
   local c = dem.load(path("threads.ckpt"))
   check.eq(grainlab.threads(), 2, "2 threads")
   run(c, 10)
-  same_bits(C.dump(a, 1), C.dump(c, 1), "saved on 1 thread, continued on 2")
+  same_bits(C.dump(a, 1), C.dump(c, 1),
+            "saved on 1 thread, continued on 2" .. (law and (", rolling " .. law) or ""))
   grainlab.threads(1)
 end
 

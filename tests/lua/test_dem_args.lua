@@ -159,7 +159,7 @@ check.errors(function() s:run{ step = 10 } end,
 check.errors(function() s:timestep{ impact = 1 } end,
   "bad argument #1 to 'timestep' (unknown field 'impact'; valid fields: impact_velocity)", "timestep typo")
 check.errors(function() grainlab.material{ densty = 2650, young = 1e9 } end,
-  "bad argument #1 to 'material' (unknown field 'densty'; valid fields: density, friction, name, poisson, restitution, young)", "material typo")
+  "bad argument #1 to 'material' (unknown field 'densty'; valid fields: density, friction, name, poisson, restitution, rolling_friction, young)", "material typo")
 check.errors(function() s:add_disk{ pos = { 0.5, 0.5 }, radius = 1e-3, material = { density = 2650 } } end,
   "bad field 'material' in argument #1 to 'add_disk' (grainlab.material expected, got table)", "plain table as material")
 
