@@ -11,7 +11,9 @@
 --   basin  below and beside the box (floor y = -0.6 W, far wall x = 3 W), for the grains that
 --          leave it when the gate is removed; the domain has no open side.
 --   law    Hertz + Brilliantov damping (restitution e_rest at 1 m/s, every pair its own time) +
---          Cundall-Strack spring capped at mu f_n; dt = dt_factor x the stability limit at 2 m/s.
+--          Cundall-Strack spring capped at mu f_n; with mu_r, rolling resistance (the EPSD law,
+--          rolling friction mu_r, rolling damping 0.3); dt = dt_factor x the stability limit at
+--          2 m/s.
 --   settle 0.1 s with a background drag of 20/s, then without, in slices of 0.02 s, until the
 --          fastest grain is below v_rest (at most 0.6 s).
 -- The returned box b has b.s (the scene), b.nf (the floor disks, the scene's first particles),
@@ -45,7 +47,7 @@ function heap_box.sweep(o)
   local progress = grainlab.progress{ label = o.label, total = #o.mus * seeds, unit = "runs" }
   local results, done = {}, 0
   for i, mu in ipairs(o.mus) do
-    local r = { mu = mu, runs = {} }
+    local r = { mu = mu, runs = {} } -- (mu: the swept value, whatever it is)
     for k = 1, seeds do
       r.runs[k] = o.run(mu, o.seed + k - 1)
       done = done + 1
@@ -95,7 +97,9 @@ function heap_box.new(o)
   b.nb = math.floor(b.W / b.bw)
   if o.geometry_only then return b end -- the sizes only, no scene
 
-  local mat = grainlab.material{ density = rho, young = b.young, poisson = nu, friction = b.mu }
+  b.mu_r = o.mu_r -- rolling friction (EPSD law, docs/dem.md "Rolling resistance"); nil: none
+  local mat = grainlab.material{ density = rho, young = b.young, poisson = nu, friction = b.mu,
+                                 rolling_friction = b.mu_r }
   local s = dem.scene{ dim = 2, box = { { 0, -b.depth }, { b.length, b.top } }, gravity = { 0, -g } }
   b.s = s
   s:contact{ normal = "hertz", tangential = "spring" } -- for the deposit's own relaxation
@@ -112,7 +116,8 @@ function heap_box.new(o)
                              region = { { 0, -2 * b.rf }, { b.W, b.top - 2 * rmax } },
                              relax_steps = 0 })
   s:contact{ normal = "hertz", damping = "brilliantov", restitution = b.e_rest, impact_velocity = 1,
-             tangential = "spring" }
+             tangential = "spring", rolling_resistance = b.mu_r and "epsd" or nil,
+             rolling_damping = b.mu_r and 0.3 or nil }
   b.dt = b.dt_factor * s:timestep{ impact_velocity = v_imp }.limit
 
   s:drag(20)
