@@ -577,6 +577,19 @@ core_status ckpt_get_f64s(ckpt_section *s, double *out, size_t n, core_error *er
 {
     return get_array(s, out, n, sizeof *out, "doubles", err);
 }
+core_status ckpt_get_new_f64s(ckpt_section *s, size_t n, size_t cap, double **out,
+                              core_error *err)
+{
+    *out = malloc((cap > n ? cap : n ? n : 1) * sizeof **out);
+    if (!*out)
+        return core_fail(err, CORE_ERR_NOMEM, "out of memory loading a checkpoint");
+    core_status st = ckpt_get_f64s(s, *out, n, err);
+    if (st) {
+        free(*out);
+        *out = NULL;
+    }
+    return st;
+}
 core_status ckpt_get_i64s(ckpt_section *s, int64_t *out, size_t n, core_error *err)
 {
     return get_array(s, out, n, sizeof *out, "int64 values", err);

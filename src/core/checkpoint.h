@@ -106,6 +106,10 @@ core_status ckpt_get_f64(ckpt_section *s, double *v, core_error *err);
 core_status ckpt_get_str(ckpt_section *s, char *out, size_t cap, core_error *err);
 /* Arrays written by ckpt_put_*s: the stored count must equal n. */
 core_status ckpt_get_f64s(ckpt_section *s, double *out, size_t n, core_error *err);
+/* n doubles into a new malloc'd array of cap >= n entries, *out (NULL on failure: out of memory,
+ * or the section ended or held something else). */
+core_status ckpt_get_new_f64s(ckpt_section *s, size_t n, size_t cap, double **out,
+                              core_error *err);
 core_status ckpt_get_i64s(ckpt_section *s, int64_t *out, size_t n, core_error *err);
 core_status ckpt_get_u32s(ckpt_section *s, uint32_t *out, size_t n, core_error *err);
 core_status ckpt_get_u64s(ckpt_section *s, uint64_t *out, size_t n, core_error *err);

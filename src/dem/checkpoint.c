@@ -305,15 +305,8 @@ static double *get_new(reader *r, size_t n, size_t cap)
 {
     if (r->st)
         return NULL;
-    double *a = malloc((cap ? cap : 1) * sizeof *a);
-    if (!a) {
-        r->st = core_fail(r->err, CORE_ERR_NOMEM, "out of memory loading a checkpoint");
-        return NULL;
-    }
-    if ((r->st = ckpt_get_f64s(&r->sec, a, n, r->err))) {
-        free(a);
-        return NULL;
-    }
+    double *a;
+    r->st = ckpt_get_new_f64s(&r->sec, n, cap, &a, r->err);
     return a;
 }
 
