@@ -3,7 +3,7 @@
 --
 -- Without rolling resistance a pile of disks levels off near 20 deg however large mu is (the
 -- disks roll once friction stops them sliding: scripts/repose.lua), where sand stands at 30-35
--- deg. Rolling resistance stands for the shape and contact width of real grains. Here mu = 0.5
+-- deg. Rolling resistance stands for the shape and contact width of real grains. Here mu = 0.8
 -- and mu_r runs through `mus_r`; for each, on the same packings (scripts/heap_box.lua):
 --  * theta_r: the wall of the box removed, the pile left at rest fitted (scripts/repose.lua);
 --  * theta_m: the closed box tilted in steps until the surface gives way
@@ -14,15 +14,15 @@
 -- Checks: theta_r rises with mu_r over the range and reaches 30 deg (real sand's 30-35) at some
 -- mu_r; theta_m >= theta_r at every mu_r; all angles in (0, 50) deg; the piles at rest.
 --
---   grainlab scripts/repose_rolling.lua [n=1000] [mu=0.5] [mus_r=0,0.1,0.2,0.3] [seed=1]
---       [seeds=2] [csv=out/repose_rolling.csv] [verbose=false]
+--   grainlab scripts/repose_rolling.lua [n=1000] [mu=0.8] [mus_r=0,0.1,0.2,0.3] [seed=1]
+--       [seeds=1] [csv=out/repose_rolling.csv] [verbose=false]
 local heap_box = dofile((arg[0]:match("^(.*)/") or ".") .. "/heap_box.lua")
 local figures = require("grainlab.figures")
 
 local n = math.tointeger(params.n or 1000)
-local mu = params.mu or 0.5
+local mu = params.mu or 0.8
 local seed = math.tointeger(params.seed or 1)
-local seeds = math.tointeger(params.seeds or 2)
+local seeds = math.tointeger(params.seeds or 1)
 local csv = params.csv or "out/repose_rolling.csv"
 local verbose = params.verbose == true
 assert(n and n >= 50, "n must be an integer >= 50")
@@ -31,7 +31,7 @@ assert(seed and seed >= 0, "seed must be a non-negative integer")
 assert(seeds and seeds >= 1, "seeds must be a positive integer")
 local mus_r = heap_box.mus(params.mus_r, { 0, 0.1, 0.2, 0.3 })
 local published = figures.published({ n = n, mu = mu, seed = seed, seeds = seeds, mus_r = table.concat(mus_r, ",") },
-                                    { n = 1000, mu = 0.5, seed = 1, seeds = 2, mus_r = "0,0.1,0.2,0.3" })
+                                    { n = 1000, mu = 0.8, seed = 1, seeds = 1, mus_r = "0,0.1,0.2,0.3" })
 local png = params.png or figures.path("repose_rolling.png", { published = published })
 local ckpt = os.tmpname()
 local function say(fmt, ...) if verbose then io.stderr:write(string.format(fmt, ...) .. "\n") end end
