@@ -14,6 +14,9 @@
 -- Checks: theta_r rises with mu_r over the range and reaches 30 deg (real sand's 30-35) at some
 -- mu_r; theta_m >= theta_r at every mu_r; all angles in (0, 50) deg; the piles at rest.
 --
+-- Measured (default run, 2026-11-26): theta_r = 20.9, 25.7, 28.5, 27.5 deg and theta_m = 24.6,
+-- 29.2, 32.4, 41.1 deg for mu_r = 0, 0.1, 0.2, 0.3: theta_r does not reach 30 deg (its check
+-- fails); at mu = 0.5 it stays near atan 0.5 = 26.6 deg (17.8, 25.0, 25.3, 27.7; 2 packings).
 --   grainlab scripts/repose_rolling.lua [n=1000] [mu=0.8] [mus_r=0,0.1,0.2,0.3] [seed=1]
 --       [seeds=1] [csv=out/repose_rolling.csv] [verbose=false]
 local heap_box = dofile((arg[0]:match("^(.*)/") or ".") .. "/heap_box.lua")
