@@ -14,11 +14,13 @@
 -- Checks: theta_r rises with mu_r over the range and reaches 30 deg (real sand's 30-35) at some
 -- mu_r; theta_m >= theta_r at every mu_r; all angles in (0, 50) deg; the piles at rest.
 --
--- Measured (default run, 2026-11-26): theta_r = 20.9, 25.7, 28.5, 27.5 deg and theta_m = 24.6,
--- 29.2, 32.4, 41.1 deg for mu_r = 0, 0.1, 0.2, 0.3: theta_r does not reach 30 deg (its check
--- fails); at mu = 0.5 it stays near atan 0.5 = 26.6 deg (17.8, 25.0, 25.3, 27.7; 2 packings).
+-- Measured (default run, 2026-11-26, box aspect 1): theta_r = 21.0, 27.0, 28.2, 29.4 deg and
+-- theta_m = 32.8, 38.2, 37.8, 39.8 deg for mu_r = 0, 0.1, 0.2, 0.3: theta_r stops just short of
+-- 30 deg (its check fails; one 600-disk packing gave 33.3 at mu_r = 0.3, so the scatter between
+-- packings is as large as the gap). In the half-full box (aspect 0.5): 20.9, 25.7, 28.5, 27.5;
+-- at mu = 0.5 theta_r stays near atan 0.5 = 26.6 deg (17.8, 25.0, 25.3, 27.7; 2 packings).
 --   grainlab scripts/repose_rolling.lua [n=1000] [mu=0.8] [mus_r=0,0.1,0.2,0.3] [seed=1]
---       [seeds=1] [csv=out/repose_rolling.csv] [verbose=false]
+--       [seeds=1] [aspect=1] [csv=out/repose_rolling.csv] [verbose=false]
 local heap_box = dofile((arg[0]:match("^(.*)/") or ".") .. "/heap_box.lua")
 local figures = require("grainlab.figures")
 
@@ -26,6 +28,10 @@ local n = math.tointeger(params.n or 1000)
 local mu = params.mu or 0.8
 local seed = math.tointeger(params.seed or 1)
 local seeds = math.tointeger(params.seeds or 1)
+-- A box filled to its width (aspect 1): a pile steeper than 30 deg needs the height; in the
+-- half-full box of repose.lua (aspect 0.5) mu_r = 0.3 gave 29.2 deg where this one gives 33.3
+-- (600 disks, one packing).
+local aspect = params.aspect or 1
 local csv = params.csv or "out/repose_rolling.csv"
 local verbose = params.verbose == true
 assert(n and n >= 50, "n must be an integer >= 50")
@@ -33,16 +39,20 @@ assert(type(mu) == "number" and mu >= 0, "mu must be a non-negative number")
 assert(seed and seed >= 0, "seed must be a non-negative integer")
 assert(seeds and seeds >= 1, "seeds must be a positive integer")
 local mus_r = heap_box.mus(params.mus_r, { 0, 0.1, 0.2, 0.3 })
-local published = figures.published({ n = n, mu = mu, seed = seed, seeds = seeds, mus_r = table.concat(mus_r, ",") },
-                                    { n = 1000, mu = 0.8, seed = 1, seeds = 1, mus_r = "0,0.1,0.2,0.3" })
+local published = figures.published({ n = n, mu = mu, seed = seed, seeds = seeds, aspect = aspect,
+                                      mus_r = table.concat(mus_r, ",") },
+                                    { n = 1000, mu = 0.8, seed = 1, seeds = 1, aspect = 1,
+                                      mus_r = "0,0.1,0.2,0.3" })
 local png = params.png or figures.path("repose_rolling.png", { published = published })
 local ckpt = os.tmpname()
 local function say(fmt, ...) if verbose then io.stderr:write(string.format(fmt, ...) .. "\n") end end
 
 local function run_one(mu_r, sd)
   local c0 = grainlab.clock()
-  local r = heap_box.new{ n = n, mu = mu, mu_r = mu_r > 0 and mu_r or nil, seed = sd }:collapse(4)
-  local theta_m = heap_box.new{ n = n, mu = mu, mu_r = mu_r > 0 and mu_r or nil, seed = sd }
+  local r = heap_box.new{ n = n, mu = mu, mu_r = mu_r > 0 and mu_r or nil, seed = sd,
+                          aspect = aspect }:collapse(4)
+  local theta_m = heap_box.new{ n = n, mu = mu, mu_r = mu_r > 0 and mu_r or nil, seed = sd,
+                                aspect = aspect }
                          :marginal{ checkpoint = ckpt, limit = 70 }
   say("mu_r %.2f seed %d: theta_r %.2f, theta_m %.2f, %.1f s", mu_r, sd, r.theta, theta_m,
       grainlab.clock() - c0)
@@ -64,8 +74,9 @@ for _, r in ipairs(results) do
   local sdr, sdm = r.theta_r_sd or 0 / 0, r.theta_m_sd or 0 / 0
   print(string.format("%6.2f %9.2f %7.2f %9.2f %7.2f %7.1f", r.mu, r.theta_r, sdr, r.theta_m, sdm, r.wall_s))
   rows[#rows + 1] = string.format("%g,%.4f,%.4f,%.4f,%.4f", r.mu, r.theta_r, sdr, r.theta_m, sdm)
-  metrics["theta_r_deg_" .. id] = r.theta_r
-  metrics["theta_m_deg_" .. id] = r.theta_m
+  if r.theta_r == r.theta_r then metrics["theta_r_deg_" .. id] = r.theta_r end
+  if r.theta_m == r.theta_m then metrics["theta_m_deg_" .. id] = r.theta_m end
+  checks[#checks + 1] = { name = "avalanche_found_" .. id, pass = r.theta_m == r.theta_m }
   metrics["wall_s_" .. id] = r.wall_s
   checks[#checks + 1] = { name = "theta_r_in_0_50_deg_" .. id, pass = r.theta_r > 0 and r.theta_r < 50 }
   checks[#checks + 1] = { name = "theta_m_at_least_theta_r_deg_" .. id, value = r.theta_m - r.theta_r,
@@ -95,7 +106,7 @@ end
 
 grainlab.report{
   scenario = "repose_rolling",
-  params = { n = n, mu = mu, mus_r = mus_r, seed = seed, seeds = seeds, csv = csv },
+  params = { n = n, mu = mu, mus_r = mus_r, seed = seed, seeds = seeds, aspect = aspect, csv = csv },
   metrics = metrics,
   checks = checks,
 }
