@@ -648,6 +648,27 @@ static core_status step_gear(dem_scene *s, double dt, core_error *err)
 }
 
 /* ---- the run loop --------------------------------------------------------------------------- */
+/* Velocity Verlet's kicks flag non-finite velocities and positions outside the domain (suspect);
+ * the other integrators, and the last step of a run, are checked in full. */
+static int full_checks_due(const dem_scene *s, const dem_run_def *run, long done_after)
+{
+    return s->suspect || run->integrator == DEM_POSITION_VERLET ||
+           run->integrator == DEM_GEAR5 || done_after >= run->steps;
+}
+
+/* The full checks: a non-finite position or velocity, or a particle outside the domain on an axis
+ * that is neither periodic nor walled (named by its global id). */
+static core_status full_checks(dem_scene *s, core_error *err)
+{
+    size_t bad = check_finite(s);
+    if (bad != (size_t)-1)
+        return unstable(s, dem_gid(s, bad), "has a non-finite position or velocity", err);
+    if ((bad = check_domain(s)) != (size_t)-1)
+        return unstable(s, dem_gid(s, bad),
+                        "left the domain (a box side without a wall and not periodic)", err);
+    return CORE_OK;
+}
+
 static core_status run_steps(dem_scene *s, const dem_run_def *run, core_error *err);
 
 core_status dem_run(dem_scene *s, const dem_run_def *run, core_error *err)
@@ -745,17 +766,8 @@ static core_status run_steps(dem_scene *s, const dem_run_def *run, core_error *e
             }
             /* the checks in full when this rank's kicks flagged something, as on one rank
              * (each rank decides alone: they make no collective call) */
-            int full = s->suspect || run->integrator == DEM_POSITION_VERLET ||
-                       run->integrator == DEM_GEAR5 || done + advance >= run->steps;
-            if (!st && full) {
-                size_t bad = check_finite(s);
-                if (bad != (size_t)-1)
-                    st = unstable(s, dem_gid(s, bad), "has a non-finite position or velocity", err);
-                else if ((bad = check_domain(s)) != (size_t)-1)
-                    st = unstable(s, dem_gid(s, bad),
-                                  "left the domain (a box side without a wall and not periodic)",
-                                  err);
-            }
+            if (!st && full_checks_due(s, run, done + advance))
+                st = full_checks(s, err);
             intr = interrupt_pending();
             st = dem_domain_agree_flag(s, st, &intr, err);
             s->suspect = 0;
@@ -766,18 +778,11 @@ static core_status run_steps(dem_scene *s, const dem_run_def *run, core_error *e
             dem_invalidate(s, 1);
             return st;
         }
-        /* Velocity Verlet's kicks flag non-finite velocities and positions outside the domain;
-         * the other integrators are checked in full every step. */
-        int full = s->suspect || run->integrator == DEM_POSITION_VERLET ||
-                   run->integrator == DEM_GEAR5 || done + advance >= run->steps;
-        if (full && !s->dom) { /* distributed: checked and agreed above */
+        /* distributed: checked and agreed above; here after the outflows removed their leavers */
+        if (!s->dom && full_checks_due(s, run, done + advance)) {
             s->suspect = 0;
-            size_t bad = check_finite(s);
-            if (bad != (size_t)-1)
-                return unstable(s, bad, "has a non-finite position or velocity", err);
-            if ((bad = check_domain(s)) != (size_t)-1)
-                return unstable(s, bad,
-                                "left the domain (a box side without a wall and not periodic)", err);
+            if ((st = full_checks(s, err)))
+                return st;
         }
         s->steps++;
         done += advance;
