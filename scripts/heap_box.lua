@@ -167,45 +167,52 @@ function heap_box:surface()
   return tops
 end
 
--- Least-squares line h = a + s x through the sloping part of the surface: bins at least two
--- largest diameters from the left wall and the gate line, above the first layer (> 2 rmax) and
--- below the settled top minus 2 rmax. Returns the angle atan(-s) (deg), the rms residual (mean
--- diameters) and the number of points.
-function heap_box:fit(tops)
-  local xs, ys = {}, {}
-  for k = 0, self.nb - 1 do
-    local x, h = (k + 0.5) * self.bw, tops[k]
-    if h and x >= 2 * self.bw and x <= self.W - 2 * self.bw and h > 2 * self.rmax
-        and h < self.h_init - 2 * self.rmax then
-      xs[#xs + 1], ys[#ys + 1] = x, h
-    end
-  end
-  local k = #xs
-  if k < 5 then return 0 / 0, 0 / 0, k end
-  local sx, sy, sxx, sxy = 0, 0, 0, 0
+-- Least squares y = a + b x through the points (xs[i], ys[i]): a, b.
+function heap_box.line(xs, ys)
+  local k, sx, sy, sxx, sxy = #xs, 0, 0, 0, 0
   for i = 1, k do
     sx, sy = sx + xs[i], sy + ys[i]
     sxx, sxy = sxx + xs[i] * xs[i], sxy + xs[i] * ys[i]
   end
-  local slope = (k * sxy - sx * sy) / (k * sxx - sx * sx)
-  local a = (sy - slope * sx) / k
+  local b = (k * sxy - sx * sy) / (k * sxx - sx * sx)
+  return (sy - b * sx) / k, b
+end
+
+-- The bins' tops at least two largest diameters from the left wall and the gate line (and, when
+-- given, keep(h)): lists x, h.
+local function inner_tops(self, tops, keep)
+  local xs, ys = {}, {}
+  for k = 0, self.nb - 1 do
+    local x, h = (k + 0.5) * self.bw, tops[k]
+    if h and x >= 2 * self.bw and x <= self.W - 2 * self.bw and (not keep or keep(h)) then
+      xs[#xs + 1], ys[#ys + 1] = x, h
+    end
+  end
+  return xs, ys
+end
+
+-- Least-squares line h = a + s x through the sloping part of the surface: the inner bins above
+-- the first layer (> 2 rmax) and below the settled top minus 2 rmax. Returns the angle atan(-s)
+-- (deg), the rms residual (mean diameters) and the number of points.
+function heap_box:fit(tops)
+  local xs, ys = inner_tops(self, tops, function(h)
+    return h > 2 * self.rmax and h < self.h_init - 2 * self.rmax
+  end)
+  local k = #xs
+  if k < 5 then return 0 / 0, 0 / 0, k end
+  local a, slope = heap_box.line(xs, ys)
   local ss = 0
   for i = 1, k do ss = ss + (ys[i] - a - slope * xs[i]) ^ 2 end
   return math.deg(math.atan(-slope)), math.sqrt(ss / k) / self.dmean, k
 end
 
 -- The slope of the whole surface in the box's frame (deg, positive when it rises towards the
--- gate): a line through the tops of the bins at least two largest diameters from both walls.
+-- gate): a line through the tops of the inner bins.
 function heap_box:surface_slope()
-  local tops, sx, sy, sxx, sxy, k = self:surface(), 0, 0, 0, 0, 0
-  for j = 0, self.nb - 1 do
-    local x, h = (j + 0.5) * self.bw, tops[j]
-    if h and x >= 2 * self.bw and x <= self.W - 2 * self.bw then
-      k, sx, sy, sxx, sxy = k + 1, sx + x, sy + h, sxx + x * x, sxy + x * h
-    end
-  end
-  if k < 5 then return 0 / 0 end
-  return math.deg(math.atan((k * sxy - sx * sy) / (k * sxx - sx * sx)))
+  local xs, ys = inner_tops(self, self:surface())
+  if #xs < 5 then return 0 / 0 end
+  local _, slope = heap_box.line(xs, ys)
+  return math.deg(math.atan(slope))
 end
 
 -- The angle of repose: the gate removed, slices of 0.05 s until, after at least 0.3 s, the

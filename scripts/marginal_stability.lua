@@ -97,15 +97,13 @@ os.remove(ckpt)
 
 -- The paper's linear relation at mu < 0.2: least squares through the points at mu <= 0.2.
 local function linear(key)
-  local sx, sy, sxx, sxy, k = 0, 0, 0, 0, 0
+  local xs, ys = {}, {}
   for _, r in ipairs(results) do
-    if r.mu <= 0.2 + 1e-12 then
-      k, sx, sy, sxx, sxy = k + 1, sx + r.mu, sy + r[key], sxx + r.mu ^ 2, sxy + r.mu * r[key]
-    end
+    if r.mu <= 0.2 + 1e-12 then xs[#xs + 1], ys[#ys + 1] = r.mu, r[key] end
   end
-  if k < 2 then return nil end
-  local b = (k * sxy - sx * sy) / (k * sxx - sx * sx)
-  return (sy - b * sx) / k, b, k
+  if #xs < 2 then return nil end
+  local a, b = heap_box.line(xs, ys)
+  return a, b, #xs
 end
 
 local metrics, checks = {}, {}
