@@ -259,8 +259,8 @@ done:
 core_status dsmc_domain_migrate(dsmc_scene *s, size_t *bcount, int *bad, int64_t *lost,
                                 core_error *err)
 {
-    *lost = 0;
     if (!s->distributed) {
+        *lost = 0;
         *bad = comm_any(*bad);
         return CORE_OK;
     }
