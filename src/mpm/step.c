@@ -8,6 +8,7 @@
 
 #include <stdlib.h>
 
+#include "core/clock.h"
 #include "core/interrupt.h"
 #include "core/threads.h"
 #include "mpm/mpm_internal.h"
@@ -18,6 +19,31 @@
 #else
 #define THREAD_ID() 0
 #endif
+
+/* The step's stages stay separate functions so that a profiler (callgrind) counts each. */
+#define STAGE __attribute__((noinline))
+
+enum { T_STENCIL, T_P2G, T_NORMALS, T_GRID, T_CONTACT, T_G2P, T_REMAP, T_MATERIAL, T_CHECK };
+const char *const mpm_stage_names[MPM_NSTAGES] = {"stencil", "p2g",   "normals",  "grid", "contact",
+                                                  "g2p",     "remap", "material", "check"};
+
+void mpm_timings(const mpm_scene *s, double seconds[MPM_NSTAGES], long *steps)
+{
+    for (int k = 0; k < MPM_NSTAGES; k++)
+        seconds[k] = s->tstage[k];
+    *steps = s->tsteps;
+}
+
+/* Thread 0 charges the time since its last reading to stage k (inside the step's parallel
+ * region, after a barrier; tl is its last reading). */
+#define STAGE_DONE(k)                                                                              \
+    do {                                                                                           \
+        if (t == 0) {                                                                              \
+            const double now_ = clock_wall();                                                      \
+            s->tstage[k] += now_ - tl;                                                             \
+            tl = now_;                                                                             \
+        }                                                                                          \
+    } while (0)
 
 /* Threads: every parallel region runs s->nt threads, thread t on points [tp[t], tp[t+1]). The
  * ranges and all reductions are fixed for a thread count, so results are the same bits run
@@ -138,7 +164,7 @@ static inline int bspline(double xi, double w[3], double d[3])
 /* Each point's nodes, weights N_i(x_p) and gradients G_pi (Eq. 8): linear tensor-product shape
  * functions (4 nodes) or quadratic B-splines (9). Points are inside the grid here (checked at the
  * end of every step). */
-static void stencil(mpm_scene *s, size_t pa, size_t pb)
+STAGE static void stencil(mpm_scene *s, size_t pa, size_t pb)
 {
     const double ox = s->def.origin[0], oy = s->def.origin[1];
     const int nx = s->def.cells[0], ny = s->def.cells[1], nnx = s->nnx, ns = s->ns;
@@ -194,7 +220,7 @@ static void stencil(mpm_scene *s, size_t pa, size_t pb)
 }
 
 /* The nodes a prescribed grain's points touch take its velocity (nforce = 1 + its index). */
-static void mark_forced(mpm_scene *s)
+STAGE static void mark_forced(mpm_scene *s)
 {
     if (!s->npres)
         return;
@@ -346,7 +372,7 @@ static inline bool near_plane(const mpm_scene *s, int k, size_t i)
 
 /* Wall and plane conditions on the centre-of-mass nodes, then the velocity of prescribed grains
  * at the nodes they touch. */
-static void apply_walls(mpm_scene *s, double *vx, double *vy, bool decide)
+STAGE static void apply_walls(mpm_scene *s, double *vx, double *vy, bool decide)
 {
 #pragma omp for schedule(static)
     for (size_t i = 0; i < s->nnodes; i++) {
@@ -365,7 +391,7 @@ static void apply_walls(mpm_scene *s, double *vx, double *vy, bool decide)
 
 /* The same for the grain fields at shared nodes (entries nnodes + q); a prescribed grain's own
  * field takes its velocity everywhere. */
-static void apply_walls_pairs(mpm_scene *s, double *vx, double *vy, bool decide)
+STAGE static void apply_walls_pairs(mpm_scene *s, double *vx, double *vy, bool decide)
 {
     const size_t nn = s->nnodes;
 #pragma omp for schedule(static)
@@ -418,14 +444,13 @@ static void move_pairs(mpm_scene *s, size_t to, size_t from, size_t n)
 
 /* Inside the parallel region; thread t takes its grains. Their pairs are first written from
  * ns * tp[t] (a grain has at most ns pairs per point), then packed in thread order. */
-static void grain_fields(mpm_scene *s, int t)
+STAGE static void grain_scatter(mpm_scene *s, int t)
 {
     const size_t nn = s->nnodes;
     const int ns = s->ns;
     const double gx0 = s->def.gravity[0], gy0 = s->def.gravity[1];
     const bool spline_normals = s->opt.normals != MPM_NORMALS_LINEAR && ns != 9;
     const bool volumes = s->opt.separation > 0;
-    const double ox = s->def.origin[0], oy = s->def.origin[1];
     int *mark = s->tmark + (size_t)t * nn;
     const size_t base = (size_t)ns * s->tp[t];
     size_t q = base;
@@ -471,8 +496,14 @@ static void grain_fields(mpm_scene *s, int t)
             mark[s->pnode[r]] = -1;
     }
     s->tc[t] = q - base;
-#pragma omp barrier
-#pragma omp master
+}
+
+/* Packs the threads' pairs in thread order, counts the grains at each node and sums the
+ * centre-of-mass field from the grain fields (one thread). */
+STAGE static void grain_pack(mpm_scene *s)
+{
+    const size_t nn = s->nnodes;
+    const int ns = s->ns;
     {
         /* pack the threads' pairs; count the grains at each node; the centre-of-mass field is
          * the sum of the grain fields */
@@ -495,8 +526,14 @@ static void grain_fields(mpm_scene *s, int t)
                 node[k][i] += node[k][nn + r];
         }
     }
-#pragma omp barrier
-    /* each point's stencil: its grain's entry at shared nodes, the centre of mass elsewhere */
+}
+
+/* Thread t's points' stencil entries: the grain's pair at shared nodes, else the node. */
+STAGE static void grain_stencil(mpm_scene *s, int t)
+{
+    const size_t nn = s->nnodes;
+    const int ns = s->ns;
+    const size_t base = (size_t)ns * s->tp[t];
     {
         const long shift = (long)base - (long)s->tq[t];
         for (size_t e = (size_t)ns * s->tp[t]; e < (size_t)ns * s->tp[t + 1]; e++) {
@@ -504,7 +541,15 @@ static void grain_fields(mpm_scene *s, int t)
             s->sv[e] = s->ngr[i] < 2 ? i : (int)(nn + (size_t)((long)s->sv[e] - shift));
         }
     }
-    if (spline_normals) {
+}
+
+/* Eq. 24 with linear transfers: thread t's grains' B-spline mass gradients at their shared pairs.
+ */
+STAGE static void grain_normals(mpm_scene *s, int t)
+{
+    const double ox = s->def.origin[0], oy = s->def.origin[1];
+    int *mark = s->tmark + (size_t)t * s->nnodes;
+    {
         /* Eq. 24 with linear transfers: each grain's B-spline mass gradient at its shared pairs,
          * from the points whose 3 x 3 B-spline nodes include one of them. */
         size_t r0 = s->tq[t];
@@ -555,8 +600,11 @@ static void grain_fields(mpm_scene *s, int t)
             r0 = r1;
         }
     }
-#pragma omp barrier
-#pragma omp master
+}
+
+/* At shared nodes: the sum of the grains' gradients and nodal volumes (one thread). */
+STAGE static void grain_sums(mpm_scene *s)
+{
     {
         /* at shared nodes: the sum of the grains' gradients and nodal volumes */
         for (size_t r = 0; r < s->npairs; r++) {
@@ -573,14 +621,35 @@ static void grain_fields(mpm_scene *s, int t)
             }
         }
     }
+}
+
+/* Inside the parallel region: the stages above with the barriers between them; *tlp is thread
+ * 0's last clock reading (STAGE_DONE). */
+static void grain_fields(mpm_scene *s, int t, double *tlp)
+{
+    double tl = *tlp;
+    const bool spline_normals = s->opt.normals != MPM_NORMALS_LINEAR && s->ns != 9;
+    grain_scatter(s, t);
 #pragma omp barrier
+#pragma omp master
+    grain_pack(s);
+#pragma omp barrier
+    grain_stencil(s, t);
+    STAGE_DONE(T_P2G); /* no barrier: the normals need none, so this is thread 0's own time */
+    if (spline_normals)
+        grain_normals(s, t);
+#pragma omp barrier
+#pragma omp master
+    grain_sums(s);
+#pragma omp barrier
+    *tlp = tl;
 }
 
 /* Step 2: v_i^n from Eq. 5 and v_i^{n+1} from Eq. 9. v_i^n = p_i / m_i is a mass-weighted mean of
  * point velocities, bounded at any mass; only the acceleration f_i / m_i blows up at nearly empty
  * nodes, so nodes lighter than m_min keep v_i^{n+1} = v_i^n (a zero velocity there would put a
  * spurious strain rate v / h into their neighbours' points). */
-static void grid_update(mpm_scene *s, double dt)
+STAGE static void grid_update(mpm_scene *s, double dt)
 {
     const double m_min = s->m_min;
 #pragma omp for schedule(static)
@@ -608,7 +677,7 @@ static void grid_update(mpm_scene *s, double dt)
  * the strain cap; then the momentum the corrections changed at a node (non-zero with three or
  * more grains, or with the cap) is taken back evenly from the corrected grains there, a common
  * velocity shift that leaves their relative motion as the rule made it. */
-static void contact_correct(mpm_scene *s, double *vx, double *vy, bool decide, double dt)
+STAGE static void contact_correct(mpm_scene *s, double *vx, double *vy, bool decide, double dt)
 {
     const size_t nn = s->nnodes;
     const double mu = s->mu;
@@ -703,7 +772,7 @@ static void contact_correct(mpm_scene *s, double *vx, double *vy, bool decide, d
  * (measured on the 0.5 m/s head-on collision: correcting v_i^g after P2G as well changed the
  * rebound speed by 1.5% and did not remove the energy error that the consistent marks below
  * fix), so a point's FLIP increment carries the whole correction. */
-static void contact_update(mpm_scene *s, double dt)
+STAGE static void contact_update(mpm_scene *s, double dt)
 {
     const size_t nn = s->nnodes;
     const double m_min = s->m_min;
@@ -730,7 +799,7 @@ static void contact_update(mpm_scene *s, double dt)
 
 /* Step 3: positions (Eq. 10) and velocities (Eq. 11, blended with PIC) of thread t's points; a
  * prescribed grain's points keep its velocity exactly. */
-static void to_points(mpm_scene *s, double dt, int t)
+STAGE static void to_points(mpm_scene *s, double dt, int t)
 {
     const double pic = s->def.pic, flip = 1 - pic;
     const int ns = s->ns;
@@ -774,7 +843,7 @@ static void to_points(mpm_scene *s, double dt, int t)
  * elastic) / initial kinetic = 1.01: no remap correction: 1.64; remap correction re-deciding
  * Eq. 12 on the remapped field (contact switching on and off every other step): 1.58; the marks
  * of the momentum update: 1.03. */
-static void nodal_velocity(mpm_scene *s, double dt, bool decide)
+STAGE static void nodal_velocity(mpm_scene *s, double dt, bool decide)
 {
     const size_t ne = s->nnodes + s->npairs;
 #pragma omp for schedule(static)
@@ -796,7 +865,7 @@ static void nodal_velocity(mpm_scene *s, double dt, bool decide)
  * the centre of mass then takes the sum of the grains' entries. Inside the parallel region. With
  * friction every entry a point feeds belongs to its thread (its grain's, or a node only its grain
  * touches); noslip scatters into thread buffers. */
-static void scatter_sf(mpm_scene *s, int t, double *a, double *b, bool force)
+STAGE static void scatter_sf(mpm_scene *s, int t, double *a, double *b, bool force)
 {
     const size_t nn = s->nnodes, ne = s->nnodes + s->npairs;
     const int ns = s->ns;
@@ -852,7 +921,7 @@ static void scatter_sf(mpm_scene *s, int t, double *a, double *b, bool force)
 
 /* MUSL: the updated point momenta mapped back (Eq. 5 with v_p^{n+1}) give the nodal velocities
  * the strain increment is taken from; with friction each grain's own field at shared nodes. */
-static void remap(mpm_scene *s, double dt, int t)
+STAGE static void remap(mpm_scene *s, double dt, int t)
 {
     scatter_sf(s, t, s->npx, s->npy, false);
     nodal_velocity(s, dt, false);
@@ -860,7 +929,7 @@ static void remap(mpm_scene *s, double dt, int t)
 
 /* Step 3, continued: velocity gradient L = sum_i v_i G_pi, F <- (I + dt L) F, stress update.
  * Returns the first point that inverts, or (size_t)-1. */
-static size_t constitutive(mpm_scene *s, double dt, int t, const double *vx, const double *vy)
+STAGE static size_t constitutive(mpm_scene *s, double dt, int t, const double *vx, const double *vy)
 {
     size_t bad = (size_t)-1;
     const int ns = s->ns;
@@ -979,16 +1048,20 @@ core_status mpm_run(mpm_scene *s, const mpm_run_def *run, long *done, core_error
         double dt = run->dt > 0 ? run->dt : run->cfl * h / (ts.wave_speed + max_speed(s));
         if (run->time_end >= 0 && s->time + dt > run->time_end)
             dt = run->time_end - s->time;
+        const double t0 = clock_wall();
+        double tlast = t0;
 #pragma omp parallel num_threads(s->nt) if (s->nt > 1)
         {
             const int t = THREAD_ID();
+            double tl = t0;
             stencil(s, s->tp[t], s->tp[t + 1]);
 #pragma omp barrier
 #pragma omp master
             mark_forced(s);
 #pragma omp barrier
+            STAGE_DONE(T_STENCIL);
             if (friction)
-                grain_fields(s, t); /* the centre-of-mass field too */
+                grain_fields(s, t, &tl); /* the centre-of-mass field too */
             else
                 to_grid(s, t);
 #pragma omp barrier
@@ -996,23 +1069,36 @@ core_status mpm_run(mpm_scene *s, const mpm_run_def *run, long *done, core_error
             if (s->nmx)
                 moments(s);
 #pragma omp barrier
+            STAGE_DONE(friction ? T_NORMALS : T_P2G);
             tbad[t] = (size_t)-1;
             if (usf) {
                 nodal_velocity(s, dt, true); /* v_i^n, for the stress update */
                 tbad[t] = constitutive(s, dt, t, s->nax, s->nay);
 #pragma omp barrier
+                STAGE_DONE(T_MATERIAL);
                 scatter_sf(s, t, s->nfx, s->nfy, true); /* forces from the new stress */
+                STAGE_DONE(T_P2G);
             }
             grid_update(s, dt);
-            if (friction)
+            STAGE_DONE(T_GRID);
+            if (friction) {
                 contact_update(s, dt);
+                STAGE_DONE(T_CONTACT);
+            }
             to_points(s, dt, t);
 #pragma omp barrier
-            if (musl)
+            STAGE_DONE(T_G2P);
+            if (musl) {
                 remap(s, dt, t);
+                STAGE_DONE(T_REMAP);
+            }
             if (!usf)
                 tbad[t] = constitutive(s, dt, t, s->nax, s->nay);
+            if (t == 0)
+                tlast = tl;
         }
+        const double tend = clock_wall(); /* the end of the region, then the checks */
+        s->tstage[usf ? T_G2P : T_MATERIAL] += tend - tlast;
         for (int t = 0; t < s->nt; t++)
             if (tbad[t] != (size_t)-1)
                 return unstable(s, tbad[t], "was inverted (det F <= 0)",
@@ -1033,6 +1119,8 @@ core_status mpm_run(mpm_scene *s, const mpm_run_def *run, long *done, core_error
         s->time += dt;
         s->steps++;
         ++*done;
+        s->tstage[T_CHECK] += clock_wall() - tend;
+        s->tsteps++;
     }
     return CORE_OK;
 }
