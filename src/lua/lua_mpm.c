@@ -380,10 +380,9 @@ static int add_grain(lua_State *L, const char *call, mpm_shape shape)
     mpm_scene *s = check_scene(L, 1);
     const bind_run *r = bind_running(L, 1);
     if (r && r->dt > 0 && !r->forced) /* with dt = 'auto' the CFL condition holds every step */
-        bind_refuse_running(L, 1, call,
-                            "a new grain can raise the wave speed the run's fixed dt "
-                            "was checked against: add grains between runs, or run "
-                            "with dt = 'auto'");
+        bind_refuse_running(L, 1, call, "a new grain can raise the wave speed the run's fixed dt "
+                                        "was checked against: add grains between runs, or run "
+                                        "with dt = 'auto'");
     bind_check_table(L, 2, call);
     bind_check_fields(L, 2, call,
                       shape == MPM_DISK   ? DISK_FIELDS
@@ -603,7 +602,8 @@ typedef struct mpm_advance_ctx {
     mpm_run_def *run;
 } mpm_advance_ctx;
 
-static core_status mpm_advance(void *ctx, long n, struct progress *p, long *done, core_error *err)
+static core_status mpm_advance(void *ctx, long n, struct progress *p, long *done,
+                               core_error *err)
 {
     (void)p;
     mpm_advance_ctx *c = ctx;

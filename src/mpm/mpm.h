@@ -57,13 +57,13 @@ typedef enum mpm_update {
 } mpm_update;
 
 typedef struct mpm_scene_def {
-    int cells[2];      /* nx, ny >= 1 */
-    double origin[2];  /* lower-left corner, m */
-    double size[2];    /* Lx, Ly, m */
-    bool periodic[2];  /* a periodic axis has no walls and wraps points */
-    double gravity[2]; /* m/s^2 */
-    mpm_wall walls[4]; /* MPM_LEFT, MPM_RIGHT, MPM_BOTTOM, MPM_TOP (ignored on periodic axes) */
-    double wall_mu[4]; /* Coulomb coefficient of a MPM_WALL_FRICTION wall */
+    int cells[2];         /* nx, ny >= 1 */
+    double origin[2];     /* lower-left corner, m */
+    double size[2];       /* Lx, Ly, m */
+    bool periodic[2];     /* a periodic axis has no walls and wraps points */
+    double gravity[2];    /* m/s^2 */
+    mpm_wall walls[4];    /* MPM_LEFT, MPM_RIGHT, MPM_BOTTOM, MPM_TOP (ignored on periodic axes) */
+    double wall_mu[4];    /* Coulomb coefficient of a MPM_WALL_FRICTION wall */
     double wall_velocity[4][2]; /* a moving wall's velocity (tangential part for friction/slip) */
     mpm_shape_fn shape;
     /* Gap test of friction walls and planes against contact "at a distance": a node takes the
@@ -72,8 +72,8 @@ typedef struct mpm_scene_def {
      * node behind the wall is in contact whenever material moves into it). */
     double wall_gap;
     mpm_update update;
-    double pic; /* PIC fraction of the velocity update in [0, 1]: 0 = pure FLIP (Eq. 11,
-                 * default), 1 = pure PIC (v_p = sum_i N_i v_i^{n+1}) */
+    double pic;           /* PIC fraction of the velocity update in [0, 1]: 0 = pure FLIP (Eq. 11,
+                           * default), 1 = pure PIC (v_p = sum_i N_i v_i^{n+1}) */
 } mpm_scene_def;
 
 mpm_scene_def mpm_default_scene_def(void);
@@ -92,20 +92,19 @@ void mpm_cell_size(const mpm_scene *s, double h[2]);
  * space (Simo 1992) with the small-strain formula. */
 typedef enum mpm_model {
     MPM_ELASTIC,
-    MPM_VONMISES /* J2 plasticity, linear isotropic hardening: q = yield + hardening eps_p */
+    MPM_VONMISES  /* J2 plasticity, linear isotropic hardening: q = yield + hardening eps_p */
 } mpm_model;
 
 typedef struct mpm_material {
     mpm_model model;
-    double density;   /* kg/m^3 */
-    double shear;     /* G, Pa */
-    double bulk;      /* K, Pa */
-    double yield;     /* von Mises yield stress (equivalent, q = sqrt(3/2)|s|), Pa */
-    double hardening; /* H = d q / d eps_p, Pa (>= 0) */
+    double density;    /* kg/m^3 */
+    double shear;      /* G, Pa */
+    double bulk;       /* K, Pa */
+    double yield;      /* von Mises yield stress (equivalent, q = sqrt(3/2)|s|), Pa */
+    double hardening;  /* H = d q / d eps_p, Pa (>= 0) */
 } mpm_material;
 
-mpm_material
-mpm_default_material(void); /* elastic, the paper's incline disk: 3000, 2.5 MPa, 10 MPa */
+mpm_material mpm_default_material(void); /* elastic, the paper's incline disk: 3000, 2.5 MPa, 10 MPa */
 /* Checks a material (positive density and moduli, yield > 0 for von Mises). */
 core_status mpm_check_material(const mpm_material *m, core_error *err);
 /* Returns the material index (>= 0) or -1 with err filled. */
@@ -133,11 +132,11 @@ typedef struct mpm_grain_def {
                                * orientation; read during mpm_add_grain only) */
     int nvertices;
     int material;
-    int points_per_cell; /* n: the cell is split into n x n sub-cells, a point at the centre
-                          * of each sub-cell inside the shape (paper: n = 2 or 3) */
-    double velocity[2];  /* initial rigid motion: v = velocity + omega x (x - centroid) */
+    int points_per_cell;      /* n: the cell is split into n x n sub-cells, a point at the centre
+                               * of each sub-cell inside the shape (paper: n = 2 or 3) */
+    double velocity[2];       /* initial rigid motion: v = velocity + omega x (x - centroid) */
     double omega;
-    bool clip; /* keep only the points inside the grid (grains cut by an edge) */
+    bool clip;                /* keep only the points inside the grid (grains cut by an edge) */
 } mpm_grain_def;
 
 mpm_grain_def mpm_default_grain_def(void);
@@ -167,7 +166,7 @@ core_status mpm_prescribe(mpm_scene *s, size_t grain, const double v[2], core_er
  * with the plane's exact normal. normal points out of the body into the material. */
 typedef struct mpm_plane_def {
     double point[2], normal[2];
-    mpm_wall kind; /* noslip, slip or friction */
+    mpm_wall kind;       /* noslip, slip or friction */
     double mu;
     double velocity[2];
 } mpm_plane_def;
@@ -193,8 +192,8 @@ core_status mpm_add_plane(mpm_scene *s, const mpm_plane_def *p, core_error *err)
  * opposite and momentum is conserved; the paper (Eq. 24) uses the grain's own
  * quadratic-B-spline density gradient (not implemented). */
 typedef enum mpm_contact_model {
-    MPM_CONTACT_NOSLIP,  /* the single centre-of-mass field (Sec. 2, the basic algorithm) */
-    MPM_CONTACT_FRICTION /* per-grain fields with Coulomb friction (Eqs. 12-24) */
+    MPM_CONTACT_NOSLIP,   /* the single centre-of-mass field (Sec. 2, the basic algorithm) */
+    MPM_CONTACT_FRICTION  /* per-grain fields with Coulomb friction (Eqs. 12-24) */
 } mpm_contact_model;
 
 /* Selects "noslip". MPM_CONTACT_FRICTION is refused here: it needs mu (mpm_set_friction). */
@@ -237,10 +236,10 @@ double mpm_friction(const mpm_scene *s); /* mu, 0 for noslip */
 /* ---- points (bulk access, in point order) --------------------------------------------------- */
 typedef struct mpm_points {
     const double *x, *y, *vx, *vy, *mass, *volume0;
-    const double *F[4];     /* total deformation gradient, xx, xy, yx, yy */
-    const double *sigma[4]; /* Cauchy stress xx, yy, xy, zz (tension positive) */
-    const double *eps_p;    /* equivalent plastic strain */
-    const double *ux, *uy;  /* displacement since the grain was added (not wrapped) */
+    const double *F[4];      /* total deformation gradient, xx, xy, yx, yy */
+    const double *sigma[4];  /* Cauchy stress xx, yy, xy, zz (tension positive) */
+    const double *eps_p;     /* equivalent plastic strain */
+    const double *ux, *uy;   /* displacement since the grain was added (not wrapped) */
     const int *grain, *material;
 } mpm_points;
 void mpm_get_points(const mpm_scene *s, mpm_points *p);
@@ -249,21 +248,21 @@ core_status mpm_set_velocities(mpm_scene *s, const double *vx, const double *vy,
 
 /* ---- time stepping ----------------------------------------------------------------------- */
 typedef struct mpm_timestep {
-    double wave_speed; /* largest P-wave speed of the materials in use */
-    double max_speed;  /* fastest point */
-    double limit;      /* CFL bound min(hx, hy) / (c + max|v|): no dt above it without force */
-    double dt_auto;    /* cfl * limit */
+    double wave_speed;  /* largest P-wave speed of the materials in use */
+    double max_speed;   /* fastest point */
+    double limit;       /* CFL bound min(hx, hy) / (c + max|v|): no dt above it without force */
+    double dt_auto;     /* cfl * limit */
 } mpm_timestep;
 
 #define MPM_DEFAULT_CFL 0.4
 core_status mpm_timestep_info(const mpm_scene *s, double cfl, mpm_timestep *out, core_error *err);
 
 typedef struct mpm_run_def {
-    long steps;      /* at most this many steps (required >= 0) */
-    double time_end; /* < 0: none; else stop once the scene time reaches it (the last step is
-                      * shortened to land on it) */
-    double dt;       /* > 0: fixed step; 0: automatic, cfl * limit re-evaluated every step */
-    double cfl;      /* for dt = 0, in (0, 1] */
+    long steps;        /* at most this many steps (required >= 0) */
+    double time_end;   /* < 0: none; else stop once the scene time reaches it (the last step is
+                        * shortened to land on it) */
+    double dt;         /* > 0: fixed step; 0: automatic, cfl * limit re-evaluated every step */
+    double cfl;        /* for dt = 0, in (0, 1] */
 } mpm_run_def;
 
 mpm_run_def mpm_default_run_def(void);
@@ -285,21 +284,21 @@ void mpm_timings(const mpm_scene *s, double seconds[MPM_NSTAGES], long *steps);
 
 /* ---- measurements -------------------------------------------------------------------------- */
 typedef struct mpm_energy {
-    double kinetic;   /* sum 1/2 m v^2 (per unit depth: J/m) */
-    double elastic;   /* sum V0 W(b_e), Hencky energy */
-    double plastic;   /* sum V0 (yield eps_p + H eps_p^2 / 2): the plastic work */
-    double potential; /* -sum m g . x */
+    double kinetic;    /* sum 1/2 m v^2 (per unit depth: J/m) */
+    double elastic;    /* sum V0 W(b_e), Hencky energy */
+    double plastic;    /* sum V0 (yield eps_p + H eps_p^2 / 2): the plastic work */
+    double potential;  /* -sum m g . x */
     double total;
 } mpm_energy;
 void mpm_measure_energy(const mpm_scene *s, mpm_energy *e);
 
 typedef struct mpm_grain_info {
     double mass;
-    double center[2]; /* centre of mass (minimum image on periodic axes) */
+    double center[2];          /* centre of mass (minimum image on periodic axes) */
     double velocity[2];
-    double angular_momentum; /* about the centre of mass, z component */
-    double inertia;          /* sum m |x - c|^2 */
-    double omega;            /* angular_momentum / inertia */
+    double angular_momentum;   /* about the centre of mass, z component */
+    double inertia;            /* sum m |x - c|^2 */
+    double omega;              /* angular_momentum / inertia */
     size_t points;
 } mpm_grain_info;
 core_status mpm_grain(const mpm_scene *s, size_t id, mpm_grain_info *out, core_error *err);
@@ -307,20 +306,10 @@ core_status mpm_grain(const mpm_scene *s, size_t id, mpm_grain_info *out, core_e
 /* Cell fields: the mass-weighted mean of a point quantity over the points in each cell (row-major,
  * nx * ny values; NAN in empty cells), and the mass per cell. */
 typedef enum mpm_field_kind {
-    MPM_FIELD_VX,
-    MPM_FIELD_VY,
-    MPM_FIELD_SPEED,
-    MPM_FIELD_UX,
-    MPM_FIELD_UY,
-    MPM_FIELD_UMAG,
-    MPM_FIELD_SXX,
-    MPM_FIELD_SYY,
-    MPM_FIELD_SXY,
-    MPM_FIELD_PRESSURE,
-    MPM_FIELD_PSD, /* principal stress difference sigma_1 - sigma_2 (in-plane) */
-    MPM_FIELD_EPS_P,
-    MPM_FIELD_GRAIN,
-    MPM_FIELD_MASS
+    MPM_FIELD_VX, MPM_FIELD_VY, MPM_FIELD_SPEED, MPM_FIELD_UX, MPM_FIELD_UY, MPM_FIELD_UMAG,
+    MPM_FIELD_SXX, MPM_FIELD_SYY, MPM_FIELD_SXY, MPM_FIELD_PRESSURE,
+    MPM_FIELD_PSD,   /* principal stress difference sigma_1 - sigma_2 (in-plane) */
+    MPM_FIELD_EPS_P, MPM_FIELD_GRAIN, MPM_FIELD_MASS
 } mpm_field_kind;
 void mpm_field(const mpm_scene *s, mpm_field_kind kind, double *out);
 /* Mass-weighted mean vertical displacement per column of cells (nx values; NAN if empty). */

@@ -20,20 +20,20 @@ typedef struct mpm_plane {
 struct mpm_scene {
     mpm_scene_def def;
     double hx, hy, inv_hx, inv_hy;
-    int nnx, nny; /* nodes per axis: cells + 1 + 2 gl, or cells on a periodic axis */
-    int gl[2];    /* ghost node layers beyond each wall: 1 for B-splines, else 0 */
-    int ns;       /* nodes per point: 4 (linear) or 9 (B-spline) */
+    int nnx, nny;           /* nodes per axis: cells + 1 + 2 gl, or cells on a periodic axis */
+    int gl[2];              /* ghost node layers beyond each wall: 1 for B-splines, else 0 */
+    int ns;                 /* nodes per point: 4 (linear) or 9 (B-spline) */
     size_t nnodes;
 
     /* nodal fields: nnodes centre-of-mass entries, then (contact "friction") one entry per
      * (grain, node) pair at index nnodes + q, so the transfers index both the same way */
-    double *nm;           /* lumped mass, Eq. 6 */
-    double *npx, *npy;    /* momentum m_i v_i^n, Eq. 5 (reused for the MUSL remap) */
-    double *nfx, *nfy;    /* internal + external force, Eq. 7 */
-    double *nvx, *nvy;    /* v_i^n */
-    double *nax, *nay;    /* v_i^{n+1} */
-    unsigned char *nwall; /* bit k: node belongs to plane k */
-    unsigned char *nwin;  /* bit k: friction plane k in contact at this node this step */
+    double *nm;             /* lumped mass, Eq. 6 */
+    double *npx, *npy;      /* momentum m_i v_i^n, Eq. 5 (reused for the MUSL remap) */
+    double *nfx, *nfy;      /* internal + external force, Eq. 7 */
+    double *nvx, *nvy;      /* v_i^n */
+    double *nax, *nay;      /* v_i^{n+1} */
+    unsigned char *nwall;   /* bit k: node belongs to plane k */
+    unsigned char *nwin;    /* bit k: friction plane k in contact at this node this step */
     mpm_plane planes[4 + MPM_MAX_PLANES];
     int nplanes;
     /* The gap test of friction planes (def.wall_gap > 0): first moments of the nodal mass about
@@ -48,51 +48,51 @@ struct mpm_scene {
     double slack[2][2];
 
     /* prescribed-velocity grains (allocated when the first is prescribed) */
-    int *gpres; /* per grain: index into pv, or -1 */
+    int *gpres;             /* per grain: index into pv, or -1 */
     double (*pv)[2];
     int npres;
-    int *nforce; /* per node: 1 + index into pv of the grain forcing it, or 0 */
+    int *nforce;            /* per node: 1 + index into pv of the grain forcing it, or 0 */
 
     /* material points */
     size_t np, cap;
     double *x, *y, *vx, *vy, *m, *v0;
-    double *F[4];   /* xx, xy, yx, yy */
-    double *be[4];  /* elastic left Cauchy-Green: xx, xy, yy, zz */
-    double *sig[4]; /* Cauchy stress: xx, yy, xy, zz */
+    double *F[4];           /* xx, xy, yx, yy */
+    double *be[4];          /* elastic left Cauchy-Green: xx, xy, yy, zz */
+    double *sig[4];         /* Cauchy stress: xx, yy, xy, zz */
     double *eps_p;
-    double *ux, *uy; /* displacement */
+    double *ux, *uy;        /* displacement */
     int *grain, *mat;
     /* stencil, MPM_STENCIL per point */
     int *sn;
     double *sw, *sgx, *sgy;
-    double m_min; /* nodes lighter than this take no acceleration */
+    double m_min;           /* nodes lighter than this take no acceleration */
     /* sf: per stencil entry, the nodal-array index of the field the point moves with: sn for
      * noslip; for friction the grain's pair at nodes shared by several grains, else sn */
     int *sf;
 
     /* frictional contact (Eqs. 12-24): sparse per-grain nodal fields, rebuilt every step */
     double mu;
-    size_t paircap; /* the nodal arrays hold nnodes + paircap entries */
+    size_t paircap;         /* the nodal arrays hold nnodes + paircap entries */
     size_t npairs;
-    int *pnode;          /* node of pair q */
-    int *pgrain;         /* grain of pair q */
-    unsigned char *pin;  /* pair q in contact this step (Eq. 12 at the momentum update) */
-    unsigned char *pwin; /* pair q: bit k, friction plane k in contact (as nwin) */
-    double *pvol;        /* sum_p N_ip V_p over the grain (the separation check) */
-    double *pcx, *pcy;   /* scratch: the contact correction of pair q this call */
-    double *tvol;        /* the same over all grains (nnodes) */
-    double *ndp;         /* scratch (3 nnodes): momentum change of the corrections at a node */
+    int *pnode;             /* node of pair q */
+    int *pgrain;            /* grain of pair q */
+    unsigned char *pin;     /* pair q in contact this step (Eq. 12 at the momentum update) */
+    unsigned char *pwin;    /* pair q: bit k, friction plane k in contact (as nwin) */
+    double *pvol;           /* sum_p N_ip V_p over the grain (the separation check) */
+    double *pcx, *pcy;      /* scratch: the contact correction of pair q this call */
+    double *tvol;           /* the same over all grains (nnodes) */
+    double *ndp;            /* scratch (3 nnodes): momentum change of the corrections at a node */
     mpm_contact_options opt;
-    double *pnx, *pny; /* sum_p m_p G_pi over the grain: its outward normal direction */
-    int *ngr;          /* grains touching node i (nnodes) */
-    double *tgx, *tgy; /* sum_p m_p G_pi over all grains (nnodes) */
-    int *sv;           /* ns per point: the friction sf */
+    double *pnx, *pny;      /* sum_p m_p G_pi over the grain: its outward normal direction */
+    int *ngr;               /* grains touching node i (nnodes) */
+    double *tgx, *tgy;      /* sum_p m_p G_pi over all grains (nnodes) */
+    int *sv;                /* ns per point: the friction sf */
 
     mpm_material *mats;
     int nmat, matcap;
     size_t ngrains, gcap;
     size_t *gstart, *gcount;
-    mpm_grain_def *gdef; /* each grain's shape, for the overlap warning */
+    mpm_grain_def *gdef;    /* each grain's shape, for the overlap warning */
 
     /* threads: nt contiguous point ranges [tp[t], tp[t+1]) aligned to grains (tg[t] the first
      * grain of range t), so that a grain's points, its per-grain field entries and the nodes
