@@ -453,13 +453,22 @@ STAGE static void grain_scatter(mpm_scene *s, int t)
     const bool volumes = s->opt.separation > 0;
     int *mark = s->tmark + (size_t)t * nn;
     const size_t base = (size_t)ns * s->tp[t];
+    /* the grain entries (pair r at nn + r of the nodal arrays) and the point arrays as locals:
+     * the stores below cannot change them, and the compiler need not reload them */
+    double *const pm = s->nm + nn, *const ppx = s->npx + nn, *const ppy = s->npy + nn;
+    double *const pfx = s->nfx + nn, *const pfy = s->nfy + nn;
+    double *const pnx = s->pnx, *const pny = s->pny, *const pvol = s->pvol;
+    int *const pnode = s->pnode, *const pgrain = s->pgrain;
+    const double *const xm = s->m, *const vx = s->vx, *const vy = s->vy, *const v0 = s->v0;
+    const double *const F0 = s->F[0], *const F1 = s->F[1], *const F2 = s->F[2], *const F3 = s->F[3];
+    const double *const s0 = s->sig[0], *const s1 = s->sig[1], *const s2 = s->sig[2];
     size_t q = base;
     for (size_t g = s->tg[t]; g < s->tg[t + 1]; g++) {
         const size_t p0 = s->gstart[g], p1 = p0 + s->gcount[g], q0 = q;
         for (size_t p = p0; p < p1; p++) {
-            const double m = s->m[p], px = m * s->vx[p], py = m * s->vy[p];
-            const double V = s->v0[p] * (s->F[0][p] * s->F[3][p] - s->F[1][p] * s->F[2][p]);
-            const double sxx = V * s->sig[0][p], syy = V * s->sig[1][p], sxy = V * s->sig[2][p];
+            const double m = xm[p], px = m * vx[p], py = m * vy[p];
+            const double V = v0[p] * (F0[p] * F3[p] - F1[p] * F2[p]);
+            const double sxx = V * s0[p], syy = V * s1[p], sxy = V * s2[p];
             const double fgx = m * gx0, fgy = m * gy0;
             const int *n = &s->sn[ns * p];
             const double *w = &s->sw[ns * p], *gx = &s->sgx[ns * p], *gy = &s->sgy[ns * p];
@@ -470,30 +479,28 @@ STAGE static void grain_scatter(mpm_scene *s, int t)
                 if (r < 0) {
                     r = (int)q++;
                     mark[i] = r;
-                    s->pnode[r] = i;
-                    s->pgrain[r] = (int)g;
-                    const size_t e = nn + (size_t)r;
-                    s->nm[e] = s->npx[e] = s->npy[e] = s->nfx[e] = s->nfy[e] = 0;
-                    s->pnx[r] = s->pny[r] = s->pvol[r] = 0;
+                    pnode[r] = i;
+                    pgrain[r] = (int)g;
+                    pm[r] = ppx[r] = ppy[r] = pfx[r] = pfy[r] = 0;
+                    pnx[r] = pny[r] = pvol[r] = 0;
                 }
-                const size_t e = nn + (size_t)r;
                 const double wk = w[k];
-                s->nm[e] += wk * m;
-                s->npx[e] += wk * px;
-                s->npy[e] += wk * py;
-                s->nfx[e] += wk * fgx - (sxx * gx[k] + sxy * gy[k]);
-                s->nfy[e] += wk * fgy - (sxy * gx[k] + syy * gy[k]);
+                pm[r] += wk * m;
+                ppx[r] += wk * px;
+                ppy[r] += wk * py;
+                pfx[r] += wk * fgx - (sxx * gx[k] + sxy * gy[k]);
+                pfy[r] += wk * fgy - (sxy * gx[k] + syy * gy[k]);
                 if (volumes)
-                    s->pvol[r] += wk * V;
+                    pvol[r] += wk * V;
                 if (!spline_normals) {
-                    s->pnx[r] += m * gx[k];
-                    s->pny[r] += m * gy[k];
+                    pnx[r] += m * gx[k];
+                    pny[r] += m * gy[k];
                 }
                 sv[k] = r; /* the pair, renumbered after packing */
             }
         }
         for (size_t r = q0; r < q; r++)
-            mark[s->pnode[r]] = -1;
+            mark[pnode[r]] = -1;
     }
     s->tc[t] = q - base;
 }
@@ -803,23 +810,29 @@ STAGE static void to_points(mpm_scene *s, double dt, int t)
 {
     const double pic = s->def.pic, flip = 1 - pic;
     const int ns = s->ns;
-    for (size_t p = s->tp[t]; p < s->tp[t + 1]; p++) {
-        const int *n = &s->sf[ns * p];
-        const double *w = &s->sw[ns * p];
+    const int *const sf = s->sf;
+    const double *const sw = s->sw;
+    const double *const nax = s->nax, *const nay = s->nay, *const nvx = s->nvx, *const nvy = s->nvy;
+    double *const x = s->x, *const y = s->y, *const ux = s->ux, *const uy = s->uy;
+    double *const vx = s->vx, *const vy = s->vy;
+    const size_t pb = s->tp[t + 1];
+    for (size_t p = s->tp[t]; p < pb; p++) {
+        const int *n = &sf[ns * p];
+        const double *w = &sw[ns * p];
         double dvx = 0, dvy = 0, ax = 0, ay = 0;
         for (int k = 0; k < ns; k++) {
             const int i = n[k];
-            ax += w[k] * s->nax[i];
-            ay += w[k] * s->nay[i];
-            dvx += w[k] * (s->nax[i] - s->nvx[i]);
-            dvy += w[k] * (s->nay[i] - s->nvy[i]);
+            ax += w[k] * nax[i];
+            ay += w[k] * nay[i];
+            dvx += w[k] * (nax[i] - nvx[i]);
+            dvy += w[k] * (nay[i] - nvy[i]);
         }
-        s->x[p] += dt * ax;
-        s->y[p] += dt * ay;
-        s->ux[p] += dt * ax;
-        s->uy[p] += dt * ay;
-        s->vx[p] = flip * (s->vx[p] + dvx) + pic * ax;
-        s->vy[p] = flip * (s->vy[p] + dvy) + pic * ay;
+        x[p] += dt * ax;
+        y[p] += dt * ay;
+        ux[p] += dt * ax;
+        uy[p] += dt * ay;
+        vx[p] = flip * (vx[p] + dvx) + pic * ax;
+        vy[p] = flip * (vy[p] + dvy) + pic * ay;
     }
     if (s->npres)
         for (size_t g = s->tg[t]; g < s->tg[t + 1]; g++) {
@@ -933,9 +946,19 @@ STAGE static size_t constitutive(mpm_scene *s, double dt, int t, const double *v
 {
     size_t bad = (size_t)-1;
     const int ns = s->ns;
-    for (size_t p = s->tp[t]; p < s->tp[t + 1]; p++) {
-        const int *n = &s->sf[ns * p];
-        const double *gx = &s->sgx[ns * p], *gy = &s->sgy[ns * p];
+    /* the arrays as locals: the material call is opaque, so fields of s would be reloaded */
+    const int *const sf = s->sf, *const mat = s->mat;
+    const double *const sgx = s->sgx, *const sgy = s->sgy;
+    double *const F0 = s->F[0], *const F1 = s->F[1], *const F2 = s->F[2], *const F3 = s->F[3];
+    double *const b0 = s->be[0], *const b1 = s->be[1], *const b2 = s->be[2], *const b3 = s->be[3];
+    double *const s0 = s->sig[0], *const s1 = s->sig[1], *const s2 = s->sig[2],
+                  *const s3 = s->sig[3];
+    double *const eps_p = s->eps_p;
+    const mpm_material *const mats = s->mats;
+    const size_t pb = s->tp[t + 1];
+    for (size_t p = s->tp[t]; p < pb; p++) {
+        const int *n = &sf[ns * p];
+        const double *gx = &sgx[ns * p], *gy = &sgy[ns * p];
         double L[4] = {0, 0, 0, 0};
         for (int k = 0; k < ns; k++) {
             const int i = n[k];
@@ -945,22 +968,28 @@ STAGE static size_t constitutive(mpm_scene *s, double dt, int t, const double *v
             L[3] += vy[i] * gy[k];
         }
         double f[4] = {1 + dt * L[0], dt * L[1], dt * L[2], 1 + dt * L[3]};
-        double F0 = s->F[0][p], F1 = s->F[1][p], F2 = s->F[2][p], F3 = s->F[3][p];
-        s->F[0][p] = f[0] * F0 + f[1] * F2;
-        s->F[1][p] = f[0] * F1 + f[1] * F3;
-        s->F[2][p] = f[2] * F0 + f[3] * F2;
-        s->F[3][p] = f[2] * F1 + f[3] * F3;
-        double J = s->F[0][p] * s->F[3][p] - s->F[1][p] * s->F[2][p];
-        double be[4] = {s->be[0][p], s->be[1][p], s->be[2][p], s->be[3][p]}, sig[4];
-        if (!mpm_material_update(&s->mats[s->mat[p]], f, be, &s->eps_p[p], J, sig)) {
+        const double Fa = F0[p], Fb = F1[p], Fc = F2[p], Fd = F3[p];
+        const double G0 = f[0] * Fa + f[1] * Fc, G1 = f[0] * Fb + f[1] * Fd;
+        const double G2 = f[2] * Fa + f[3] * Fc, G3 = f[2] * Fb + f[3] * Fd;
+        F0[p] = G0;
+        F1[p] = G1;
+        F2[p] = G2;
+        F3[p] = G3;
+        const double J = G0 * G3 - G1 * G2;
+        double be[4] = {b0[p], b1[p], b2[p], b3[p]}, sig[4];
+        if (!mpm_material_update(&mats[mat[p]], f, be, &eps_p[p], J, sig)) {
             if (bad == (size_t)-1)
                 bad = p;
             continue;
         }
-        for (int k = 0; k < 4; k++) {
-            s->be[k][p] = be[k];
-            s->sig[k][p] = sig[k];
-        }
+        b0[p] = be[0];
+        b1[p] = be[1];
+        b2[p] = be[2];
+        b3[p] = be[3];
+        s0[p] = sig[0];
+        s1[p] = sig[1];
+        s2[p] = sig[2];
+        s3[p] = sig[3];
     }
     return bad;
 }
