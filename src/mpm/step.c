@@ -948,11 +948,54 @@ STAGE static void remap(mpm_scene *s, double dt, int t)
     nodal_velocity(s, dt, false);
 }
 
-/* Step 3, continued: velocity gradient L = sum_i v_i G_pi, F <- (I + dt L) F, stress update.
- * Returns the first point that inverts, or (size_t)-1. */
-STAGE static size_t constitutive(mpm_scene *s, double dt, int t, const double *vx, const double *vy)
+/* The end-of-step check of a point at (*x, *y) with velocity (vx, vy) and in-plane stress sig:
+ * wraps it on periodic axes; true when it is non-finite or outside the grid on an axis that is
+ * not periodic. */
+static inline bool point_bad_at(const mpm_scene *s, double *x, double *y, double vx, double vy,
+                                const double sig[3])
 {
-    size_t bad = (size_t)-1;
+    /* 0 * v is 0 for finite v and NaN for inf or NaN: one test for all seven */
+    const double z = 0 * *x + 0 * *y + 0 * vx + 0 * vy + 0 * sig[0] + 0 * sig[1] + 0 * sig[2];
+    if (!(z == 0))
+        return true;
+    const mpm_scene_def *d = &s->def;
+    double *c[2] = {x, y};
+    bool bad = false;
+    for (int a = 0; a < 2; a++) {
+        double o = d->origin[a], L = d->size[a];
+        if (d->periodic[a]) {
+            if (*c[a] < o || *c[a] >= o + L)
+                *c[a] -= L * floor((*c[a] - o) / L);
+            if (*c[a] >= o + L) /* rounding of a value just below o */
+                *c[a] = o;
+        } else if (*c[a] < o - s->slack[a][0] || *c[a] > o + L + s->slack[a][1]) {
+            bad = true;
+        }
+    }
+    return bad;
+}
+
+static inline bool point_bad(mpm_scene *s, size_t p)
+{
+    const double sig[3] = {s->sig[0][p], s->sig[1][p], s->sig[2][p]};
+    return point_bad_at(s, &s->x[p], &s->y[p], s->vx[p], s->vy[p], sig);
+}
+
+/* Whether the first bad point (point_bad) is finite but outside the grid (1) or not (0). */
+static int bad_why(const mpm_scene *s, size_t first)
+{
+    return isfinite(s->x[first]) && isfinite(s->y[first]) && isfinite(s->vx[first]) &&
+           isfinite(s->vy[first]) && isfinite(s->sig[0][first]) && isfinite(s->sig[1][first]) &&
+           isfinite(s->sig[2][first]);
+}
+
+/* Step 3, continued: velocity gradient L = sum_i v_i G_pi, F <- (I + dt L) F, stress update.
+ * Returns the first point that inverts, or (size_t)-1; with check, each point's end-of-step
+ * check (point_bad) follows its update, and *check is the first bad point. */
+STAGE static size_t constitutive(mpm_scene *s, double dt, int t, const double *vx, const double *vy,
+                                 size_t *check)
+{
+    size_t bad = (size_t)-1, first = (size_t)-1;
     const int ns = s->ns;
     /* the arrays as locals: the material call is opaque, so fields of s would be reloaded */
     const int *const sf = s->sf, *const mat = s->mat;
@@ -962,6 +1005,8 @@ STAGE static size_t constitutive(mpm_scene *s, double dt, int t, const double *v
     double *const s0 = s->sig[0], *const s1 = s->sig[1], *const s2 = s->sig[2],
                   *const s3 = s->sig[3];
     double *const eps_p = s->eps_p;
+    double *const x = s->x, *const y = s->y;
+    const double *const pvx = s->vx, *const pvy = s->vy;
     const mpm_material *const mats = s->mats;
     const size_t pb = s->tp[t + 1];
     for (size_t p = s->tp[t]; p < pb; p++) {
@@ -998,7 +1043,13 @@ STAGE static size_t constitutive(mpm_scene *s, double dt, int t, const double *v
         s1[p] = sig[1];
         s2[p] = sig[2];
         s3[p] = sig[3];
+        /* the end-of-step check, while the point is in cache (one pass and one parallel region
+         * fewer per step) */
+        if (check && point_bad_at(s, &x[p], &y[p], pvx[p], pvy[p], sig) && first == (size_t)-1)
+            first = p;
     }
+    if (check)
+        *check = first;
     return bad;
 }
 
@@ -1012,37 +1063,16 @@ static core_status unstable(const mpm_scene *s, size_t p, const char *what, cons
                      p + 1, s->grain[p] + 1, what, s->steps + 1, s->time, s->x[p], s->y[p], cause);
 }
 
-/* Non-finite values, points outside the grid on axes that are not periodic; periodic axes wrap. */
-/* Wraps points on periodic axes; returns the first point that is non-finite (*why = 0) or
- * outside the grid on an axis that is not periodic (*why = 1), or (size_t)-1. */
-static size_t check_points(mpm_scene *s, int *why)
+/* The check of every point, for USF (whose stress update comes before the positions'); the
+ * other orders check each point right after its stress update (constitutive). Returns the first
+ * bad point, or (size_t)-1. */
+static size_t check_points(mpm_scene *s)
 {
-    const mpm_scene_def *d = &s->def;
     size_t first = (size_t)-1;
 #pragma omp parallel for schedule(static) reduction(min : first) num_threads(s->nt) if (s->nt > 1)
-    for (size_t p = 0; p < s->np; p++) {
-        double *c[2] = {&s->x[p], &s->y[p]};
-        if (!isfinite(*c[0]) || !isfinite(*c[1]) || !isfinite(s->vx[p]) || !isfinite(s->vy[p]) ||
-            !isfinite(s->sig[0][p]) || !isfinite(s->sig[1][p]) || !isfinite(s->sig[2][p])) {
+    for (size_t p = 0; p < s->np; p++)
+        if (point_bad(s, p))
             first = p < first ? p : first;
-            continue;
-        }
-        for (int a = 0; a < 2; a++) {
-            double o = d->origin[a], L = d->size[a];
-            if (d->periodic[a]) {
-                if (*c[a] < o || *c[a] >= o + L)
-                    *c[a] -= L * floor((*c[a] - o) / L);
-                if (*c[a] >= o + L) /* rounding of a value just below o */
-                    *c[a] = o;
-            } else if (*c[a] < o - s->slack[a][0] || *c[a] > o + L + s->slack[a][1]) {
-                first = p < first ? p : first;
-            }
-        }
-    }
-    if (first != (size_t)-1)
-        *why = isfinite(s->x[first]) && isfinite(s->y[first]) && isfinite(s->vx[first]) &&
-               isfinite(s->vy[first]) && isfinite(s->sig[0][first]) && isfinite(s->sig[1][first]) &&
-               isfinite(s->sig[2][first]);
     return first;
 }
 
@@ -1074,7 +1104,7 @@ core_status mpm_run(mpm_scene *s, const mpm_run_def *run, long *done, core_error
     if ((st = mpm_timestep_info(s, run->cfl > 0 && run->cfl <= 1 ? run->cfl : 1, &ts, err)))
         return st;
     const bool musl = s->def.update == MPM_MUSL, usf = s->def.update == MPM_USF;
-    size_t tbad[64];
+    size_t tbad[64], tcheck[64];
     while (*done < run->steps) {
         if (run->time_end >= 0 && s->time >= run->time_end * (1 - 1e-14))
             break;
@@ -1110,7 +1140,7 @@ core_status mpm_run(mpm_scene *s, const mpm_run_def *run, long *done, core_error
             tbad[t] = (size_t)-1;
             if (usf) {
                 nodal_velocity(s, dt, true); /* v_i^n, for the stress update */
-                tbad[t] = constitutive(s, dt, t, s->nax, s->nay);
+                tbad[t] = constitutive(s, dt, t, s->nax, s->nay, NULL);
 #pragma omp barrier
                 STAGE_DONE(T_MATERIAL);
                 scatter_sf(s, t, s->nfx, s->nfy, true); /* forces from the new stress */
@@ -1130,7 +1160,7 @@ core_status mpm_run(mpm_scene *s, const mpm_run_def *run, long *done, core_error
                 STAGE_DONE(T_REMAP);
             }
             if (!usf)
-                tbad[t] = constitutive(s, dt, t, s->nax, s->nay);
+                tbad[t] = constitutive(s, dt, t, s->nax, s->nay, &tcheck[t]);
             if (t == 0)
                 tlast = tl;
         }
@@ -1142,8 +1172,13 @@ core_status mpm_run(mpm_scene *s, const mpm_run_def *run, long *done, core_error
                                 "the time step is too large for the wave speed, or a point too "
                                 "strongly compressed between walls",
                                 err);
-        int why = 0;
-        size_t bad = check_points(s, &why);
+        size_t bad = (size_t)-1;
+        if (usf)
+            bad = check_points(s);
+        else
+            for (int t = 0; t < s->nt; t++)
+                bad = tcheck[t] < bad ? tcheck[t] : bad;
+        const int why = bad != (size_t)-1 ? bad_why(s, bad) : 0;
         if (bad != (size_t)-1)
             return why ? unstable(s, bad, "left the grid",
                                   "an edge without a wall (walls = 'none'), or a time step too "
