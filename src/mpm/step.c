@@ -452,13 +452,11 @@ static void move_pairs(mpm_scene *s, size_t to, size_t from, size_t n)
 
 /* Inside the parallel region; thread t takes its grains. Their pairs are first written from
  * ns * tp[t] (a grain has at most ns pairs per point), then packed in thread order. */
-STAGE static void grain_scatter(mpm_scene *s, int t)
+static inline __attribute__((always_inline)) void
+grain_scatter_with(mpm_scene *s, int t, const int ns, const bool volumes, const bool spline_normals)
 {
     const size_t nn = s->nnodes;
-    const int ns = s->ns;
     const double gx0 = s->def.gravity[0], gy0 = s->def.gravity[1];
-    const bool spline_normals = s->opt.normals != MPM_NORMALS_LINEAR && ns != 9;
-    const bool volumes = s->opt.separation > 0;
     int *mark = s->tmark + (size_t)t * nn;
     const size_t base = (size_t)ns * s->tp[t];
     /* the grain entries (pair r at nn + r of the nodal arrays) and the point arrays as locals:
@@ -511,6 +509,18 @@ STAGE static void grain_scatter(mpm_scene *s, int t)
             mark[pnode[r]] = -1;
     }
     s->tc[t] = q - base;
+}
+
+/* grain_scatter_with with constant options for the common case (linear shapes, spline normals,
+ * no separation check): the stencil loop unrolls and the per-entry tests go. */
+STAGE static void grain_scatter(mpm_scene *s, int t)
+{
+    const bool spline_normals = s->opt.normals != MPM_NORMALS_LINEAR && s->ns != 9;
+    const bool volumes = s->opt.separation > 0;
+    if (s->ns == 4 && spline_normals && !volumes)
+        grain_scatter_with(s, t, 4, false, true);
+    else
+        grain_scatter_with(s, t, s->ns, volumes, spline_normals);
 }
 
 /* Packs the threads' pairs in thread order, counts the grains at each node and sums the
@@ -814,10 +824,10 @@ STAGE static void contact_update(mpm_scene *s, double dt)
 
 /* Step 3: positions (Eq. 10) and velocities (Eq. 11, blended with PIC) of thread t's points; a
  * prescribed grain's points keep its velocity exactly. */
-STAGE static void to_points(mpm_scene *s, double dt, int t)
+static inline __attribute__((always_inline)) void to_points_with(mpm_scene *s, double dt, int t,
+                                                                 const int ns)
 {
     const double pic = s->def.pic, flip = 1 - pic;
-    const int ns = s->ns;
     const int *const sf = s->sf;
     const double *const sw = s->sw;
     const double *const nax = s->nax, *const nay = s->nay, *const nvx = s->nvx, *const nvy = s->nvy;
@@ -854,6 +864,15 @@ STAGE static void to_points(mpm_scene *s, double dt, int t)
         }
 }
 
+/* to_points_with with ns = 4 (linear shapes) a constant: the stencil loops unroll. */
+STAGE static void to_points(mpm_scene *s, double dt, int t)
+{
+    if (s->ns == 4)
+        to_points_with(s, dt, t, 4);
+    else
+        to_points_with(s, dt, t, s->ns);
+}
+
 /* v = p / m on the centre-of-mass nodes and the grain entries, then the walls and the contact
  * rule: for the MUSL remap with the contact marks of the momentum update (decide = false), for
  * USF before the stress update with contacts decided on it (the momentum update decides again).
@@ -886,10 +905,10 @@ STAGE static void nodal_velocity(mpm_scene *s, double dt, bool decide)
  * the centre of mass then takes the sum of the grains' entries. Inside the parallel region. With
  * friction every entry a point feeds belongs to its thread (its grain's, or a node only its grain
  * touches); noslip scatters into thread buffers. */
-STAGE static void scatter_sf(mpm_scene *s, int t, double *a, double *b, bool force)
+static inline __attribute__((always_inline)) void
+scatter_sf_with(mpm_scene *s, int t, double *a, double *b, bool force, const int ns)
 {
     const size_t nn = s->nnodes, ne = s->nnodes + s->npairs;
-    const int ns = s->ns;
     const bool friction = s->contact == MPM_CONTACT_FRICTION;
     const double gx0 = s->def.gravity[0], gy0 = s->def.gravity[1];
     double *const main[2] = {a, b};
@@ -938,6 +957,15 @@ STAGE static void scatter_sf(mpm_scene *s, int t, double *a, double *b, bool for
     } else {
         reduce_buffers(s, main, 2);
     }
+}
+
+/* scatter_sf_with with ns = 4 (linear shapes) a constant: the stencil loops unroll. */
+STAGE static void scatter_sf(mpm_scene *s, int t, double *a, double *b, bool force)
+{
+    if (s->ns == 4)
+        scatter_sf_with(s, t, a, b, force, 4);
+    else
+        scatter_sf_with(s, t, a, b, force, s->ns);
 }
 
 /* MUSL: the updated point momenta mapped back (Eq. 5 with v_p^{n+1}) give the nodal velocities
@@ -992,11 +1020,12 @@ static int bad_why(const mpm_scene *s, size_t first)
 /* Step 3, continued: velocity gradient L = sum_i v_i G_pi, F <- (I + dt L) F, stress update.
  * Returns the first point that inverts, or (size_t)-1; with check, each point's end-of-step
  * check (point_bad) follows its update, and *check is the first bad point. */
-STAGE static size_t constitutive(mpm_scene *s, double dt, int t, const double *vx, const double *vy,
-                                 size_t *check)
+static inline __attribute__((always_inline)) size_t constitutive_with(mpm_scene *s, double dt,
+                                                                      int t, const double *vx,
+                                                                      const double *vy,
+                                                                      size_t *check, const int ns)
 {
     size_t bad = (size_t)-1, first = (size_t)-1;
-    const int ns = s->ns;
     /* the arrays as locals: the material call is opaque, so fields of s would be reloaded */
     const int *const sf = s->sf, *const mat = s->mat;
     const double *const sgx = s->sgx, *const sgy = s->sgy;
@@ -1051,6 +1080,15 @@ STAGE static size_t constitutive(mpm_scene *s, double dt, int t, const double *v
     if (check)
         *check = first;
     return bad;
+}
+
+/* constitutive_with with ns = 4 (linear shapes) a constant: the stencil loops unroll. */
+STAGE static size_t constitutive(mpm_scene *s, double dt, int t, const double *vx, const double *vy,
+                                 size_t *check)
+{
+    if (s->ns == 4)
+        return constitutive_with(s, dt, t, vx, vy, check, 4);
+    return constitutive_with(s, dt, t, vx, vy, check, s->ns);
 }
 
 /* The step being taken when a check fails is s->steps + 1. */
