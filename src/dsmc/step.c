@@ -10,6 +10,7 @@
 #include "core/clock.h"
 #include "core/comm.h"
 #include "core/interrupt.h"
+#include "core/threads.h"
 #include "dsmc/dsmc_internal.h"
 
 enum { STREAM_COLLIDE = 1, STREAM_WALL = 2 };
@@ -692,6 +693,9 @@ core_status dsmc_run(dsmc_scene *s, const dsmc_run_def *run, long *done, core_er
     bool sorted = true;
     int64_t lost = 0;     /* particles this rank could not store at the last migration */
     int64_t overflow = 0; /* cells of the last step whose collision count overflowed */
+    /* A step gives the same bits on any thread count: the tuner may choose it (core/threads.h)
+     * when the step runs threaded. */
+    threads_tune_begin(s, s->n >= DSMC_PARALLEL_MIN);
     while (*done < run->steps) {
         if (run->time_end >= 0 && s->t >= run->time_end * (1 - 1e-14))
             break;
@@ -758,7 +762,9 @@ core_status dsmc_run(dsmc_scene *s, const dsmc_run_def *run, long *done, core_er
         cnt[3] += ct.collisions;
         cnt[4] += ct.raised;
         cnt[5] += ct.overpacked;
+        threads_tune_step();
     }
+    threads_tune_end();
     /* between runs the arrays are in cell then identity order, for everything that reads them
      * (unless a step stopped between its flight and its sort: non-finite, or out of memory) */
     if (sorted)
