@@ -18,17 +18,17 @@
 --   mpm  : the shear of bench/mpm_shear.lua (369 grains, ~74,000 points, frictional contact),
 --          `mpm_warm` warm cycles.
 --   dsmc : `dsmc_n` disks (default 10^6) of the cooling benchmark (bench/dsmc_cooling.lua).
--- Every measurement runs for about `seconds` s of wall time (default 2), in `rounds` rounds
--- (default 3) of the three modes with their order rotated, each mode a fresh start: the auto
+-- Every measurement runs for about `seconds` s of wall time (default 5), in `rounds` rounds
+-- (default 2) of the three modes with their order rotated, each mode a fresh start: the auto
 -- mode's first probe comes after 0.1 s, so its figure includes what it costs to find the faster
 -- count every `seconds` s (a long run pays that once).
---   grainlab scripts/bench/contended.lua [engines=dem,mpm,dsmc] [seconds=2] [rounds=3] [busy=1]
+--   grainlab scripts/bench/contended.lua [engines=dem,mpm,dsmc] [seconds=5] [rounds=2] [busy=1]
 -- Metrics: <engine>_<quiet|contended>_<one|all|auto>_per_s (particle-steps per second), the
 -- ratios auto / one thread (contended: never below ~1 is the target) and auto / all (quiet: ~1),
 -- the tuner's probes and steps on one thread.
-local seconds = params.seconds or 2
+local seconds = params.seconds or 5
 local busy = math.tointeger(params.busy or 1)
-local rounds = math.tointeger(params.rounds or 3)
+local rounds = math.tointeger(params.rounds or 2)
 local engines = {}
 for e in tostring(params.engines or "dem,mpm,dsmc"):gmatch("[^,]+") do engines[#engines + 1] = e end
 local P = select(1, grainlab.threads("auto"))

@@ -27,9 +27,10 @@ int threads_available(void) { return 1; }
 #define MAX_EVERY_S 8.0   /* the longest interval between probes */
 #define SLOWER 1.5        /* a window this much slower than the best: probe now */
 #define MARGIN 0.9        /* the probe must be this much faster to become the choice */
-#define WAITED                                                                                     \
-    0.05 /* run-queue waiting, as a fraction of the threads' time, that shows                      \
-          * another process competing for our cores */
+/* Run-queue waiting, as a fraction of the threads' time in a window, that shows another
+ * process competing for our cores (a quiet machine: up to ~5 %; one busy process on one of two
+ * cores: 20-50 %). */
+#define WAITED 0.10
 
 static struct {
     int ready, fixed;

@@ -26,7 +26,7 @@ int threads_available(void);
  * thread waits (spinning, so the scheduler sees both cores busy and never moves the other
  * process away) for the thread that shares its core. The engines' run loops time their steps in
  * windows of about 0.1 s. On all threads, when our threads waited on a run queue for more than
- * 5 % of their time in a window (Linux's per-thread schedstat: another process competes for the
+ * 10 % of their time in a window (Linux's per-thread schedstat: another process competes for the
  * cores), one window runs on one thread; on one thread, a window runs on all now and then. The
  * faster count is kept, and probed again after an interval that doubles (1 s to 8 s; the first
  * probe 0.1 s into the first tuned run) while the choice holds, or at once when a window is 1.5
