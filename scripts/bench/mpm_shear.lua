@@ -11,11 +11,11 @@
 --       [save=prep.ckpt | load=prep.ckpt]   (save the prepared scene / start from it, no packing)
 --   valgrind --tool=callgrind --instr-atstart=no grainlab scripts/bench/mpm_shear.lua \
 --       cycles=20 warm=20 threads=1 callgrind=true   (instructions per point-step)
--- With callgrind=true the timed cycles alone are collected (callgrind_control -i on/off), dumped
--- (callgrind_control -d) and the bench prints instructions_per_point_step from the dump. On a
--- machine where someone else runs callgrind_control, that reaches every callgrind process of the
--- user: then run `valgrind --tool=callgrind --vgdb=no ... load=prep.ckpt` and divide mpm_run's
--- inclusive count (callgrind_annotate --inclusive=yes) by points x cycles.
+-- With callgrind=true the timed cycles alone are collected (callgrind_control -i on/off of this
+-- process), dumped (callgrind_control -d) and the bench prints instructions_per_point_step from
+-- the dump. Without vgdb (--vgdb=no) run with load=prep.ckpt and divide mpm_run's inclusive count
+-- (callgrind_annotate --inclusive=yes) by points x cycles; that is how docs/mpm.md's stage table
+-- was taken.
 -- Metrics: particle_steps_per_s (per thread count), wall_s, projected_full_run_s (25,124 cycles at
 -- the measured rate of the last thread count), points, grains; stage_<name>_ns (wall ns per
 -- point-step of each stage of the last thread count's run, from m:timings()), also printed as a
@@ -71,7 +71,7 @@ end
 local stages
 local function timed(threads)
   grainlab.threads(threads)
-  if callgrind then os.execute("callgrind_control -z >/dev/null; callgrind_control -i on >/dev/null") end
+  if callgrind then os.execute("callgrind_control -z $PPID >/dev/null; callgrind_control -i on $PPID >/dev/null") end
   local s0 = m:timings()
   local w0 = grainlab.clock()
   m:run{ steps = cycles, dt = dt, progress = false }
@@ -79,7 +79,7 @@ local function timed(threads)
   local s1 = m:timings()
   stages = {}
   for k, x in pairs(s1) do stages[k] = x - s0[k] end
-  if callgrind then os.execute("callgrind_control -i off >/dev/null; callgrind_control -d >/dev/null") end
+  if callgrind then os.execute("callgrind_control -i off $PPID >/dev/null; callgrind_control -d $PPID >/dev/null") end
   return np * cycles / wall, wall
 end
 
