@@ -1002,7 +1002,8 @@ void bind_open_mpm(lua_State *L)
          "contact, mu (0 for noslip), shape, normals, separation, strain_cap, conserve."},
         {"timings", l_timings, "m:timings()",
          "Wall seconds spent in each stage of the step, summed over the steps run since the "
-         "scene was created or loaded: stencil, p2g (particle to grid, with the grain fields), "
+         "scene was created or loaded: stencil (0 with friction: p2g takes it), p2g (particle to "
+         "grid, with the grain fields), "
          "normals (contact normals), grid (momentum update and walls), contact (the contact "
          "rule), g2p (grid to particle), remap (MUSL), material (stress update), check (the "
          "end-of-step checks); total, and steps. Read on thread 0 once per stage per step "

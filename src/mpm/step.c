@@ -172,10 +172,11 @@ static inline int bspline(double xi, double w[3], double d[3])
 /* Each point's nodes, weights N_i(x_p) and gradients G_pi (Eq. 8): linear tensor-product shape
  * functions (4 nodes) or quadratic B-splines (9). Points are inside the grid here (checked at the
  * end of every step). */
-STAGE static void stencil(mpm_scene *s, size_t pa, size_t pb)
+static inline __attribute__((always_inline)) void stencil_range(mpm_scene *s, size_t pa, size_t pb,
+                                                                const int ns)
 {
     const double ox = s->def.origin[0], oy = s->def.origin[1];
-    const int nx = s->def.cells[0], ny = s->def.cells[1], nnx = s->nnx, ns = s->ns;
+    const int nx = s->def.cells[0], ny = s->def.cells[1], nnx = s->nnx;
     const double ihx = s->inv_hx, ihy = s->inv_hy;
     for (size_t p = pa; p < pb; p++) {
         const double xi = (s->x[p] - ox) * ihx, eta = (s->y[p] - oy) * ihy;
@@ -225,6 +226,16 @@ STAGE static void stencil(mpm_scene *s, size_t pa, size_t pb)
         gy[2] = (1 - fx) * ihy;
         gy[3] = fx * ihy;
     }
+}
+
+/* The stencil of points [pa, pb) (noslip; with friction grain_scatter computes each point's
+ * stencil as it scatters it). */
+STAGE static void stencil(mpm_scene *s, size_t pa, size_t pb)
+{
+    if (s->ns == 4)
+        stencil_range(s, pa, pb, 4);
+    else
+        stencil_range(s, pa, pb, s->ns);
 }
 
 /* The nodes a prescribed grain's points touch take its velocity (nforce = 1 + its index). */
@@ -472,6 +483,7 @@ grain_scatter_with(mpm_scene *s, int t, const int ns, const bool volumes, const 
     for (size_t g = s->tg[t]; g < s->tg[t + 1]; g++) {
         const size_t p0 = s->gstart[g], p1 = p0 + s->gcount[g], q0 = q;
         for (size_t p = p0; p < p1; p++) {
+            stencil_range(s, p, p + 1, ns); /* in cache for the scatter below */
             const double m = xm[p], px = m * vx[p], py = m * vy[p];
             const double V = v0[p] * (F0[p] * F3[p] - F1[p] * F2[p]);
             const double sxx = V * s0[p], syy = V * s1[p], sxy = V * s2[p];
@@ -657,7 +669,10 @@ static void grain_fields(mpm_scene *s, int t, double *tlp)
     grain_scatter(s, t);
 #pragma omp barrier
 #pragma omp master
-    grain_pack(s);
+    {
+        mark_forced(s);
+        grain_pack(s);
+    }
 #pragma omp barrier
     grain_stencil(s, t);
     STAGE_DONE(T_P2G); /* no barrier: the normals need none, so this is thread 0's own time */
@@ -1173,16 +1188,17 @@ static core_status run_steps(mpm_scene *s, const mpm_run_def *run, long *done, c
         {
             const int t = THREAD_ID();
             double tl = t0;
-            stencil(s, s->tp[t], s->tp[t + 1]);
+            if (friction) {
+                grain_fields(s, t, &tl); /* the stencil and the centre-of-mass field too */
+            } else {
+                stencil(s, s->tp[t], s->tp[t + 1]);
 #pragma omp barrier
 #pragma omp master
-            mark_forced(s);
+                mark_forced(s);
 #pragma omp barrier
-            STAGE_DONE(T_STENCIL);
-            if (friction)
-                grain_fields(s, t, &tl); /* the centre-of-mass field too */
-            else
+                STAGE_DONE(T_STENCIL);
                 to_grid(s, t);
+            }
 #pragma omp barrier
 #pragma omp master
             if (s->nmx)
