@@ -11,6 +11,7 @@
 #include "core/clock.h"
 #include "core/interrupt.h"
 #include "core/threads.h"
+#include "mpm/material_inline.h"
 #include "mpm/mpm_internal.h"
 
 #ifdef GRAINLAB_HAVE_OPENMP
@@ -1074,7 +1075,7 @@ static inline __attribute__((always_inline)) size_t constitutive_with(mpm_scene 
         F3[p] = G3;
         const double J = G0 * G3 - G1 * G2;
         double be[4] = {b0[p], b1[p], b2[p], b3[p]}, sig[4];
-        if (!mpm_material_update(&mats[mat[p]], f, be, &eps_p[p], J, sig)) {
+        if (!material_update(&mats[mat[p]], f, be, &eps_p[p], J, sig)) {
             if (bad == (size_t)-1)
                 bad = p;
             continue;
