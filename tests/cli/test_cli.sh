@@ -106,11 +106,17 @@ expect_rc 0 mpm-overlap; has "$out" "added	2" mpm-overlap
 has "$err" "grainlab: warning: add_disk: grain 2 overlaps grain 1 by 0.1 m" mpm-overlap
 
 # --- Ctrl-C (SIGINT) stops a running script with an error naming it ---
-"$G" -e 'while true do end' </dev/null >"$tmp/out" 2>"$tmp/err" &
-pid=$!
-sleep 0.5
-kill -INT "$pid"
-wait "$pid"; rc=$?; out=$(cat "$tmp/out"); err=$(cat "$tmp/err")
+# The signals are sent once the script says it runs: a background job of this non-interactive
+# shell starts with SIGINT ignored until grainlab's handler is in place, so a signal sent at a
+# fixed delay was lost whenever a loaded machine made the start-up slower than the delay.
+start_long() {
+  "$@" >"$tmp/out" 2>"$tmp/err" &
+  pid=$!
+  for _ in $(seq 200); do grep -q running "$tmp/err" 2>/dev/null && break; sleep 0.05; done
+}
+finish_long() { wait "$pid"; rc=$?; out=$(cat "$tmp/out"); err=$(cat "$tmp/err"); }
+start_long "$G" -e 'io.stderr:write("running\n") while true do end' </dev/null
+kill -INT "$pid"; finish_long
 expect_rc 1 sigint; has "$err" "interrupted by Ctrl-C" sigint
 
 # --- progress of every engine's run, standard error redirected to a file ---
@@ -137,12 +143,6 @@ lines "$err" 3 progress-stopped
 
 # --- Ctrl-C during a run: the last progress line and the error say where it stopped ---
 # start_long ARGS...: runs long_run.lua in the background until it says "running"
-start_long() {
-  "$@" >"$tmp/out" 2>"$tmp/err" &
-  pid=$!
-  for _ in $(seq 200); do grep -q running "$tmp/err" 2>/dev/null && break; sleep 0.05; done
-}
-finish_long() { wait "$pid"; rc=$?; out=$(cat "$tmp/out"); err=$(cat "$tmp/err"); }
 start_long env GRAINLAB_PROGRESS_DELAY=0 "$G" long_run.lua </dev/null
 kill -INT "$pid"; finish_long
 expect_rc 1 run-sigint
