@@ -21,24 +21,31 @@
 --    packings, seeds seed, seed + 1, ...
 --  * A run: the checkpoint is loaded, the floor replaced by one that moves vertically, its
 --    height A (1 - cos omega t), A = Gamma g / omega^2, omega = 2 pi f (at rest at t = 0, so the
---    start is smooth; the table of its velocity is sampled by the step itself). Once per cycle,
---    with the floor at its lowest, the intruder's height above the floor (normalised by the bed
---    height h at rest) and the rank count: the small grains whose centre is above the
---    intruder's. The intruder has reached the top when that count is at most the number of
---    grains in a layer of one intruder radius, N r_b / h; the rise time is the first cycle it
---    is, in cycles. A run that has not risen by `t_max` cycles is reported as not risen.
---  * Law: Hertz, Brilliantov damping (restitution 0.5 at 1 m/s), Cundall-Strack spring, E = 1e6
---    Pa (soft: a long step; the overlaps stay a few % of a radius), dt = the stability limit at
---    2 m/s.
+--    start is smooth; the table of its velocity is sampled by the step itself; the new floor sits
+--    below the old one by the deepest overlap, ~1 % of a small radius, as a wall may not be
+--    added into a grain). Once per cycle, with the floor at its lowest, the intruder's height
+--    above the floor (its bottom, normalised by the bed height h at rest) and the rank count: the
+--    small grains whose centre is above the intruder's (a rank does not change when the bed
+--    dilates or flies). The intruder has reached the top when that count is at most the number
+--    of grains in a layer one intruder diameter thick, N 2 r_b / h (its centre within one
+--    diameter of the surface: a stricter N r_b / h is seldom met, the intruder near the top is
+--    carried about by the rolls); the rise time is the first cycle it is, in cycles, and the run
+--    stops there. A run that has not risen by `t_max` cycles is reported as not risen.
+--  * Law: Hertz, Brilliantov damping (restitution 0.5 at 1 m/s), Cundall-Strack spring, E = 1e7
+--    Pa, dt = the stability limit at 2 m/s. Not softer: the bed is a spring under its own
+--    weight; at E = 1e6 it sinks by ~1 mm, which puts its bounce (sqrt(g / x) / 2 pi ~ 16 Hz)
+--    at the drive's 20 Hz, and surface grains left at 9 A omega (and the domain); at 1e7 they
+--    stay below 3 A omega and the overlaps below a few % of a radius.
 -- Checks: every packing rises for Gamma >= `rise_from`; none rises for Gamma < 1; the median rise
 -- time at the largest Gamma is below that at the smallest rising Gamma, and the least-squares
--- slope of log(rise time) against Gamma over the rising Gammas is negative; the largest pair
--- overlap sampled stays below 10 % of the smaller radius and no grain moves faster than 10 A
--- omega.
+-- slope of log(rise time) against Gamma over the rising Gammas is negative; the largest contact
+-- overlap sampled (every 10 cycles, walls included) stays below 10 % of the smaller radius, and
+-- no grain moves faster than 5 A omega (sampled once per cycle).
 -- Output: a report, a CSV (param csv: one row per run and cycle), and figures (images/ for the
--- default run): the intruder's height against cycles for every Gamma (packing 1), and the
--- rise time against Gamma for every packing with the median; a snapshot of packing 1 at the
--- largest Gamma when its intruder reached the top.
+-- default run): the intruder's height against cycles for every Gamma (packing 1, each trace
+-- ending where it reached the top), the rise time against Gamma for every packing with the
+-- median, and a snapshot of packing 1 at the largest Gamma when its intruder reached the top,
+-- the small grains shaded by their starting layer.
 --
 --   grainlab scripts/brazil_nut.lua [gammas=0.8,2,2.5,3,4,5] [packings=3] [seed=1]
 --       [frequency=20] [ratio=4] [width=24] [depth=4] [t_max=200] [rise_from=2]
