@@ -73,11 +73,11 @@ end
 local callgrind = params.callgrind == true
 local function timed(threads)
   grainlab.threads(threads)
-  if callgrind then os.execute("callgrind_control -i on >/dev/null") end
+  if callgrind then os.execute("callgrind_control -i on $PPID >/dev/null") end
   local c0, w0 = grainlab.cpu_clock(), grainlab.clock()
   s:run{ steps = steps, dt = dt, progress = false }
   local wall = grainlab.clock() - w0
-  if callgrind then os.execute("callgrind_control -i off >/dev/null") end
+  if callgrind then os.execute("callgrind_control -i off $PPID >/dev/null") end
   return n * steps / wall, wall, grainlab.cpu_clock() - c0
 end
 
