@@ -30,7 +30,8 @@
 --    of grains in a layer one intruder diameter thick, N 2 r_b / h (its centre within one
 --    diameter of the surface: a stricter N r_b / h is seldom met, the intruder near the top is
 --    carried about by the rolls); the rise time is the first cycle it is, in cycles, and the run
---    stops there. A run that has not risen by `t_max` cycles is reported as not risen.
+--    stops there. A run that has not risen by `t_max` cycles is reported as not risen (and a
+--    Gamma where one did has no median: the median is over every packing).
 --  * Law: Hertz, Brilliantov damping (restitution 0.5 at 1 m/s), Cundall-Strack spring, E = 1e7
 --    Pa, dt = the stability limit at 2 m/s. Not softer: the bed is a spring under its own
 --    weight; at E = 1e6 it sinks by ~1 mm, which puts its bounce (sqrt(g / x) / 2 pi ~ 16 Hz)
