@@ -1,0 +1,68 @@
+#!/bin/sh
+# Before and after, side by side (issue 16): the three engines' benchmarks run by two grainlab
+# checkouts on the same machine, alternating (old new old new ...), each checkout with its own
+# bench scripts (the scenes are the same; a newer script may call what an older binary lacks).
+#   scripts/bench/before_after.sh OLD_CHECKOUT NEW_CHECKOUT [reps=2]
+# Each checkout must be built in its build/. Benches (their defaults but shorter runs), each on 1
+# and then 2 threads in one process:
+#   mpm  : bench/mpm_shear.lua cycles=200 warm=50 (74,079 points, 369 grains, friction)
+#   dem  : bench/dem_dense.lua steps=2000 (20,000 disks; the new checkout starts from the pile it
+#          exported once, pile=; the old one prepares the same state, bit for bit)
+#   dsmc : bench/dsmc_cooling.lua steps=30 (10^6 disks)
+# Prints one line per run (engine, threads, side, rate, load) and a Markdown table of medians
+# (particle- or point-steps per second).
+set -eu
+OLD=$1 NEW=$2
+shift 2
+REPS=2
+for a in "$@"; do
+  case $a in
+    reps=*) REPS=${a#reps=} ;;
+    *) echo "before_after.sh: unknown argument '$a' (reps=)" >&2; exit 2 ;;
+  esac
+done
+for d in "$OLD" "$NEW"; do
+  [ -x "$d/build/grainlab" ] || { echo "before_after.sh: no $d/build/grainlab" >&2; exit 2; }
+done
+PILE=$NEW/out/before_after_pile
+mkdir -p "$NEW/out"
+if [ ! -f "$PILE.ckpt" ]; then
+  (cd "$NEW" && build/grainlab scripts/bench/dem_dense.lua n=20000 export="$PILE" >/dev/null 2>&1)
+fi
+LOG=$(mktemp)
+# run <checkout> <side> <engine>: the bench on 1 and 2 threads in one process (one preparation);
+# logs "engine threads side rate load"
+run() {
+  case $3 in
+    mpm) args="scripts/bench/mpm_shear.lua cycles=200 warm=50" ;;
+    dem) args="scripts/bench/dem_dense.lua steps=2000"
+         # the new side starts from the pile it exported (the old one prepares the same state)
+         [ "$2" = new ] && args="$args pile=$PILE.ckpt" ;;
+    dsmc) args="scripts/bench/dsmc_cooling.lua steps=30" ;;
+  esac
+  load=$(cut -d' ' -f1 /proc/loadavg)
+  (cd "$1" && build/grainlab $args 2>/dev/null) |
+    awk -v e="$3" -v s="$2" -v l="$load" '$1 ~ /^particle_steps_per_s_[0-9]+_threads$/ {
+      t = $1; sub(/^particle_steps_per_s_/, "", t); sub(/_threads$/, "", t); print e, t, s, $2, l }' |
+    tee -a "$LOG"
+}
+for e in mpm dem dsmc; do
+  r=1
+  while [ "$r" -le "$REPS" ]; do
+    run "$OLD" old $e
+    run "$NEW" new $e
+    r=$((r + 1))
+  done
+done
+echo
+echo "| engine | threads | before | after | after / before |"
+echo "|---|---:|---:|---:|---:|"
+med() { sort -g | awk '{ a[NR] = $1 } END { print a[int((NR + 1) / 2)] }'; }
+for e in mpm dem dsmc; do
+  for t in 1 2; do
+    o=$(awk -v e=$e -v t=$t '$1 == e && $2 == t && $3 == "old" { print $4 }' "$LOG" | med)
+    n=$(awk -v e=$e -v t=$t '$1 == e && $2 == t && $3 == "new" { print $4 }' "$LOG" | med)
+    echo "| $e | $t | $o | $n | $(awk -v o="$o" -v n="$n" 'BEGIN { printf "%.2f", n / o }') |"
+  done
+done
+rm -f "$LOG"
