@@ -81,18 +81,19 @@ do
     s:add_polyline{ points = { { -0.5, 0 }, { 0, 0 } } }
     return s
   end
-  local c = 0.02 / math.sqrt(2)
+  -- 1 mm from the end point at 0.5 m/s: contact from 2 ms for about t_c = pi sqrt(m/k) = 1 ms
+  local c = (r + 1e-3) / math.sqrt(2)
   local s = scene(c, c, -v / math.sqrt(2), -v / math.sqrt(2))
-  s:run{ time = 0.1, dt = 1e-6 }
+  s:run{ time = 0.005, dt = 1e-6 }
   local P = s:particles()
   -- the direction exactly reversed; the speed within the step's energy error (Verlet, O(dt^2))
   check.near(P.vy[1] / P.vx[1], 1, 1e-12, "end point: bounces straight back (direction)")
   check.near(math.sqrt(P.vx[1] ^ 2 + P.vy[1] ^ 2), v, 1e-5, "end point: elastic (speed)")
   check.gt(P.vx[1], 0, "end point: moving away")
   -- off-axis: the normal is (x - e)/|x - e| whenever the disk touches the end point e = (0, 0)
-  s = scene(0.03, 0.004, -v, 0)
+  s = scene(r + 2e-3, 0.004, -v, 0)
   local seen, worst = 0, 0
-  s:run{ time = 0.1, dt = 1e-6, every = 1, on_step = function(sc)
+  s:run{ time = 0.006, dt = 1e-6, every = 1, on_step = function(sc)
     local C = sc:measure("contacts")
     if C.count > 0 then
       local Q = sc:particles()
@@ -114,7 +115,7 @@ do
     s:contact{ normal = "linear", stiffness = 1e5, damping = "viscous" }
     s:add_disk{ pos = { x, r }, radius = r }
     local w = wall(s)
-    s:run{ time = 0.2 }
+    s:run{ time = 0.05 } -- 50 contact times: the bounce is damped to round-off (e = 0.5)
     return s, w
   end
   local poly = function(s) return s:add_polyline{ points = { { -0.1, 0 }, { 0, 0 }, { 0.1, 0 } } } end
@@ -133,7 +134,7 @@ do
   s:contact{ normal = "linear", stiffness = 1e5, damping = "viscous" }
   s:add_disk{ pos = { 0, r * math.sqrt(2) + 1e-4 }, radius = r }
   local w = s:add_polyline{ points = { { -0.1, 0.1 }, { 0, 0 }, { 0.1, 0.1 } } }
-  s:run{ time = 0.3 }
+  s:run{ time = 0.06 }
   local C = s:measure("contacts")
   check.eq(C.count, 2, "concave corner: two contacts")
   check.near(C.fn[1], m * g / math.sqrt(2), 1e-6, "concave corner: each face m g / sqrt 2")
@@ -147,9 +148,9 @@ do
     local s = dem.scene{ dim = 3, box = { { -0.2, -0.2, -0.1 }, { 0.2, 0.2, 0.2 } },
                          gravity = { 0, 0, -g } }
     s:contact{ normal = "linear", stiffness = 1e5, damping = "viscous" }
-    s:add_sphere{ pos = { x, y, 0.03 }, radius = r }
+    s:add_sphere{ pos = { x, y, r + 2e-3 }, radius = r } -- lands at 0.2 m/s after 20 ms
     local w = wall(s)
-    s:run{ time = 0.5, dt = 1e-5 }
+    s:run{ time = 0.08, dt = 2e-5 }
     return s, w
   end
   local a, b, c, d = { -0.1, -0.1, 0 }, { 0.1, -0.1, 0 }, { 0.1, 0.1, 0 }, { -0.1, 0.1, 0 }
@@ -178,7 +179,7 @@ do
     s:contact{ normal = "linear", stiffness = 1e5, damping = "viscous" }
     s:add_sphere{ pos = pos, radius = r }
     local w = s:add_cylinder(cyl)
-    s:run{ time = 0.5, dt = 1e-5 }
+    s:run{ time = 0.06, dt = 2e-5 }
     return s, w
   end
   local s, w = scene({ 0.03, 0, -(R - r) + 1e-4 }, { center = { 0, 0, 0 }, radius = R, axis = { 1, 0, 0 } })
@@ -195,7 +196,7 @@ do
   s:add_sphere{ pos = { R + 0.3 * r, 0, 0.05 + r + 1e-4 }, radius = r }
   s:add_cylinder{ center = { 0, 0, 0 }, radius = R, axis = { 0, 0, 1 }, inside = false, length = 0.1 }
   local seen, worst = 0, 0
-  s:run{ time = 0.02, dt = 1e-5, every = 1, on_step = function(sc)
+  s:run{ time = 0.012, dt = 2e-5, every = 1, on_step = function(sc)
     local C = sc:measure("contacts")
     if C.count > 0 then
       local Q = sc:particles()
@@ -228,7 +229,7 @@ for _, law in ipairs{ "none", "coulomb_regularized" } do
       k = k + 1
     end
   end
-  s:run{ time = 0.1 }
+  s:run{ time = 0.05 } -- the lowest row reaches the floor
   local f, t = s:wall_load(w)
   for _ = 1, 200 do -- until the wall is touched (undamped disks bounce)
     if f[1] ~= 0 and f[2] ~= 0 then break end
@@ -272,7 +273,7 @@ do
     for k = 0, 4999 do -- resting on the floor, sliding to and fro
       s:add_disk{ pos = { 0.001 + 0.0022 * k, 0.001 }, radius = 0.001, vel = { 0.01 * math.sin(k), 0 } }
     end
-    s:run{ steps = 20, dt = 5e-6 }
+    s:run{ steps = 10, dt = 5e-6 }
     local f, t = s:wall_load(w)
     local P = s:particles()
     local out = { string.format("%a %a %a %a", f[1], f[2], t, s:wall_force(w)) }
