@@ -18,7 +18,9 @@
 --  7. Newton's third law: disks in a rotating polygon, force (frictional: from the particles' total
 --     forces) and torque (frictionless: from the contact list) equal and opposite to round-off;
 --  8. 1 and 2 threads give the same bits for a wall with more than 4096 candidates (the kernel's
---     parallel loop), particles and wall load alike.
+--     parallel loop), particles and wall load alike;
+--  9. a turning flat wall (one segment, 2D; a two-triangle square, 3D): after t the contact
+--     normal is the first one turned by omega t (1e-12).
 local check = grainlab.check
 local g = 9.81
 
@@ -285,5 +287,33 @@ do
   grainlab.threads(1)
   check.lt(fy, 0, "5000 candidates: the wall is loaded")
   check.eq(a, b, "5000 candidates: 1 and 2 threads give the same bits")
+end
+-- 9. -------------------------------------------------------------------------------------------
+-- A turning flat wall is a one-segment polyline (2D) or a two-triangle square (3D) turning about a
+-- point on it: after t its normal is the first one turned by omega t, and a frictionless grain
+-- lying on it sees that normal (1e-12).
+do
+  local r, om = 0.01, 0.5
+  local s = dem.scene{ dim = 2, box = { { -0.2, -0.2 }, { 0.2, 0.2 } }, gravity = { 0, -g } }
+  s:contact{ normal = "linear", stiffness = 1e5, damping = "viscous" }
+  s:add_disk{ pos = { 0, r }, radius = r }
+  s:add_polyline{ points = { { -0.15, 0 }, { 0.15, 0 } }, center = { 0, 0 }, omega = om }
+  s:run{ time = 0.2 }
+  local th, C = om * s:info().time, s:measure("contacts")
+  check.eq(C.count, 1, "turning segment: the disk lies on it")
+  check.near_abs(C.nx[1], -math.sin(th), 1e-12, "turning segment: normal x = -sin(omega t)")
+  check.near_abs(C.ny[1], math.cos(th), 1e-12, "turning segment: normal y = cos(omega t)")
+  check.lt(s:particles().x[1], -1e-3, "turning segment: the disk slides down the tilt")
+  local s3 = dem.scene{ dim = 3, box = { { -0.2, -0.2, -0.2 }, { 0.2, 0.2, 0.2 } }, gravity = { 0, 0, -g } }
+  s3:contact{ normal = "linear", stiffness = 1e5, damping = "viscous" }
+  s3:add_sphere{ pos = { 0.02, 0, r }, radius = r }
+  local a, b, c, d = { -0.15, -0.15, 0 }, { 0.15, -0.15, 0 }, { 0.15, 0.15, 0 }, { -0.15, 0.15, 0 }
+  s3:add_mesh{ triangles = { { a, b, c }, { a, c, d } }, center = { 0, 0, 0 }, omega = { om, 0, 0 } }
+  s3:run{ time = 0.2 }
+  th, C = om * s3:info().time, s3:measure("contacts")
+  check.eq(C.count, 1, "turning square: the sphere lies on it")
+  check.near_abs(C.nx[1], 0, 1e-12, "turning square: normal x = 0")
+  check.near_abs(C.ny[1], -math.sin(th), 1e-12, "turning square: normal y = -sin(omega t)")
+  check.near_abs(C.nz[1], math.cos(th), 1e-12, "turning square: normal z = cos(omega t)")
 end
 check.done()
