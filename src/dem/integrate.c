@@ -9,6 +9,7 @@
 
 #include "core/comm.h"
 #include "core/interrupt.h"
+#include "core/threads.h"
 #include "dem/dem_internal.h"
 
 dem_run_def dem_default_run_def(void)
@@ -673,13 +674,20 @@ static core_status run_steps(dem_scene *s, const dem_run_def *run, core_error *e
 
 core_status dem_run(dem_scene *s, const dem_run_def *run, core_error *err)
 {
-    if (comm_size() == 1)
-        return run_steps(s, run, err);
+    /* A DEM step gives the same bits on any thread count, so the tuner of a shared machine may
+     * choose it (core/threads.h) once the step runs threaded (the loops' n > 4096). */
+    threads_tune_begin(s, s->n > 4096);
+    if (comm_size() == 1) {
+        core_status st = run_steps(s, run, err);
+        threads_tune_end();
+        return st;
+    }
     comm_stats c0, c1; /* distributed: the time inside communication, for the stats */
     comm_get_stats(&c0);
     core_status st = run_steps(s, run, err);
     comm_get_stats(&c1);
     s->dstats.comm_s += c1.seconds - c0.seconds;
+    threads_tune_end();
     return st;
 }
 
@@ -786,6 +794,7 @@ static core_status run_steps(dem_scene *s, const dem_run_def *run, core_error *e
         }
         s->steps++;
         done += advance;
+        threads_tune_step();
         if (s->steps >= s->watch_next && (st = energy_watch(s, h, err)))
             return st;
         if (run->progress)

@@ -34,19 +34,35 @@ static int l_elapsed(lua_State *L)
 
 static int l_threads(lua_State *L)
 {
-    if (!lua_isnoneornil(L, 1)) {
+    if (lua_type(L, 1) == LUA_TSTRING && strcmp(lua_tostring(L, 1), "auto") == 0) {
+        threads_set_auto();
+    } else if (!lua_isnoneornil(L, 1)) {
         int isint;
         lua_Integer n = lua_tointegerx(L, 1, &isint);
         if (!isint || n < 1 || n > 4096) {
             char got[64];
             bind_describe(L, 1, got, sizeof got);
-            return luaL_error(L, "bad argument #1 to 'threads' (integer in [1, 4096] expected, got %s)",
+            return luaL_error(L,
+                              "bad argument #1 to 'threads' (integer in [1, 4096] or \"auto\" "
+                              "expected, got %s)",
                               got);
         }
         threads_set((int)n);
     }
     lua_pushinteger(L, threads_get());
-    return 1;
+    lua_pushstring(L, threads_auto() ? "auto" : "fixed");
+    threads_tune_stats st;
+    threads_tune_get_stats(&st);
+    lua_createtable(L, 0, 4);
+    lua_pushinteger(L, st.probes);
+    lua_setfield(L, -2, "probes");
+    lua_pushinteger(L, st.switches);
+    lua_setfield(L, -2, "switches");
+    lua_pushinteger(L, st.steps_one);
+    lua_setfield(L, -2, "steps_one_thread");
+    lua_pushinteger(L, st.steps_all);
+    lua_setfield(L, -2, "steps_all_threads");
+    return 3;
 }
 
 /* ---- random streams ---------------------------------------------------------------------- */
@@ -203,9 +219,14 @@ void bind_open_core(lua_State *L, int idx)
          "CPU seconds used by the process so far, all threads together."},
         {"elapsed", l_elapsed, "grainlab.elapsed()",
          "Wall-clock seconds since grainlab started (the report's wall_s)."},
-        {"threads", l_threads, "grainlab.threads([n])",
-         "Returns the number of worker threads the kernels use; with n, sets it first "
-         "(same as --threads N)."},
+        {"threads", l_threads, "grainlab.threads([n | \"auto\"])",
+         "Returns the number of worker threads the kernels use, the mode (\"auto\" or "
+         "\"fixed\") and the tuner's counts {probes, switches, steps_one_thread, "
+         "steps_all_threads}. With n, fixes the count first (same as --threads N); with "
+         "\"auto\" (the default unless OMP_NUM_THREADS is set), all processors, and a run "
+         "whose step gives the same bits on any count (DEM, DSMC, MPM with frictional "
+         "contact) times its steps and runs on one thread while another process makes that "
+         "faster (a busy core shared with a waiting thread)."},
         {"rng", l_rng_new, "grainlab.rng{ seed = 0, stream = 0 }",
          "A random stream (xoshiro256**, seeded through splitmix64) that gives the same numbers on "
          "every platform. Streams with the same seed and different `stream` numbers are "

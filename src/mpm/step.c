@@ -940,7 +940,21 @@ static size_t check_points(mpm_scene *s, int *why)
     return first;
 }
 
+static core_status run_steps(mpm_scene *s, const mpm_run_def *run, long *done, core_error *err);
+
 core_status mpm_run(mpm_scene *s, const mpm_run_def *run, long *done, core_error *err)
+{
+    /* With frictional contact a step gives the same bits on any thread count (every grain's
+     * nodal entries are built by one thread and packed in grain order), so the tuner of a shared
+     * machine may choose it (core/threads.h); noslip adds the threads' node buffers, whose
+     * summation order follows the count: it keeps all processors. */
+    threads_tune_begin(s, s->contact == MPM_CONTACT_FRICTION && s->np >= 8192);
+    core_status st = run_steps(s, run, done, err);
+    threads_tune_end();
+    return st;
+}
+
+static core_status run_steps(mpm_scene *s, const mpm_run_def *run, long *done, core_error *err)
 {
     *done = 0;
     if (run->steps < 0)
@@ -1033,6 +1047,8 @@ core_status mpm_run(mpm_scene *s, const mpm_run_def *run, long *done, core_error
         s->time += dt;
         s->steps++;
         ++*done;
+        if (threads_tune_step() && (st = threads_setup(s, err)))
+            return st;
     }
     return CORE_OK;
 }

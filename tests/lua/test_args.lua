@@ -28,7 +28,18 @@ check.errors(function() return grainlab.progress() end,
   "bad argument #1 to 'progress' (table expected, got no value)", "missing table")
 
 check.errors(function() return grainlab.threads(0) end,
-  "bad argument #1 to 'threads' (integer in [1, 4096] expected, got 0)", "threads 0")
+  "bad argument #1 to 'threads' (integer in [1, 4096] or \"auto\" expected, got 0)", "threads 0")
+check.errors(function() return grainlab.threads("fast") end,
+  "bad argument #1 to 'threads' (integer in [1, 4096] or \"auto\" expected, got 'fast')", "threads string")
+-- a fixed count, then auto mode (all processors between runs; the tuner's counts)
+local n, mode, st = grainlab.threads(1)
+check.eq(n, 1, "fixed count")
+check.eq(mode, "fixed", "fixed mode")
+check.eq(math.type(st.probes), "integer", "tuner probes")
+n, mode, st = grainlab.threads("auto")
+check.eq(mode, "auto", "auto mode")
+check.eq(n, select(1, grainlab.threads()), "auto: the count between runs")
+check.eq(st.steps_one_thread + st.steps_all_threads >= 0, true, "tuner step counts")
 
 -- Methods count arguments as the user sees them: self is not #1.
 local r = grainlab.rng{ seed = 1 }
