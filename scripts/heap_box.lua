@@ -262,7 +262,9 @@ end
 -- avalanche, then again from the last stable state (restored from a checkpoint: the same state,
 -- exactly) in steps of step / refine until the first avalanche (which may come past the coarse
 -- step's tilt: a jump of a whole coarse step can set off what smaller steps do not). Returns theta_m (deg), the surface's angle to the
--- horizontal after the failing hold, the tilt that failed, and the number of holds.
+-- horizontal after the failing hold, the tilt that failed, the number of holds, and true when the
+-- fine steps found no avalanche within two coarse steps past the coarse one (the pile crept: the
+-- coarse result is returned).
 -- on_hold(tilt, moved, slope) is called after each hold when given (moved: the grains that
 -- moved by more than a mean diameter).
 function heap_box:marginal(o)
@@ -290,27 +292,32 @@ function heap_box:marginal(o)
   local stable, theta = 0, start
   local stable_slope = prev
   self.s:save(ckpt)
-  local failed = false
+  local failed, coarse_after = false, nil
   while theta <= limit do
-    if gives_way(theta) then failed = true break end
+    local gave, slope = gives_way(theta)
+    if gave then failed, coarse_after = true, slope break end
     stable, stable_slope = theta, prev
     self.s:save(ckpt)
     theta = theta + step
   end
   if not failed then return 0 / 0, 0 / 0, theta, holds end
+  local coarse = { theta - stable_slope, theta - coarse_after, theta }
   -- fine: from the last stable state, on past the coarse failure if need be (a jump of the
-  -- whole coarse step can set off what smaller steps to the same tilt do not)
+  -- whole coarse step can set off what smaller steps to the same tilt do not), up to `span`
+  -- (two coarse steps) beyond it; a pile that only creeps under the small steps (strong rolling
+  -- resistance: each hold moves fewer than `fraction` of the grains a diameter) keeps the coarse
+  -- result, and the fifth value says so
   self.s = dem.load(ckpt)
   prev = stable_slope
   local fine = step / refine
-  local t = stable + fine
-  while t <= limit + 1e-9 do
+  local t, last = stable + fine, math.min(limit, theta + (o.span or 2 * step))
+  while t <= last + 1e-9 do
     local before = prev
     local gave, slope = gives_way(t)
-    if gave then return t - before, t - slope, t, holds end
+    if gave then return t - before, t - slope, t, holds, false end
     t = t + fine
   end
-  return 0 / 0, 0 / 0, t, holds
+  return coarse[1], coarse[2], coarse[3], holds, true
 end
 
 return heap_box

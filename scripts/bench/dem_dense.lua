@@ -20,6 +20,10 @@
 --                                        [collapse=0|0.5] [prep_threads=1] [verbose=1]
 --   valgrind --tool=callgrind --instr-atstart=no grainlab scripts/bench/dem_dense.lua \
 --       steps=200 threads=1 callgrind=true   (instructions per particle-step: total / (n steps))
+--   valgrind --tool=callgrind --instr-atstart=no grainlab scripts/bench/dem_dense.lua \
+--       pile=out/pile.data.ckpt steps=50 threads=1 callgrind=true
+--       the same on a pile prepared once by export= (below): preparing 20,000 disks under
+--       callgrind takes hours. The checkpoint keeps the pile's laws and spring histories.
 --   grainlab scripts/bench/dem_dense.lua n=2000 export=out/pile.data
 --       writes the prepared pile as a LAMMPS data file (atom type 1 = quartz, velocities included)
 --       and as a grainlab checkpoint PATH.ckpt (the same state with its walls: a settled pile
@@ -33,32 +37,48 @@ local W, H = 0.25, 0.30
 local dt = 1e-7
 local check_steps = 2000 -- drag-free steps at dt after settling that must leave the contacts alone
 
-local s = dem.scene{ dim = 2, box = {{0, 0}, {W, H}}, gravity = {0, -9.81} }
 local quartz = grainlab.material{ name = "quartz", density = 2650, young = 30e9, poisson = 0.3,
                                   friction = 0.45, restitution = 0.5 }
-s:add_wall{ point = {0, 0}, normal = {0, 1} }
-s:add_wall{ point = {0, 0}, normal = {1, 0} }
-s:add_wall{ point = {W, 0}, normal = {-1, 0} }
-s:add_wall{ point = {0, H}, normal = {0, -1} }
-local t0 = grainlab.clock()
-grainlab.pack.deposit(s, { n = n, seed = 1, material = quartz, relax_steps = 0 })
-s:contact{ normal = "hertz", damping = "brilliantov", restitution = 0.5, impact_velocity = 1,
-          tangential = "spring" }
-local T = s:damping_time(1, 2) -- each pair has its own T; this is the first pair's
-local t_deposit = grainlab.clock() - t0
+local s, T, t_prep, settle, z
+if params.pile then -- a pile prepared by export= (its checkpoint), timed as it is
+  s = dem.load(params.pile)
+  n = s:particles().count
+  T = s:damping_time(1, 2)
+  z = s:measure("coordination")
+  t_prep = 0
+  local p, v2, vmax = s:particles(), 0, 0
+  for i = 1, n do
+    local q = p.vx[i] ^ 2 + p.vy[i] ^ 2
+    v2, vmax = v2 + q, math.max(vmax, q)
+  end
+  settle = { steps = 0, dt = dt, drag = 0, v_rms = math.sqrt(v2 / n), v_max = math.sqrt(vmax),
+             z_settled = z.z }
+else
+  s = dem.scene{ dim = 2, box = {{0, 0}, {W, H}}, gravity = {0, -9.81} }
+  s:add_wall{ point = {0, 0}, normal = {0, 1} }
+  s:add_wall{ point = {0, 0}, normal = {1, 0} }
+  s:add_wall{ point = {W, 0}, normal = {-1, 0} }
+  s:add_wall{ point = {0, H}, normal = {0, -1} }
+  local t0 = grainlab.clock()
+  grainlab.pack.deposit(s, { n = n, seed = 1, material = quartz, relax_steps = 0 })
+  s:contact{ normal = "hertz", damping = "brilliantov", restitution = 0.5, impact_velocity = 1,
+            tangential = "spring" }
+  T = s:damping_time(1, 2) -- each pair has its own T; this is the first pair's
+  local t_deposit = grainlab.clock() - t0
 
-grainlab.threads(params.prep_threads or 1)
-local settle = grainlab.pack.settle(s, { quiet = quiet, collapse = collapse, final_steps = check_steps,
-                                         dt_final = dt, verbose = params.verbose and true or false })
-local z = s:measure("coordination")
-local t_prep = grainlab.clock() - t0
-io.stderr:write(string.format(
-  "prepared %d disks in %.1f s (deposit %.1f s, %d relaxation steps at dt %.3g s, drag %.4g /s): " ..
-  "v_rms %.2g m/s (v_max %.2g), z %.4f; after %d drag-free steps at dt %g: v_rms %.2g m/s, z %.4f\n",
-  n, t_prep, t_deposit, settle.steps - check_steps, settle.dt, settle.drag, settle.v_rms_settled,
-  settle.v_max_settled, settle.z_settled, check_steps, dt, settle.v_rms, z.z))
+  grainlab.threads(params.prep_threads or 1)
+  settle = grainlab.pack.settle(s, { quiet = quiet, collapse = collapse, final_steps = check_steps,
+                                     dt_final = dt, verbose = params.verbose and true or false })
+  z = s:measure("coordination")
+  t_prep = grainlab.clock() - t0
+  io.stderr:write(string.format(
+    "prepared %d disks in %.1f s (deposit %.1f s, %d relaxation steps at dt %.3g s, drag %.4g /s): " ..
+    "v_rms %.2g m/s (v_max %.2g), z %.4f; after %d drag-free steps at dt %g: v_rms %.2g m/s, z %.4f\n",
+    n, t_prep, t_deposit, settle.steps - check_steps, settle.dt, settle.drag, settle.v_rms_settled,
+    settle.v_max_settled, settle.z_settled, check_steps, dt, settle.v_rms, z.z))
+end
 
-if params.export then
+if params.export and not params.pile then
   s:write_lammps_data(params.export, { types = { [1] = quartz },
                                        title = string.format("dem_dense.lua n=%d, settled", n) })
   s:save(params.export .. ".ckpt")
@@ -73,11 +93,11 @@ end
 local callgrind = params.callgrind == true
 local function timed(threads)
   grainlab.threads(threads)
-  if callgrind then os.execute("callgrind_control -i on >/dev/null") end
+  if callgrind then os.execute("callgrind_control -i on $PPID >/dev/null") end
   local c0, w0 = grainlab.cpu_clock(), grainlab.clock()
   s:run{ steps = steps, dt = dt, progress = false }
   local wall = grainlab.clock() - w0
-  if callgrind then os.execute("callgrind_control -i off >/dev/null") end
+  if callgrind then os.execute("callgrind_control -i off $PPID >/dev/null") end
   return n * steps / wall, wall, grainlab.cpu_clock() - c0
 end
 

@@ -36,11 +36,11 @@ for _, th in ipairs(list) do
   local dt = 0.1 / s:measure("temperature").collision_frequency
   s:run{ steps = warm, dt = dt, progress = false }
   s:reset_stats()
-  if callgrind then os.execute("callgrind_control -i on >/dev/null") end
+  if callgrind then os.execute("callgrind_control -i on $PPID >/dev/null") end
   local w0 = grainlab.clock()
   s:run{ steps = steps, dt = dt, progress = false }
   local wall = grainlab.clock() - w0
-  if callgrind then os.execute("callgrind_control -i off >/dev/null") end
+  if callgrind then os.execute("callgrind_control -i off $PPID >/dev/null") end
   local st = s:measure("stats")
   metrics["particle_steps_per_s_" .. th .. "_threads"] = n * steps / wall
   metrics["wall_s_" .. th .. "_threads"] = wall

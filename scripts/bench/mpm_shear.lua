@@ -39,11 +39,11 @@ local t_prep = grainlab.clock() - t0
 
 local function timed(threads)
   grainlab.threads(threads)
-  if callgrind then os.execute("callgrind_control -i on >/dev/null") end
+  if callgrind then os.execute("callgrind_control -i on $PPID >/dev/null") end
   local w0 = grainlab.clock()
   m:run{ steps = cycles, dt = dt, progress = false }
   local wall = grainlab.clock() - w0
-  if callgrind then os.execute("callgrind_control -i off >/dev/null") end
+  if callgrind then os.execute("callgrind_control -i off $PPID >/dev/null") end
   return np * cycles / wall, wall
 end
 

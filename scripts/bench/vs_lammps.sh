@@ -177,7 +177,7 @@ load() { uptime | sed 's/.*load average: //; s/,.*//'; }
 # of the machine's CPU time: on a virtual machine a quiet load average can hide a host that runs
 # this guest's 2 cores at half speed, and then the 2-core figures mean little.
 cpustat() { awk '/^cpu / { print $2 + $3 + $4 + $5 + $6 + $7 + $8 + $9, $9 }' /proc/stat; }
-steal() { echo "$1 $2" | awk '{ d = $3 - $1; printf "%.0f", d > 0 ? 100 * ($4 - $2) / d : 0 }'; }
+steal() { echo "$1 $2" | awk '{ d = $3 - $1; printf "%.0f", (d > 0 ? 100 * ($4 - $2) / d : 0) }'; }
 run_gl() { OMP_NUM_THREADS=$1 "$GL" "$OUT/grainlab_side.lua" mode=time threads="$1" steps="$STEPS" data="$DATA" | awk '/^RATE/'; }
 run_lmp() {
   if [ "$1" = 1 ]; then "$LMP" -in "$OUT/in.time" -log "$OUT/log.time" -screen none

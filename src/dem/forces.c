@@ -81,6 +81,12 @@ static inline double regularized(const dem_contact_def *c, const dem_power *pw, 
 
 #include "dem/rolling.inc"
 
+#if defined(__GNUC__) && !defined(__clang__)
+#define GATHER_NO_VECTORIZE __attribute__((optimize("no-tree-vectorize")))
+#else
+#define GATHER_NO_VECTORIZE
+#endif
+
 #define DIM 2
 #include "dem/forces_dim.inc"
 #undef DIM

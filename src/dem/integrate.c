@@ -378,38 +378,66 @@ static void advance_angles(dem_scene *s, double dt)
         a[i] += dt * w[i];
 }
 
-/* The fused 2D pass: kick, drift, domain flag, displacement since the build (of owned particles
- * only when gh, the ghost flags, is given: a constant where this is inlined). */
-static inline __attribute__((always_inline)) double
-kick_drift_2d(dem_scene *s, double h, double dt, const unsigned char *restrict gh)
+/* The fused 2D pass: kick, drift, the extent of the positions, the displacement since the build
+ * (of owned particles only when GHOSTED), and with ROT the spin's kick and the angle's advance.
+ * GHOSTED and ROT are literals in each expansion, so that each parallel loop (outlined before
+ * any inlining) has no per-particle tests and vectorises. Every operation is per particle, so
+ * the vector code (omp simd) gives the bits of the scalar one; the max, the min and the extent
+ * do not depend on the order either. The extent is compared with the box after the loop (a NaN
+ * is ignored there as it was by the per-particle comparisons; kick_check's test catches it). */
+/* clang-format off: _Pragma takes one string literal */
+#define KICK_DRIFT_2D_LOOP(GHOSTED, ROT)                                                           \
+    do {                                                                                           \
+    _Pragma("omp parallel for simd schedule(static) reduction(min : x0, y0) reduction(max : m, x1, y1) if (n > 4096)") \
+    for (long i = 0; i < n; i++) {                                                                 \
+        vx[i] += h * fx[i] * im[i];                                                                \
+        vy[i] += h * fy[i] * im[i];                                                                \
+        x[i] += dt * vx[i];                                                                        \
+        y[i] += dt * vy[i];                                                                        \
+        x0 = x[i] < x0 ? x[i] : x0;                                                                \
+        x1 = x[i] > x1 ? x[i] : x1;                                                                \
+        y0 = y[i] < y0 ? y[i] : y0;                                                                \
+        y1 = y[i] > y1 ? y[i] : y1;                                                                \
+        double ex = x[i] - xb[i], ey = y[i] - yb[i], d2 = ex * ex + ey * ey;                       \
+        if (GHOSTED)                                                                               \
+            d2 = gh[i] ? 0 : d2;                                                                   \
+        m = d2 > m ? d2 : m;                                                                       \
+        if (ROT) {                                                                                 \
+            w[i] += h * tq[i] * ii[i];                                                             \
+            a[i] += dt * w[i];                                                                     \
+        }                                                                                          \
+    }                                                                                              \
+    } while (0)
+/* clang-format on */
+
+static double kick_drift_2d(dem_scene *s, double h, double dt, int rot)
 {
     const long n = (long)s->n;
     const double *restrict im = s->inv_m;
-    int out = 0;
     double *restrict x = s->x[0], *restrict y = s->x[1];
     double *restrict vx = s->v[0], *restrict vy = s->v[1];
     const double *restrict fx = s->f[0], *restrict fy = s->f[1];
     const double *restrict xb = s->x_build[0], *restrict yb = s->x_build[1];
+    const unsigned char *restrict gh = s->ghost;
+    double *restrict w = rot ? s->w[2] : NULL, *restrict a = rot ? s->angle : NULL;
+    const double *restrict tq = rot ? s->tq[2] : NULL, *restrict ii = rot ? s->inv_inertia : NULL;
     const double xlo = s->periodic[0] ? -DBL_MAX : s->lo[0];
     const double xhi = s->periodic[0] ? DBL_MAX : s->hi[0];
     const double ylo = s->periodic[1] ? -DBL_MAX : s->lo[1];
     const double yhi = s->periodic[1] ? DBL_MAX : s->hi[1];
-    double m = 0;
-#pragma omp parallel for schedule(static) reduction(| : out) reduction(max : m) if (n > 4096)
-    for (long i = 0; i < n; i++) {
-        vx[i] += h * fx[i] * im[i];
-        vy[i] += h * fy[i] * im[i];
-        x[i] += dt * vx[i];
-        y[i] += dt * vy[i];
-        out |= (x[i] < xlo) | (x[i] > xhi) | (y[i] < ylo) | (y[i] > yhi);
-        double ex = x[i] - xb[i], ey = y[i] - yb[i], d2 = ex * ex + ey * ey;
-        if (gh && gh[i])
-            d2 = 0;
-        m = d2 > m ? d2 : m;
-    }
-    s->suspect |= out;
+    double m = 0, x0 = DBL_MAX, x1 = -DBL_MAX, y0 = DBL_MAX, y1 = -DBL_MAX;
+    if (gh && rot)
+        KICK_DRIFT_2D_LOOP(1, 1);
+    else if (gh)
+        KICK_DRIFT_2D_LOOP(1, 0);
+    else if (rot)
+        KICK_DRIFT_2D_LOOP(0, 1);
+    else
+        KICK_DRIFT_2D_LOOP(0, 0);
+    s->suspect |= (x0 < xlo) | (x1 > xhi) | (y0 < ylo) | (y1 > yhi);
     return m;
 }
+#undef KICK_DRIFT_2D_LOOP
 
 static double kick_drift(dem_scene *s, double h, double dt)
 {
@@ -417,7 +445,9 @@ static double kick_drift(dem_scene *s, double h, double dt)
     const double *restrict im = s->inv_m;
     int out = 0;
     if (s->dim == 2) {
-        double m = s->ghost ? kick_drift_2d(s, h, dt, s->ghost) : kick_drift_2d(s, h, dt, NULL);
+        if (s->rot && s->angle) /* 2D rotations come with their angle (dem_ensure_rotation) */
+            return kick_drift_2d(s, h, dt, 1);
+        double m = kick_drift_2d(s, h, dt, 0);
         if (s->rot) {
             kick_rotation(s, h);
             advance_angles(s, dt);
@@ -445,11 +475,50 @@ static double kick_drift(dem_scene *s, double h, double dt)
     return max_displacement2(s);
 }
 
+/* The 2D final kick in one vector pass (with ROT, a literal, the spin's too). 0 v is 0 for a
+ * finite v and NaN for an infinite or NaN one: the sum is 0 (of either sign, in any order)
+ * exactly when every velocity is finite. */
+/* clang-format off: _Pragma takes one string literal */
+#define KICK_CHECK_2D_LOOP(ROT)                                                                    \
+    do {                                                                                           \
+    _Pragma("omp parallel for simd schedule(static) reduction(+ : chk) if (n > 4096)")              \
+    for (long i = 0; i < n; i++) {                                                                 \
+        vx[i] += h * fx[i] * im[i];                                                                \
+        vy[i] += h * fy[i] * im[i];                                                                \
+        chk += vx[i] * 0.0 + vy[i] * 0.0;                                                          \
+        if (ROT)                                                                                   \
+            w[i] += h * tq[i] * ii[i];                                                             \
+    }                                                                                              \
+    } while (0)
+/* clang-format on */
+
+static int kick_check_2d(dem_scene *s, double h)
+{
+    const long n = (long)s->n;
+    const int rot = s->rot;
+    const double *restrict im = s->inv_m;
+    double *restrict vx = s->v[0], *restrict vy = s->v[1];
+    const double *restrict fx = s->f[0], *restrict fy = s->f[1];
+    double *restrict w = rot ? s->w[2] : NULL;
+    const double *restrict tq = rot ? s->tq[2] : NULL, *restrict ii = rot ? s->inv_inertia : NULL;
+    double chk = 0;
+    if (rot)
+        KICK_CHECK_2D_LOOP(1);
+    else
+        KICK_CHECK_2D_LOOP(0);
+    return !(chk == 0);
+}
+#undef KICK_CHECK_2D_LOOP
+
 static void kick_check(dem_scene *s, double h)
 {
     const long n = (long)s->n;
     const double *restrict im = s->inv_m;
     int bad = 0;
+    if (s->dim == 2) {
+        s->suspect |= kick_check_2d(s, h);
+        return;
+    }
     for (int d = 0; d < s->dim; d++) {
         double *restrict v = s->v[d];
         const double *restrict f = s->f[d];

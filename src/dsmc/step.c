@@ -380,7 +380,7 @@ static __attribute__((noinline)) long walls_one(const dsmc_scene *s, const fligh
 
 /* The flight loop for a dimension D, walls W (some axis below D not periodic) and gravity G
  * (some component not zero) known at compile time: a periodic box without gravity, the common
- * gas, pays nothing for the walls and gravity it does not have (14 of its 149 instructions per
+ * gas, pays nothing for the walls and gravity it does not have (9 of its 149 instructions per
  * particle before; a zero gravity added +0.0, which only turns a -0.0 into +0.0). */
 static inline __attribute__((always_inline)) flight_totals
 flight_dim(dsmc_scene *s, const flight_consts *fc, size_t bcount[DSMC_SORT_BLOCKS], const int D,
