@@ -8,10 +8,18 @@
 -- Then `cycles` cycles (default 400) are timed on 1 and 2 threads (or on `threads` only), each
 -- continuing the same run.
 --   grainlab scripts/bench/mpm_shear.lua [cycles=400] [warm=200] [threads=N] [model=friction|noslip]
+--       [save=prep.ckpt | load=prep.ckpt]   (save the prepared scene / start from it, no packing)
 --   valgrind --tool=callgrind --instr-atstart=no grainlab scripts/bench/mpm_shear.lua \
---       cycles=20 warm=20 threads=1 callgrind=true   (instructions per particle-step)
+--       cycles=20 warm=20 threads=1 callgrind=true   (instructions per point-step)
+-- With callgrind=true the timed cycles alone are collected (callgrind_control -i on/off of this
+-- process), dumped (callgrind_control -d) and the bench prints instructions_per_point_step from
+-- the dump. Without vgdb (--vgdb=no) run with load=prep.ckpt and divide mpm_run's inclusive count
+-- (callgrind_annotate --inclusive=yes) by points x cycles; that is how docs/mpm.md's stage table
+-- was taken.
 -- Metrics: particle_steps_per_s (per thread count), wall_s, projected_full_run_s (25,124 cycles at
--- the measured rate of the last thread count), points, grains.
+-- the measured rate of the last thread count), points, grains; stage_<name>_ns (wall ns per
+-- point-step of each stage of the last thread count's run, from m:timings()), also printed as a
+-- table with each stage's share.
 local cycles = math.tointeger(params.cycles or 400)
 local warm = math.tointeger(params.warm or 200)
 local model = params.model or "friction"
@@ -21,33 +29,61 @@ local full_cycles = 25124
 local dt = 0.8 * L / v / full_cycles
 
 local t0 = grainlab.clock()
-local pk = grainlab.pack.slab{ size = L, n = 369, diameter = { 31e-6, 57e-6, 250e-6 }, seed = 5 }
-local hmx = mpm.material{ model = "vonmises", density = 1900, shear = 7.5e9, bulk = 11.4e9, yield = 0.3e9,
-                          hardening = 0.01e9 }
-local m = mpm.scene{ cells = { cells, cells }, size = { L, L }, periodic = { false, true },
-                     walls = { left = "noslip", right = { kind = "noslip", velocity = { 0, v } } } }
-local h = L / cells
-for i = 1, #pk.x do
-  local g = m:add_disk{ center = { pk.x[i], pk.y[i] }, radius = pk.r[i], material = hmx, points_per_cell = 2, clip = true }
-  if pk.x[i] - pk.r[i] < h then m:prescribe(g, { 0, 0 }) elseif pk.x[i] + pk.r[i] > L - h then m:prescribe(g, { 0, v }) end
+local m, ngrains, area_fraction
+if params.load then
+  -- A prepared scene saved by save= (checkpoints continue bit for bit): skips the packing, which
+  -- dominates a callgrind run.
+  m = mpm.load(params.load)
+  ngrains, area_fraction = m:info().grains, nil
+else
+  local pk = grainlab.pack.slab{ size = L, n = 369, diameter = { 31e-6, 57e-6, 250e-6 }, seed = 5 }
+  local hmx = mpm.material{ model = "vonmises", density = 1900, shear = 7.5e9, bulk = 11.4e9, yield = 0.3e9,
+                            hardening = 0.01e9 }
+  m = mpm.scene{ cells = { cells, cells }, size = { L, L }, periodic = { false, true },
+                 walls = { left = "noslip", right = { kind = "noslip", velocity = { 0, v } } } }
+  local h = L / cells
+  for i = 1, #pk.x do
+    local g = m:add_disk{ center = { pk.x[i], pk.y[i] }, radius = pk.r[i], material = hmx, points_per_cell = 2, clip = true }
+    if pk.x[i] - pk.r[i] < h then m:prescribe(g, { 0, 0 }) elseif pk.x[i] + pk.r[i] > L - h then m:prescribe(g, { 0, v }) end
+  end
+  if model == "friction" then m:contact{ model = "friction", mu = 0.3, normals = params.normals } end
+  grainlab.threads(params.prep_threads or 1)
+  m:run{ steps = warm, dt = dt, progress = false }
+  ngrains, area_fraction = #pk.x, pk.area_fraction
+  if params.save then m:save(params.save) end
 end
-if model == "friction" then m:contact{ model = "friction", mu = 0.3, normals = params.normals } end
 local np = m:info().points
-grainlab.threads(params.prep_threads or 1)
-m:run{ steps = warm, dt = dt, progress = false }
 local t_prep = grainlab.clock() - t0
 
+-- Instructions collected in the newest callgrind dump of this directory, or nil.
+local function dumped_instructions()
+  local f = io.popen("ls -t callgrind.out.* 2>/dev/null | head -n 1")
+  local name = f and f:read("l")
+  if f then f:close() end
+  if not name then return nil end
+  f = io.popen("callgrind_annotate '" .. name .. "' 2>/dev/null")
+  local out = f and f:read("a") or ""
+  if f then f:close() end
+  local n = out:match("([%d,]+)%s+%(?[%d.%%]*%)?%s*PROGRAM TOTALS")
+  return n and tonumber((n:gsub(",", ""))) or nil
+end
+
+local stages
 local function timed(threads)
   grainlab.threads(threads)
-  if callgrind then os.execute("callgrind_control -i on $PPID >/dev/null") end
+  if callgrind then os.execute("callgrind_control -z $PPID >/dev/null; callgrind_control -i on $PPID >/dev/null") end
+  local s0 = m:timings()
   local w0 = grainlab.clock()
   m:run{ steps = cycles, dt = dt, progress = false }
   local wall = grainlab.clock() - w0
-  if callgrind then os.execute("callgrind_control -i off $PPID >/dev/null") end
+  local s1 = m:timings()
+  stages = {}
+  for k, x in pairs(s1) do stages[k] = x - s0[k] end
+  if callgrind then os.execute("callgrind_control -i off $PPID >/dev/null; callgrind_control -d $PPID >/dev/null") end
   return np * cycles / wall, wall
 end
 
-local metrics = { points = np, grains = #pk.x, area_fraction = pk.area_fraction, dt_s = dt, cycles = cycles,
+local metrics = { points = np, grains = ngrains, area_fraction = area_fraction, dt_s = dt, cycles = cycles,
                   warm_cycles = warm, prepare_s = t_prep }
 local list = params.threads and { params.threads } or { 1, 2 }
 local total = 0
@@ -64,6 +100,21 @@ metrics.projected_full_run_s = metrics["projected_full_run_s_" .. last .. "_thre
 metrics.wall_s = total
 -- The 5-minute target is reported beside the projection, not checked: timing depends on the load.
 metrics.projected_full_run_target_s = 300
+local names = { "stencil", "p2g", "normals", "grid", "contact", "g2p", "remap", "material", "check" }
+print(string.format("stages (%d thread(s), %d cycles): wall ns per point-step, share", last, cycles))
+for _, k in ipairs(names) do
+  local ns = stages[k] / (np * cycles) * 1e9
+  metrics["stage_" .. k .. "_ns"] = ns
+  print(string.format("  %-9s %8.1f  %5.1f %%", k, ns, 100 * stages[k] / stages.total))
+end
+if callgrind then
+  local n = dumped_instructions()
+  if n then
+    metrics.instructions_per_point_step = n / (np * cycles)
+  else
+    print("callgrind=true: no callgrind.out.* dump found here (run under valgrind --tool=callgrind)")
+  end
+end
 
 local e = m:measure("energy")
 grainlab.report{

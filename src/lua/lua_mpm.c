@@ -864,6 +864,23 @@ static int l_info(lua_State *L)
     return 1;
 }
 
+static int l_timings(lua_State *L)
+{
+    mpm_scene *s = check_scene(L, 1);
+    double sec[MPM_NSTAGES], total = 0;
+    long steps;
+    mpm_timings(s, sec, &steps);
+    lua_createtable(L, 0, MPM_NSTAGES + 2);
+    for (int k = 0; k < MPM_NSTAGES; k++) {
+        set_number(L, mpm_stage_names[k], sec[k]);
+        total += sec[k];
+    }
+    set_number(L, "total", total);
+    lua_pushinteger(L, steps);
+    lua_setfield(L, -2, "steps");
+    return 1;
+}
+
 static int l_gc(lua_State *L)
 {
     lscene *u = luaL_checkudata(L, 1, SCENE);
@@ -983,6 +1000,14 @@ void bind_open_mpm(lua_State *L)
         {"info", l_info, "m:info()",
          "cells, size, origin, cell_size, gravity, points, grains, time, steps, update, pic, "
          "contact, mu (0 for noslip), shape, normals, separation, strain_cap, conserve."},
+        {"timings", l_timings, "m:timings()",
+         "Wall seconds spent in each stage of the step, summed over the steps run since the "
+         "scene was created or loaded: stencil (0 with friction: p2g takes it), p2g (particle to "
+         "grid, with the grain fields), "
+         "normals (contact normals), grid (momentum update and walls), contact (the contact "
+         "rule), g2p (grid to particle), remap (MUSL), material (stress update), check (the "
+         "end-of-step checks); total, and steps. Read on thread 0 once per stage per step "
+         "(scripts/bench/mpm_shear.lua prints them)."},
         {NULL, NULL, NULL, NULL}};
     static const luaL_Reg meta[] = {
         {"__gc", l_gc}, {"__close", l_gc}, {"__tostring", l_tostring}, {NULL, NULL}};

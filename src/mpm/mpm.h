@@ -273,6 +273,16 @@ core_status mpm_run(mpm_scene *s, const mpm_run_def *run, long *done, core_error
 double mpm_time(const mpm_scene *s);
 long mpm_steps_done(const mpm_scene *s);
 
+/* Wall time of each stage of the step, summed over the steps run since the scene was created or
+ * loaded (not stored in checkpoints): the stencil, particle-to-grid (with the grain fields),
+ * the contact normals, the grid update, the grid contact rule, grid-to-particle, the MUSL remap,
+ * the material update and the end-of-step checks (with contact "friction" the stencil is taken
+ * inside p2g, point by point, and its entry stays 0). Read on thread 0 after each stage; most end at
+ * a barrier, so their time includes the wait for the slowest thread (p2g and normals share one). */
+enum { MPM_NSTAGES = 9 };
+extern const char *const mpm_stage_names[MPM_NSTAGES];
+void mpm_timings(const mpm_scene *s, double seconds[MPM_NSTAGES], long *steps);
+
 /* ---- measurements -------------------------------------------------------------------------- */
 typedef struct mpm_energy {
     double kinetic;    /* sum 1/2 m v^2 (per unit depth: J/m) */

@@ -106,6 +106,8 @@ struct mpm_scene {
     mpm_contact_model contact;
     double time;
     long steps;
+    double tstage[MPM_NSTAGES]; /* mpm_timings */
+    long tsteps;
 };
 
 /* Sizes the per-grain field arrays for the current points (called before a run with contact

@@ -8,8 +8,10 @@
 
 #include <stdlib.h>
 
+#include "core/clock.h"
 #include "core/interrupt.h"
 #include "core/threads.h"
+#include "mpm/material_inline.h"
 #include "mpm/mpm_internal.h"
 
 #ifdef GRAINLAB_HAVE_OPENMP
@@ -18,6 +20,31 @@
 #else
 #define THREAD_ID() 0
 #endif
+
+/* The step's stages stay separate functions so that a profiler (callgrind) counts each. */
+#define STAGE __attribute__((noinline))
+
+enum { T_STENCIL, T_P2G, T_NORMALS, T_GRID, T_CONTACT, T_G2P, T_REMAP, T_MATERIAL, T_CHECK };
+const char *const mpm_stage_names[MPM_NSTAGES] = {"stencil", "p2g",   "normals",  "grid", "contact",
+                                                  "g2p",     "remap", "material", "check"};
+
+void mpm_timings(const mpm_scene *s, double seconds[MPM_NSTAGES], long *steps)
+{
+    for (int k = 0; k < MPM_NSTAGES; k++)
+        seconds[k] = s->tstage[k];
+    *steps = s->tsteps;
+}
+
+/* Thread 0 charges the time since its last reading to stage k (inside the step's parallel
+ * region, after a barrier; tl is its last reading). */
+#define STAGE_DONE(k)                                                                              \
+    do {                                                                                           \
+        if (t == 0) {                                                                              \
+            const double now_ = clock_wall();                                                      \
+            s->tstage[k] += now_ - tl;                                                             \
+            tl = now_;                                                                             \
+        }                                                                                          \
+    } while (0)
 
 /* Threads: every parallel region runs s->nt threads, thread t on points [tp[t], tp[t+1]). The
  * ranges and all reductions are fixed for a thread count, so results are the same bits run
@@ -120,11 +147,19 @@ static inline int node_of(const mpm_scene *s, int a, int gi)
     return I >= 0 && I < nn ? I : -1;
 }
 
+/* floor(x) as an int for finite x in int range (grid coordinates): a truncation and a
+ * correction below zero, cheaper than floor() without SSE4.1 and the same value. */
+static inline int ifloor(double x)
+{
+    const int i = (int)x;
+    return i - (x < (double)i);
+}
+
 /* Quadratic B-spline weights and derivatives (per grid unit) of the three nodes base, base+1,
  * base+2 around a point at grid coordinate xi. */
 static inline int bspline(double xi, double w[3], double d[3])
 {
-    const int b = (int)floor(xi - 0.5);
+    const int b = ifloor(xi - 0.5);
     const double t = xi - b; /* in [0.5, 1.5) */
     w[0] = 0.5 * (1.5 - t) * (1.5 - t);
     w[1] = 0.75 - (t - 1) * (t - 1);
@@ -138,10 +173,11 @@ static inline int bspline(double xi, double w[3], double d[3])
 /* Each point's nodes, weights N_i(x_p) and gradients G_pi (Eq. 8): linear tensor-product shape
  * functions (4 nodes) or quadratic B-splines (9). Points are inside the grid here (checked at the
  * end of every step). */
-static void stencil(mpm_scene *s, size_t pa, size_t pb)
+static inline __attribute__((always_inline)) void stencil_range(mpm_scene *s, size_t pa, size_t pb,
+                                                                const int ns)
 {
     const double ox = s->def.origin[0], oy = s->def.origin[1];
-    const int nx = s->def.cells[0], ny = s->def.cells[1], nnx = s->nnx, ns = s->ns;
+    const int nx = s->def.cells[0], ny = s->def.cells[1], nnx = s->nnx;
     const double ihx = s->inv_hx, ihy = s->inv_hy;
     for (size_t p = pa; p < pb; p++) {
         const double xi = (s->x[p] - ox) * ihx, eta = (s->y[p] - oy) * ihy;
@@ -162,7 +198,7 @@ static void stencil(mpm_scene *s, size_t pa, size_t pb)
             }
             continue;
         }
-        int i = (int)floor(xi), j = (int)floor(eta);
+        int i = ifloor(xi), j = ifloor(eta);
         if (i > nx - 1)
             i = nx - 1; /* a point exactly on the upper edge */
         if (i < 0)
@@ -193,8 +229,18 @@ static void stencil(mpm_scene *s, size_t pa, size_t pb)
     }
 }
 
+/* The stencil of points [pa, pb) (noslip; with friction grain_scatter computes each point's
+ * stencil as it scatters it). */
+STAGE static void stencil(mpm_scene *s, size_t pa, size_t pb)
+{
+    if (s->ns == 4)
+        stencil_range(s, pa, pb, 4);
+    else
+        stencil_range(s, pa, pb, s->ns);
+}
+
 /* The nodes a prescribed grain's points touch take its velocity (nforce = 1 + its index). */
-static void mark_forced(mpm_scene *s)
+STAGE static void mark_forced(mpm_scene *s)
 {
     if (!s->npres)
         return;
@@ -346,7 +392,7 @@ static inline bool near_plane(const mpm_scene *s, int k, size_t i)
 
 /* Wall and plane conditions on the centre-of-mass nodes, then the velocity of prescribed grains
  * at the nodes they touch. */
-static void apply_walls(mpm_scene *s, double *vx, double *vy, bool decide)
+STAGE static void apply_walls(mpm_scene *s, double *vx, double *vy, bool decide)
 {
 #pragma omp for schedule(static)
     for (size_t i = 0; i < s->nnodes; i++) {
@@ -365,7 +411,7 @@ static void apply_walls(mpm_scene *s, double *vx, double *vy, bool decide)
 
 /* The same for the grain fields at shared nodes (entries nnodes + q); a prescribed grain's own
  * field takes its velocity everywhere. */
-static void apply_walls_pairs(mpm_scene *s, double *vx, double *vy, bool decide)
+STAGE static void apply_walls_pairs(mpm_scene *s, double *vx, double *vy, bool decide)
 {
     const size_t nn = s->nnodes;
 #pragma omp for schedule(static)
@@ -418,23 +464,30 @@ static void move_pairs(mpm_scene *s, size_t to, size_t from, size_t n)
 
 /* Inside the parallel region; thread t takes its grains. Their pairs are first written from
  * ns * tp[t] (a grain has at most ns pairs per point), then packed in thread order. */
-static void grain_fields(mpm_scene *s, int t)
+static inline __attribute__((always_inline)) void
+grain_scatter_with(mpm_scene *s, int t, const int ns, const bool volumes, const bool spline_normals)
 {
     const size_t nn = s->nnodes;
-    const int ns = s->ns;
     const double gx0 = s->def.gravity[0], gy0 = s->def.gravity[1];
-    const bool spline_normals = s->opt.normals != MPM_NORMALS_LINEAR && ns != 9;
-    const bool volumes = s->opt.separation > 0;
-    const double ox = s->def.origin[0], oy = s->def.origin[1];
     int *mark = s->tmark + (size_t)t * nn;
     const size_t base = (size_t)ns * s->tp[t];
+    /* the grain entries (pair r at nn + r of the nodal arrays) and the point arrays as locals:
+     * the stores below cannot change them, and the compiler need not reload them */
+    double *const pm = s->nm + nn, *const ppx = s->npx + nn, *const ppy = s->npy + nn;
+    double *const pfx = s->nfx + nn, *const pfy = s->nfy + nn;
+    double *const pnx = s->pnx, *const pny = s->pny, *const pvol = s->pvol;
+    int *const pnode = s->pnode, *const pgrain = s->pgrain;
+    const double *const xm = s->m, *const vx = s->vx, *const vy = s->vy, *const v0 = s->v0;
+    const double *const F0 = s->F[0], *const F1 = s->F[1], *const F2 = s->F[2], *const F3 = s->F[3];
+    const double *const s0 = s->sig[0], *const s1 = s->sig[1], *const s2 = s->sig[2];
     size_t q = base;
     for (size_t g = s->tg[t]; g < s->tg[t + 1]; g++) {
         const size_t p0 = s->gstart[g], p1 = p0 + s->gcount[g], q0 = q;
         for (size_t p = p0; p < p1; p++) {
-            const double m = s->m[p], px = m * s->vx[p], py = m * s->vy[p];
-            const double V = s->v0[p] * (s->F[0][p] * s->F[3][p] - s->F[1][p] * s->F[2][p]);
-            const double sxx = V * s->sig[0][p], syy = V * s->sig[1][p], sxy = V * s->sig[2][p];
+            stencil_range(s, p, p + 1, ns); /* in cache for the scatter below */
+            const double m = xm[p], px = m * vx[p], py = m * vy[p];
+            const double V = v0[p] * (F0[p] * F3[p] - F1[p] * F2[p]);
+            const double sxx = V * s0[p], syy = V * s1[p], sxy = V * s2[p];
             const double fgx = m * gx0, fgy = m * gy0;
             const int *n = &s->sn[ns * p];
             const double *w = &s->sw[ns * p], *gx = &s->sgx[ns * p], *gy = &s->sgy[ns * p];
@@ -445,34 +498,50 @@ static void grain_fields(mpm_scene *s, int t)
                 if (r < 0) {
                     r = (int)q++;
                     mark[i] = r;
-                    s->pnode[r] = i;
-                    s->pgrain[r] = (int)g;
-                    const size_t e = nn + (size_t)r;
-                    s->nm[e] = s->npx[e] = s->npy[e] = s->nfx[e] = s->nfy[e] = 0;
-                    s->pnx[r] = s->pny[r] = s->pvol[r] = 0;
+                    pnode[r] = i;
+                    pgrain[r] = (int)g;
+                    pm[r] = ppx[r] = ppy[r] = pfx[r] = pfy[r] = 0;
+                    pnx[r] = pny[r] = pvol[r] = 0;
                 }
-                const size_t e = nn + (size_t)r;
                 const double wk = w[k];
-                s->nm[e] += wk * m;
-                s->npx[e] += wk * px;
-                s->npy[e] += wk * py;
-                s->nfx[e] += wk * fgx - (sxx * gx[k] + sxy * gy[k]);
-                s->nfy[e] += wk * fgy - (sxy * gx[k] + syy * gy[k]);
+                pm[r] += wk * m;
+                ppx[r] += wk * px;
+                ppy[r] += wk * py;
+                pfx[r] += wk * fgx - (sxx * gx[k] + sxy * gy[k]);
+                pfy[r] += wk * fgy - (sxy * gx[k] + syy * gy[k]);
                 if (volumes)
-                    s->pvol[r] += wk * V;
+                    pvol[r] += wk * V;
                 if (!spline_normals) {
-                    s->pnx[r] += m * gx[k];
-                    s->pny[r] += m * gy[k];
+                    pnx[r] += m * gx[k];
+                    pny[r] += m * gy[k];
                 }
                 sv[k] = r; /* the pair, renumbered after packing */
             }
         }
         for (size_t r = q0; r < q; r++)
-            mark[s->pnode[r]] = -1;
+            mark[pnode[r]] = -1;
     }
     s->tc[t] = q - base;
-#pragma omp barrier
-#pragma omp master
+}
+
+/* grain_scatter_with with constant options for the common case (linear shapes, spline normals,
+ * no separation check): the stencil loop unrolls and the per-entry tests go. */
+STAGE static void grain_scatter(mpm_scene *s, int t)
+{
+    const bool spline_normals = s->opt.normals != MPM_NORMALS_LINEAR && s->ns != 9;
+    const bool volumes = s->opt.separation > 0;
+    if (s->ns == 4 && spline_normals && !volumes)
+        grain_scatter_with(s, t, 4, false, true);
+    else
+        grain_scatter_with(s, t, s->ns, volumes, spline_normals);
+}
+
+/* Packs the threads' pairs in thread order, counts the grains at each node and sums the
+ * centre-of-mass field from the grain fields (one thread). */
+STAGE static void grain_pack(mpm_scene *s)
+{
+    const size_t nn = s->nnodes;
+    const int ns = s->ns;
     {
         /* pack the threads' pairs; count the grains at each node; the centre-of-mass field is
          * the sum of the grain fields */
@@ -495,8 +564,14 @@ static void grain_fields(mpm_scene *s, int t)
                 node[k][i] += node[k][nn + r];
         }
     }
-#pragma omp barrier
-    /* each point's stencil: its grain's entry at shared nodes, the centre of mass elsewhere */
+}
+
+/* Thread t's points' stencil entries: the grain's pair at shared nodes, else the node. */
+STAGE static void grain_stencil(mpm_scene *s, int t)
+{
+    const size_t nn = s->nnodes;
+    const int ns = s->ns;
+    const size_t base = (size_t)ns * s->tp[t];
     {
         const long shift = (long)base - (long)s->tq[t];
         for (size_t e = (size_t)ns * s->tp[t]; e < (size_t)ns * s->tp[t + 1]; e++) {
@@ -504,7 +579,15 @@ static void grain_fields(mpm_scene *s, int t)
             s->sv[e] = s->ngr[i] < 2 ? i : (int)(nn + (size_t)((long)s->sv[e] - shift));
         }
     }
-    if (spline_normals) {
+}
+
+/* Eq. 24 with linear transfers: thread t's grains' B-spline mass gradients at their shared pairs.
+ */
+STAGE static void grain_normals(mpm_scene *s, int t)
+{
+    const double ox = s->def.origin[0], oy = s->def.origin[1];
+    int *mark = s->tmark + (size_t)t * s->nnodes;
+    {
         /* Eq. 24 with linear transfers: each grain's B-spline mass gradient at its shared pairs,
          * from the points whose 3 x 3 B-spline nodes include one of them. */
         size_t r0 = s->tq[t];
@@ -555,8 +638,11 @@ static void grain_fields(mpm_scene *s, int t)
             r0 = r1;
         }
     }
-#pragma omp barrier
-#pragma omp master
+}
+
+/* At shared nodes: the sum of the grains' gradients and nodal volumes (one thread). */
+STAGE static void grain_sums(mpm_scene *s)
+{
     {
         /* at shared nodes: the sum of the grains' gradients and nodal volumes */
         for (size_t r = 0; r < s->npairs; r++) {
@@ -573,14 +659,38 @@ static void grain_fields(mpm_scene *s, int t)
             }
         }
     }
+}
+
+/* Inside the parallel region: the stages above with the barriers between them; *tlp is thread
+ * 0's last clock reading (STAGE_DONE). */
+static void grain_fields(mpm_scene *s, int t, double *tlp)
+{
+    double tl = *tlp;
+    const bool spline_normals = s->opt.normals != MPM_NORMALS_LINEAR && s->ns != 9;
+    grain_scatter(s, t);
 #pragma omp barrier
+#pragma omp master
+    {
+        mark_forced(s);
+        grain_pack(s);
+    }
+#pragma omp barrier
+    grain_stencil(s, t);
+    STAGE_DONE(T_P2G); /* no barrier: the normals need none, so this is thread 0's own time */
+    if (spline_normals)
+        grain_normals(s, t);
+#pragma omp barrier
+#pragma omp master
+    grain_sums(s);
+#pragma omp barrier
+    *tlp = tl;
 }
 
 /* Step 2: v_i^n from Eq. 5 and v_i^{n+1} from Eq. 9. v_i^n = p_i / m_i is a mass-weighted mean of
  * point velocities, bounded at any mass; only the acceleration f_i / m_i blows up at nearly empty
  * nodes, so nodes lighter than m_min keep v_i^{n+1} = v_i^n (a zero velocity there would put a
  * spurious strain rate v / h into their neighbours' points). */
-static void grid_update(mpm_scene *s, double dt)
+STAGE static void grid_update(mpm_scene *s, double dt)
 {
     const double m_min = s->m_min;
 #pragma omp for schedule(static)
@@ -608,7 +718,7 @@ static void grid_update(mpm_scene *s, double dt)
  * the strain cap; then the momentum the corrections changed at a node (non-zero with three or
  * more grains, or with the cap) is taken back evenly from the corrected grains there, a common
  * velocity shift that leaves their relative motion as the rule made it. */
-static void contact_correct(mpm_scene *s, double *vx, double *vy, bool decide, double dt)
+STAGE static void contact_correct(mpm_scene *s, double *vx, double *vy, bool decide, double dt)
 {
     const size_t nn = s->nnodes;
     const double mu = s->mu;
@@ -703,7 +813,7 @@ static void contact_correct(mpm_scene *s, double *vx, double *vy, bool decide, d
  * (measured on the 0.5 m/s head-on collision: correcting v_i^g after P2G as well changed the
  * rebound speed by 1.5% and did not remove the energy error that the consistent marks below
  * fix), so a point's FLIP increment carries the whole correction. */
-static void contact_update(mpm_scene *s, double dt)
+STAGE static void contact_update(mpm_scene *s, double dt)
 {
     const size_t nn = s->nnodes;
     const double m_min = s->m_min;
@@ -730,27 +840,33 @@ static void contact_update(mpm_scene *s, double dt)
 
 /* Step 3: positions (Eq. 10) and velocities (Eq. 11, blended with PIC) of thread t's points; a
  * prescribed grain's points keep its velocity exactly. */
-static void to_points(mpm_scene *s, double dt, int t)
+static inline __attribute__((always_inline)) void to_points_with(mpm_scene *s, double dt, int t,
+                                                                 const int ns)
 {
     const double pic = s->def.pic, flip = 1 - pic;
-    const int ns = s->ns;
-    for (size_t p = s->tp[t]; p < s->tp[t + 1]; p++) {
-        const int *n = &s->sf[ns * p];
-        const double *w = &s->sw[ns * p];
+    const int *const sf = s->sf;
+    const double *const sw = s->sw;
+    const double *const nax = s->nax, *const nay = s->nay, *const nvx = s->nvx, *const nvy = s->nvy;
+    double *const x = s->x, *const y = s->y, *const ux = s->ux, *const uy = s->uy;
+    double *const vx = s->vx, *const vy = s->vy;
+    const size_t pb = s->tp[t + 1];
+    for (size_t p = s->tp[t]; p < pb; p++) {
+        const int *n = &sf[ns * p];
+        const double *w = &sw[ns * p];
         double dvx = 0, dvy = 0, ax = 0, ay = 0;
         for (int k = 0; k < ns; k++) {
             const int i = n[k];
-            ax += w[k] * s->nax[i];
-            ay += w[k] * s->nay[i];
-            dvx += w[k] * (s->nax[i] - s->nvx[i]);
-            dvy += w[k] * (s->nay[i] - s->nvy[i]);
+            ax += w[k] * nax[i];
+            ay += w[k] * nay[i];
+            dvx += w[k] * (nax[i] - nvx[i]);
+            dvy += w[k] * (nay[i] - nvy[i]);
         }
-        s->x[p] += dt * ax;
-        s->y[p] += dt * ay;
-        s->ux[p] += dt * ax;
-        s->uy[p] += dt * ay;
-        s->vx[p] = flip * (s->vx[p] + dvx) + pic * ax;
-        s->vy[p] = flip * (s->vy[p] + dvy) + pic * ay;
+        x[p] += dt * ax;
+        y[p] += dt * ay;
+        ux[p] += dt * ax;
+        uy[p] += dt * ay;
+        vx[p] = flip * (vx[p] + dvx) + pic * ax;
+        vy[p] = flip * (vy[p] + dvy) + pic * ay;
     }
     if (s->npres)
         for (size_t g = s->tg[t]; g < s->tg[t + 1]; g++) {
@@ -764,6 +880,15 @@ static void to_points(mpm_scene *s, double dt, int t)
         }
 }
 
+/* to_points_with with ns = 4 (linear shapes) a constant: the stencil loops unroll. */
+STAGE static void to_points(mpm_scene *s, double dt, int t)
+{
+    if (s->ns == 4)
+        to_points_with(s, dt, t, 4);
+    else
+        to_points_with(s, dt, t, s->ns);
+}
+
 /* v = p / m on the centre-of-mass nodes and the grain entries, then the walls and the contact
  * rule: for the MUSL remap with the contact marks of the momentum update (decide = false), for
  * USF before the stress update with contacts decided on it (the momentum update decides again).
@@ -774,7 +899,7 @@ static void to_points(mpm_scene *s, double dt, int t)
  * elastic) / initial kinetic = 1.01: no remap correction: 1.64; remap correction re-deciding
  * Eq. 12 on the remapped field (contact switching on and off every other step): 1.58; the marks
  * of the momentum update: 1.03. */
-static void nodal_velocity(mpm_scene *s, double dt, bool decide)
+STAGE static void nodal_velocity(mpm_scene *s, double dt, bool decide)
 {
     const size_t ne = s->nnodes + s->npairs;
 #pragma omp for schedule(static)
@@ -796,10 +921,10 @@ static void nodal_velocity(mpm_scene *s, double dt, bool decide)
  * the centre of mass then takes the sum of the grains' entries. Inside the parallel region. With
  * friction every entry a point feeds belongs to its thread (its grain's, or a node only its grain
  * touches); noslip scatters into thread buffers. */
-static void scatter_sf(mpm_scene *s, int t, double *a, double *b, bool force)
+static inline __attribute__((always_inline)) void
+scatter_sf_with(mpm_scene *s, int t, double *a, double *b, bool force, const int ns)
 {
     const size_t nn = s->nnodes, ne = s->nnodes + s->npairs;
-    const int ns = s->ns;
     const bool friction = s->contact == MPM_CONTACT_FRICTION;
     const double gx0 = s->def.gravity[0], gy0 = s->def.gravity[1];
     double *const main[2] = {a, b};
@@ -850,23 +975,88 @@ static void scatter_sf(mpm_scene *s, int t, double *a, double *b, bool force)
     }
 }
 
+/* scatter_sf_with with ns = 4 (linear shapes) a constant: the stencil loops unroll. */
+STAGE static void scatter_sf(mpm_scene *s, int t, double *a, double *b, bool force)
+{
+    if (s->ns == 4)
+        scatter_sf_with(s, t, a, b, force, 4);
+    else
+        scatter_sf_with(s, t, a, b, force, s->ns);
+}
+
 /* MUSL: the updated point momenta mapped back (Eq. 5 with v_p^{n+1}) give the nodal velocities
  * the strain increment is taken from; with friction each grain's own field at shared nodes. */
-static void remap(mpm_scene *s, double dt, int t)
+STAGE static void remap(mpm_scene *s, double dt, int t)
 {
     scatter_sf(s, t, s->npx, s->npy, false);
     nodal_velocity(s, dt, false);
 }
 
-/* Step 3, continued: velocity gradient L = sum_i v_i G_pi, F <- (I + dt L) F, stress update.
- * Returns the first point that inverts, or (size_t)-1. */
-static size_t constitutive(mpm_scene *s, double dt, int t, const double *vx, const double *vy)
+/* The end-of-step check of a point at (*x, *y) with velocity (vx, vy) and in-plane stress sig:
+ * wraps it on periodic axes; true when it is non-finite or outside the grid on an axis that is
+ * not periodic. */
+static inline bool point_bad_at(const mpm_scene *s, double *x, double *y, double vx, double vy,
+                                const double sig[3])
 {
-    size_t bad = (size_t)-1;
-    const int ns = s->ns;
-    for (size_t p = s->tp[t]; p < s->tp[t + 1]; p++) {
-        const int *n = &s->sf[ns * p];
-        const double *gx = &s->sgx[ns * p], *gy = &s->sgy[ns * p];
+    /* 0 * v is 0 for finite v and NaN for inf or NaN: one test for all seven */
+    const double z = 0 * *x + 0 * *y + 0 * vx + 0 * vy + 0 * sig[0] + 0 * sig[1] + 0 * sig[2];
+    if (!(z == 0))
+        return true;
+    const mpm_scene_def *d = &s->def;
+    double *c[2] = {x, y};
+    bool bad = false;
+    for (int a = 0; a < 2; a++) {
+        double o = d->origin[a], L = d->size[a];
+        if (d->periodic[a]) {
+            if (*c[a] < o || *c[a] >= o + L)
+                *c[a] -= L * floor((*c[a] - o) / L);
+            if (*c[a] >= o + L) /* rounding of a value just below o */
+                *c[a] = o;
+        } else if (*c[a] < o - s->slack[a][0] || *c[a] > o + L + s->slack[a][1]) {
+            bad = true;
+        }
+    }
+    return bad;
+}
+
+static inline bool point_bad(mpm_scene *s, size_t p)
+{
+    const double sig[3] = {s->sig[0][p], s->sig[1][p], s->sig[2][p]};
+    return point_bad_at(s, &s->x[p], &s->y[p], s->vx[p], s->vy[p], sig);
+}
+
+/* Whether the first bad point (point_bad) is finite but outside the grid (1) or not (0). */
+static int bad_why(const mpm_scene *s, size_t first)
+{
+    return isfinite(s->x[first]) && isfinite(s->y[first]) && isfinite(s->vx[first]) &&
+           isfinite(s->vy[first]) && isfinite(s->sig[0][first]) && isfinite(s->sig[1][first]) &&
+           isfinite(s->sig[2][first]);
+}
+
+/* Step 3, continued: velocity gradient L = sum_i v_i G_pi, F <- (I + dt L) F, stress update.
+ * Returns the first point that inverts, or (size_t)-1; with check, each point's end-of-step
+ * check (point_bad) follows its update, and *check is the first bad point. */
+static inline __attribute__((always_inline)) size_t constitutive_with(mpm_scene *s, double dt,
+                                                                      int t, const double *vx,
+                                                                      const double *vy,
+                                                                      size_t *check, const int ns)
+{
+    size_t bad = (size_t)-1, first = (size_t)-1;
+    /* the arrays as locals: the material call is opaque, so fields of s would be reloaded */
+    const int *const sf = s->sf, *const mat = s->mat;
+    const double *const sgx = s->sgx, *const sgy = s->sgy;
+    double *const F0 = s->F[0], *const F1 = s->F[1], *const F2 = s->F[2], *const F3 = s->F[3];
+    double *const b0 = s->be[0], *const b1 = s->be[1], *const b2 = s->be[2], *const b3 = s->be[3];
+    double *const s0 = s->sig[0], *const s1 = s->sig[1], *const s2 = s->sig[2],
+                  *const s3 = s->sig[3];
+    double *const eps_p = s->eps_p;
+    double *const x = s->x, *const y = s->y;
+    const double *const pvx = s->vx, *const pvy = s->vy;
+    const mpm_material *const mats = s->mats;
+    const size_t pb = s->tp[t + 1];
+    for (size_t p = s->tp[t]; p < pb; p++) {
+        const int *n = &sf[ns * p];
+        const double *gx = &sgx[ns * p], *gy = &sgy[ns * p];
         double L[4] = {0, 0, 0, 0};
         for (int k = 0; k < ns; k++) {
             const int i = n[k];
@@ -876,24 +1066,45 @@ static size_t constitutive(mpm_scene *s, double dt, int t, const double *vx, con
             L[3] += vy[i] * gy[k];
         }
         double f[4] = {1 + dt * L[0], dt * L[1], dt * L[2], 1 + dt * L[3]};
-        double F0 = s->F[0][p], F1 = s->F[1][p], F2 = s->F[2][p], F3 = s->F[3][p];
-        s->F[0][p] = f[0] * F0 + f[1] * F2;
-        s->F[1][p] = f[0] * F1 + f[1] * F3;
-        s->F[2][p] = f[2] * F0 + f[3] * F2;
-        s->F[3][p] = f[2] * F1 + f[3] * F3;
-        double J = s->F[0][p] * s->F[3][p] - s->F[1][p] * s->F[2][p];
-        double be[4] = {s->be[0][p], s->be[1][p], s->be[2][p], s->be[3][p]}, sig[4];
-        if (!mpm_material_update(&s->mats[s->mat[p]], f, be, &s->eps_p[p], J, sig)) {
+        const double Fa = F0[p], Fb = F1[p], Fc = F2[p], Fd = F3[p];
+        const double G0 = f[0] * Fa + f[1] * Fc, G1 = f[0] * Fb + f[1] * Fd;
+        const double G2 = f[2] * Fa + f[3] * Fc, G3 = f[2] * Fb + f[3] * Fd;
+        F0[p] = G0;
+        F1[p] = G1;
+        F2[p] = G2;
+        F3[p] = G3;
+        const double J = G0 * G3 - G1 * G2;
+        double be[4] = {b0[p], b1[p], b2[p], b3[p]}, sig[4];
+        if (!material_update(&mats[mat[p]], f, be, &eps_p[p], J, sig)) {
             if (bad == (size_t)-1)
                 bad = p;
             continue;
         }
-        for (int k = 0; k < 4; k++) {
-            s->be[k][p] = be[k];
-            s->sig[k][p] = sig[k];
-        }
+        b0[p] = be[0];
+        b1[p] = be[1];
+        b2[p] = be[2];
+        b3[p] = be[3];
+        s0[p] = sig[0];
+        s1[p] = sig[1];
+        s2[p] = sig[2];
+        s3[p] = sig[3];
+        /* the end-of-step check, while the point is in cache (one pass and one parallel region
+         * fewer per step) */
+        if (check && point_bad_at(s, &x[p], &y[p], pvx[p], pvy[p], sig) && first == (size_t)-1)
+            first = p;
     }
+    if (check)
+        *check = first;
     return bad;
+}
+
+/* constitutive_with with ns = 4 (linear shapes) a constant: the stencil loops unroll. */
+STAGE static size_t constitutive(mpm_scene *s, double dt, int t, const double *vx, const double *vy,
+                                 size_t *check)
+{
+    if (s->ns == 4)
+        return constitutive_with(s, dt, t, vx, vy, check, 4);
+    return constitutive_with(s, dt, t, vx, vy, check, s->ns);
 }
 
 /* The step being taken when a check fails is s->steps + 1. */
@@ -906,37 +1117,16 @@ static core_status unstable(const mpm_scene *s, size_t p, const char *what, cons
                      p + 1, s->grain[p] + 1, what, s->steps + 1, s->time, s->x[p], s->y[p], cause);
 }
 
-/* Non-finite values, points outside the grid on axes that are not periodic; periodic axes wrap. */
-/* Wraps points on periodic axes; returns the first point that is non-finite (*why = 0) or
- * outside the grid on an axis that is not periodic (*why = 1), or (size_t)-1. */
-static size_t check_points(mpm_scene *s, int *why)
+/* The check of every point, for USF (whose stress update comes before the positions'); the
+ * other orders check each point right after its stress update (constitutive). Returns the first
+ * bad point, or (size_t)-1. */
+static size_t check_points(mpm_scene *s)
 {
-    const mpm_scene_def *d = &s->def;
     size_t first = (size_t)-1;
 #pragma omp parallel for schedule(static) reduction(min : first) num_threads(s->nt) if (s->nt > 1)
-    for (size_t p = 0; p < s->np; p++) {
-        double *c[2] = {&s->x[p], &s->y[p]};
-        if (!isfinite(*c[0]) || !isfinite(*c[1]) || !isfinite(s->vx[p]) || !isfinite(s->vy[p]) ||
-            !isfinite(s->sig[0][p]) || !isfinite(s->sig[1][p]) || !isfinite(s->sig[2][p])) {
+    for (size_t p = 0; p < s->np; p++)
+        if (point_bad(s, p))
             first = p < first ? p : first;
-            continue;
-        }
-        for (int a = 0; a < 2; a++) {
-            double o = d->origin[a], L = d->size[a];
-            if (d->periodic[a]) {
-                if (*c[a] < o || *c[a] >= o + L)
-                    *c[a] -= L * floor((*c[a] - o) / L);
-                if (*c[a] >= o + L) /* rounding of a value just below o */
-                    *c[a] = o;
-            } else if (*c[a] < o - s->slack[a][0] || *c[a] > o + L + s->slack[a][1]) {
-                first = p < first ? p : first;
-            }
-        }
-    }
-    if (first != (size_t)-1)
-        *why = isfinite(s->x[first]) && isfinite(s->y[first]) && isfinite(s->vx[first]) &&
-               isfinite(s->vy[first]) && isfinite(s->sig[0][first]) && isfinite(s->sig[1][first]) &&
-               isfinite(s->sig[2][first]);
     return first;
 }
 
@@ -982,7 +1172,7 @@ static core_status run_steps(mpm_scene *s, const mpm_run_def *run, long *done, c
     if ((st = mpm_timestep_info(s, run->cfl > 0 && run->cfl <= 1 ? run->cfl : 1, &ts, err)))
         return st;
     const bool musl = s->def.update == MPM_MUSL, usf = s->def.update == MPM_USF;
-    size_t tbad[64];
+    size_t tbad[64], tcheck[64];
     while (*done < run->steps) {
         if (run->time_end >= 0 && s->time >= run->time_end * (1 - 1e-14))
             break;
@@ -993,48 +1183,71 @@ static core_status run_steps(mpm_scene *s, const mpm_run_def *run, long *done, c
         double dt = run->dt > 0 ? run->dt : run->cfl * h / (ts.wave_speed + max_speed(s));
         if (run->time_end >= 0 && s->time + dt > run->time_end)
             dt = run->time_end - s->time;
+        const double t0 = clock_wall();
+        double tlast = t0;
 #pragma omp parallel num_threads(s->nt) if (s->nt > 1)
         {
             const int t = THREAD_ID();
-            stencil(s, s->tp[t], s->tp[t + 1]);
+            double tl = t0;
+            if (friction) {
+                grain_fields(s, t, &tl); /* the stencil and the centre-of-mass field too */
+            } else {
+                stencil(s, s->tp[t], s->tp[t + 1]);
 #pragma omp barrier
 #pragma omp master
-            mark_forced(s);
+                mark_forced(s);
 #pragma omp barrier
-            if (friction)
-                grain_fields(s, t); /* the centre-of-mass field too */
-            else
+                STAGE_DONE(T_STENCIL);
                 to_grid(s, t);
+            }
 #pragma omp barrier
 #pragma omp master
             if (s->nmx)
                 moments(s);
 #pragma omp barrier
+            STAGE_DONE(friction ? T_NORMALS : T_P2G);
             tbad[t] = (size_t)-1;
             if (usf) {
                 nodal_velocity(s, dt, true); /* v_i^n, for the stress update */
-                tbad[t] = constitutive(s, dt, t, s->nax, s->nay);
+                tbad[t] = constitutive(s, dt, t, s->nax, s->nay, NULL);
 #pragma omp barrier
+                STAGE_DONE(T_MATERIAL);
                 scatter_sf(s, t, s->nfx, s->nfy, true); /* forces from the new stress */
+                STAGE_DONE(T_P2G);
             }
             grid_update(s, dt);
-            if (friction)
+            STAGE_DONE(T_GRID);
+            if (friction) {
                 contact_update(s, dt);
+                STAGE_DONE(T_CONTACT);
+            }
             to_points(s, dt, t);
 #pragma omp barrier
-            if (musl)
+            STAGE_DONE(T_G2P);
+            if (musl) {
                 remap(s, dt, t);
+                STAGE_DONE(T_REMAP);
+            }
             if (!usf)
-                tbad[t] = constitutive(s, dt, t, s->nax, s->nay);
+                tbad[t] = constitutive(s, dt, t, s->nax, s->nay, &tcheck[t]);
+            if (t == 0)
+                tlast = tl;
         }
+        const double tend = clock_wall(); /* the end of the region, then the checks */
+        s->tstage[usf ? T_G2P : T_MATERIAL] += tend - tlast;
         for (int t = 0; t < s->nt; t++)
             if (tbad[t] != (size_t)-1)
                 return unstable(s, tbad[t], "was inverted (det F <= 0)",
                                 "the time step is too large for the wave speed, or a point too "
                                 "strongly compressed between walls",
                                 err);
-        int why = 0;
-        size_t bad = check_points(s, &why);
+        size_t bad = (size_t)-1;
+        if (usf)
+            bad = check_points(s);
+        else
+            for (int t = 0; t < s->nt; t++)
+                bad = tcheck[t] < bad ? tcheck[t] : bad;
+        const int why = bad != (size_t)-1 ? bad_why(s, bad) : 0;
         if (bad != (size_t)-1)
             return why ? unstable(s, bad, "left the grid",
                                   "an edge without a wall (walls = 'none'), or a time step too "
@@ -1047,6 +1260,8 @@ static core_status run_steps(mpm_scene *s, const mpm_run_def *run, long *done, c
         s->time += dt;
         s->steps++;
         ++*done;
+        s->tstage[T_CHECK] += clock_wall() - tend;
+        s->tsteps++;
         if (threads_tune_step() && (st = threads_setup(s, err)))
             return st;
     }

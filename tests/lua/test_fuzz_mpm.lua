@@ -102,6 +102,7 @@ local calls = {
   ["mpm.scene:grain"] = { setup = scene, self = self, args = function() return { 1 } end, pos = { {} } },
   ["mpm.scene:points"] = { setup = scene, self = self },
   ["mpm.scene:info"] = { setup = scene, self = self },
+  ["mpm.scene:timings"] = { setup = scene, self = self },
   ["mpm.scene:set_velocities"] = {
     setup = scene, self = self, opts = 1,
     args = function(m)
