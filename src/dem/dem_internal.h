@@ -186,6 +186,11 @@ int dem_flow_inserting(const dem_scene *s);
  * itself and the effective mass; 0 when q does not exist. */
 int dem_flow_probe(dem_scene *s, int q, double *k, double *gamma, double *m_eff);
 void dem_flow_tag_new(dem_scene *s, size_t i); /* a particle was appended: its tag */
+/* LAMMPS ids as tags (lammps.c): ids sorted, unique, each id - 1 the tag of particle first + k;
+ * tag_clash finds a particle of the scene whose tag + 1 is already one of them (-1: none). */
+long dem_flow_tag_clash(const dem_scene *s, const long long *ids, size_t n, size_t *k);
+core_status dem_flow_adopt_tags(dem_scene *s, size_t first, const long long *ids, size_t n,
+                                core_error *err);
 void dem_flow_free(dem_scene *s);
 core_status dem_flow_save(const dem_scene *s, struct ckpt_writer *w, core_error *err);
 core_status dem_flow_load(dem_scene *s, struct ckpt_section *sec, core_error *err);

@@ -77,6 +77,42 @@ void dem_flow_tag_new(dem_scene *s, size_t i)
     s->flow->next_tag += 1;
 }
 
+/* The first particle of [0, s->n) whose tag + 1 is one of the sorted ids, or -1 (and *k the id's
+ * position). A scene without tags numbers its particles by index. */
+long dem_flow_tag_clash(const dem_scene *s, const long long *ids, size_t n, size_t *k)
+{
+    for (size_t i = 0; i < s->n && n > 0; i++) {
+        const long long want = (s->tag ? (long long)s->tag[i] : (long long)i) + 1;
+        size_t a = 0, b = n;
+        while (a < b) {
+            const size_t m = a + (b - a) / 2;
+            if (ids[m] < want)
+                a = m + 1;
+            else
+                b = m;
+        }
+        if (a < n && ids[a] == want) {
+            *k = a;
+            return (long)i;
+        }
+    }
+    return -1;
+}
+
+core_status dem_flow_adopt_tags(dem_scene *s, size_t first, const long long *ids, size_t n,
+                                core_error *err)
+{
+    core_status st = flow_on(s, err);
+    if (st)
+        return st;
+    for (size_t k = 0; k < n; k++) {
+        s->tag[first + k] = (double)(ids[k] - 1);
+        if (ids[k] > s->flow->next_tag) /* tags are never reused: the next one is above all */
+            s->flow->next_tag = (double)ids[k];
+    }
+    return CORE_OK;
+}
+
 void dem_flow_free(dem_scene *s)
 {
     dem_flow *f = s->flow;
@@ -114,7 +150,8 @@ core_status dem_outflow_counts(const dem_scene *s, int id, dem_flow_counts *out,
 
 core_status dem_flow_check_run(const dem_scene *s, core_error *err)
 {
-    if (comm_size() > 1)
+    /* tags alone (a LAMMPS file's ids) travel with their particles (domain.c's table) */
+    if (comm_size() > 1 && (s->flow->nins > 0 || s->flow->nout > 0))
         return core_fail(err, CORE_ERR_STATE,
                          "particle insertion and removal (inserters, outflows) do not yet run "
                          "distributed (comm_size() > 1): run this scene on one rank");

@@ -652,6 +652,25 @@ core_status dem_lammps_add(dem_scene *s, const dem_lammps_data *d, const dem_lam
                                  d->path, d->line[k], d->id[k], 'x' + a, x, s->lo[a], s->hi[a]);
         }
     }
+    /* Ids other than 1..n (a scene written after removals) become the particles' tags, so that
+     * a grain keeps its number across the round trip; 1..n is what the particles get anyway. */
+    int adopt = 0;
+    for (size_t k = 0; k < d->n && !adopt; k++)
+        adopt = d->id[k] != (long long)k + 1;
+    if (adopt) {
+        size_t k = 0;
+        long i = dem_flow_tag_clash(s, d->id, d->n, &k);
+        if (i >= 0)
+            return core_fail(err, CORE_ERR_ARG,
+                             "%s:%ld: atom id %lld is already the tag of particle %ld of the "
+                             "scene (ids other than 1..n become tags: read such a file into an "
+                             "empty scene)",
+                             d->path, d->line[k], d->id[k], i + 1);
+        if (d->n > 0 && d->id[d->n - 1] > (1LL << 53))
+            return core_fail(err, CORE_ERR_ARG,
+                             "%s:%ld: atom id %lld is too large to keep as a tag (at most 2^53)",
+                             d->path, d->line[d->n - 1], d->id[d->n - 1]);
+    }
     /* ---- materials: each type's own, then copies for densities that differ ---- */
     size_t n0 = s->n;
     int nmat0 = s->nmat;
@@ -749,6 +768,8 @@ core_status dem_lammps_add(dem_scene *s, const dem_lammps_data *d, const dem_lam
         }
     }
     free(mat);
+    if (st == CORE_OK && adopt)
+        st = dem_flow_adopt_tags(s, n0, d->id, d->n, err);
     if (st != CORE_OK) {
         rollback(s, n0, nmat0);
         for (int t = 0; t < d->ntypes; t++)
@@ -831,6 +852,13 @@ static void wrapped(const dem_scene *s, size_t i, double x[3], long img[3])
 
 static double omega_of(const dem_scene *s, int a, size_t i) { return s->w[a] ? s->w[a][i] : 0; }
 
+/* The atom id of particle i: its tag + 1 in a scene with insertion or removal (OVITO follows a
+ * grain across a removal by it; dem_lammps_add reads it back as the tag), else index + 1. */
+static long long atom_id(const dem_scene *s, size_t i)
+{
+    return (s->tag ? (long long)s->tag[i] : (long long)i) + 1;
+}
+
 core_status dem_write_lammps_data(const dem_scene *s, const char *path,
                                   const dem_lammps_write_def *def, core_error *err)
 {
@@ -866,13 +894,13 @@ core_status dem_write_lammps_data(const dem_scene *s, const char *path,
         double x[3];
         long img[3];
         wrapped(s, i, x, img);
-        fprintf(fp, "%zu %d %.17g %.17g %.17g %.17g %.17g %ld %ld %ld\n", i + 1, type[i],
+        fprintf(fp, "%lld %d %.17g %.17g %.17g %.17g %.17g %ld %ld %ld\n", atom_id(s, i), type[i],
                 2 * s->r[i], s->mats[s->mat[i]].density, x[0], x[1], x[2], img[0], img[1], img[2]);
     }
     fprintf(fp, "\nVelocities\n\n");
     for (size_t i = 0; i < s->n; i++) {
         double v[3] = {s->v[0][i], s->v[1][i], s->dim == 3 ? s->v[2][i] : 0};
-        fprintf(fp, "%zu %.17g %.17g %.17g %.17g %.17g %.17g\n", i + 1, v[0], v[1], v[2],
+        fprintf(fp, "%lld %.17g %.17g %.17g %.17g %.17g %.17g\n", atom_id(s, i), v[0], v[1], v[2],
                 omega_of(s, 0, i), omega_of(s, 1, i), omega_of(s, 2, i));
     }
     free(type);
@@ -948,10 +976,10 @@ core_status dem_write_lammps_dump(const dem_scene *s, const char *path,
             f[a] = a < s->dim ? s->f[a][i] : 0;
         }
         sb_printf(&b,
-                  "%zu %d %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g "
+                  "%lld %d %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g "
                   "%.17g %.17g %.17g\n",
-                  i + 1, type[i], s->r[i], s->m[i], x[0], x[1], x[2], v[0], v[1], v[2], f[0], f[1],
-                  f[2], omega_of(s, 0, i), omega_of(s, 1, i), omega_of(s, 2, i));
+                  atom_id(s, i), type[i], s->r[i], s->m[i], x[0], x[1], x[2], v[0], v[1], v[2],
+                  f[0], f[1], f[2], omega_of(s, 0, i), omega_of(s, 1, i), omega_of(s, 2, i));
     }
     free(type);
     if (b.failed) {

@@ -14,6 +14,14 @@ const double *dem_forces(const dem_scene *s, int d)
     return d >= 0 && d < s->dim ? s->f[d] : NULL;
 }
 
+/* The id a file gives particle i: its tag + 1 in a scene with insertion or removal (the index
+ * shifts at a removal; ParaView and OVITO follow a grain by this array), else index + 1, the
+ * same number. */
+static int64_t particle_id(const double *tag, size_t i)
+{
+    return (tag ? (int64_t)tag[i] : (int64_t)i) + 1;
+}
+
 /* Copies up to dim component arrays (NULL: zeros) into an interleaved 3-vector array. */
 static void interleave(double *out, const double *const c[3], size_t n)
 {
@@ -58,9 +66,10 @@ core_status dem_vtk_particles(const dem_scene *s, const char *path, core_error *
     interleave(fo, force, n);
     const double *rad = dem_radii(s), *mass = dem_masses(s);
     const int *pm = dem_particle_materials(s);
+    const double *tag = dem_tags(s);
     for (size_t i = 0; i < n; i++) {
         conn[i] = (int64_t)i;
-        id[i] = (int64_t)i + 1;
+        id[i] = particle_id(tag, i);
         r[i] = rad[i];
         m[i] = mass[i];
         mat[i] = pm[i] + 1;
@@ -155,12 +164,14 @@ core_status dem_vtk_contacts(dem_scene *s, const char *path, core_error *err)
         free(l.c);
         return vtk_file_finish(f, path, err ? err->status : CORE_ERR_NOMEM, err);
     }
+    const double *tag = dem_tags(s);
     for (size_t k = 0; k < n; k++) {
         const contact_rec *c = &l.c[k];
         conn[2 * k] = (int64_t)(2 * k);
         conn[2 * k + 1] = (int64_t)(2 * k + 1);
-        ci[k] = c->i + 1;
-        cj[k] = c->j >= 0 ? c->j + 1 : c->j; /* walls: minus the wall id, as s:measure */
+        ci[k] = particle_id(tag, (size_t)c->i); /* the particles' id array */
+        /* walls: minus the wall id, as s:measure */
+        cj[k] = c->j >= 0 ? particle_id(tag, (size_t)c->j) : c->j;
         fn[k] = c->fn;
         ft[k] = c->ft;
         ov[k] = c->overlap;

@@ -1783,8 +1783,9 @@ void bind_open_dem(lua_State *L)
         {"particles", l_particles, "s:particles()",
          "Arrays x, y (z), vx, vy (vz), omega (2D) or wx, wy, wz (3D), angle (2D: the integrated "
          "rotation in rad), radius and mass; fx, fy (fz): the total force (N) of the last force "
-         "evaluation (zero before any run); count; tag (with inserters or outflows): a number "
-         "each particle keeps while ids shift on removals."},
+         "evaluation (zero before any run); count; tag (with inserters or outflows, or the ids "
+         "of a LAMMPS data file with gaps): a number each particle keeps while ids shift on "
+         "removals, and the id VTK and LAMMPS files give it."},
         {"set_reference", l_set_reference, "s:set_reference()",
          "Remembers the current positions for displacement measurements."},
         {"scale_mass", l_scale_mass, "s:scale_mass(factor)",

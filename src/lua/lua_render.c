@@ -228,6 +228,7 @@ static void read_walls(lua_State *L, int arg, const char *call, dem_scene *s, sc
         }
         o->def.walls = walls;
         o->def.nwalls = k;
+        o->def.shapes = true; /* and the walls beyond planes, as they are now */
         return;
     }
     if (!lua_istable(L, -1) || !pure_array(L, -1))
@@ -1148,9 +1149,11 @@ void bind_open_render(lua_State *L)
          "(well-separated colours by id), speed |v|, rotation (omega), or an array with one "
          "number per grain, through the colour map with limits range (default: min and max). "
          "walls (default true): the scene's walls where they are now (removed ones not), "
-         "clipped to the box: in 2D a thick line on the wall's outer side, in 3D the outline of "
-         "the wall's section of the box, drawn with the box's edges behind the grains; false: "
-         "none; an array: those walls instead. "
+         "planes clipped to the box: in 2D a thick line on the wall's outer side, in 3D the "
+         "outline of the wall's section of the box, drawn with the box's edges behind the "
+         "grains; polylines and circles (2D) a line along the surface over the grains; meshes "
+         "and cylinders (3D) their triangles' edges, rims and four lines along the axis behind "
+         "the grains; false: none; an array: those planes instead. "
          "show (default box, colorbar): force_chains draws segments between contacting "
          "centres, width and shade proportional to the normal force; rotation a radius line at "
          "each grain's angle (integrated from omega between frames); displacement arrows of the displacement since s:set_reference() less the "

@@ -273,6 +273,58 @@ static int box_section(const double lo[3], const double hi[3], const double p[3]
     return out;
 }
 
+/* ---- walls beyond planes ------------------------------------------------------------------ *
+ * Their outlines now (dem_wall_outline: the wall's current pose, so a moving wall moves), taken
+ * before anything is drawn. */
+enum { SHAPE_SEGMENTS = 96 }; /* points around a circle or a cylinder's rim */
+
+typedef struct shape_lines {
+    double *pts;   /* 3 per point, strip after strip */
+    int *nv, *cyl; /* points of each strip; 1: a rim of a 3D cylinder (paired with the next) */
+    int n;
+} shape_lines;
+
+static void shape_lines_free(shape_lines *o)
+{
+    free(o->pts);
+    free(o->nv);
+    free(o->cyl);
+}
+
+static core_status collect_shapes(dem_scene *s, shape_lines *o, core_error *err)
+{
+    memset(o, 0, sizeof *o);
+    const int nw = dem_wall_count(s);
+    size_t np = 0;
+    int ns = 0;
+    for (int id = 0; id < nw; id++) {
+        size_t k = 0;
+        ns += dem_wall_outline(s, id, SHAPE_SEGMENTS, NULL, NULL, &k);
+        np += k;
+    }
+    if (ns == 0)
+        return CORE_OK;
+    o->pts = malloc(3 * np * sizeof *o->pts);
+    o->nv = malloc((size_t)ns * sizeof *o->nv);
+    o->cyl = malloc((size_t)ns * sizeof *o->cyl);
+    if (!o->pts || !o->nv || !o->cyl) {
+        shape_lines_free(o);
+        memset(o, 0, sizeof *o);
+        return core_fail(err, CORE_ERR_NOMEM, "render: out of memory for the walls");
+    }
+    size_t q = 0;
+    for (int id = 0; id < nw; id++) {
+        size_t k = 0;
+        const int m = dem_wall_outline(s, id, SHAPE_SEGMENTS, o->nv + o->n, o->pts + 3 * q, &k);
+        const int rims = dem_dim(s) == 3 && dem_wall_kind_of(s, id) == DEM_WALL_CYLINDER;
+        for (int j = 0; j < m; j++)
+            o->cyl[o->n + j] = rims && j == 0 && m == 2;
+        o->n += m;
+        q += k;
+    }
+    return CORE_OK;
+}
+
 core_status render_dem(render_context *rc, dem_scene *s, const render_grains_def *def,
                        render_image *out, render_view *view, core_error *err)
 {
@@ -439,19 +491,30 @@ core_status render_dem(render_context *rc, dem_scene *s, const render_grains_def
 #define PX(X) (ox + ((X) - lo[0]) * sc)
 #define PY(Y) (oy + (hi[1] - (Y)) * sc)
 
-    /* Contacts first: if they cannot be had, nothing has been drawn. */
+    /* Contacts and wall outlines first: if they cannot be had, nothing has been drawn. */
     chain_list chains = {0};
     if (def->force_chains && n) {
         dem_each_contact(s, collect_chain, &chains);
         if (chains.oom) {
             free(chains.c);
             free(val);
+            free(proj);
+            free(order);
             return core_fail(err, CORE_ERR_NOMEM, "render: out of memory for force chains");
         }
+    }
+    shape_lines shapes = {0};
+    if (def->shapes && collect_shapes(s, &shapes, err) != CORE_OK) {
+        free(chains.c);
+        free(val);
+        free(proj);
+        free(order);
+        return err ? err->status : CORE_ERR_NOMEM;
     }
 
     core_status st = canvas_begin(rc, W, H, err);
     if (st != CORE_OK) {
+        shape_lines_free(&shapes);
         free(chains.c);
         free(val);
         free(proj);
@@ -485,6 +548,31 @@ core_status render_dem(render_context *rc, dem_scene *s, const render_grains_def
                     break;
                 canvas_segment(rc, PX(P[i][0]), PY(P[i][1]), PX(P[j][0]), PY(P[j][1]), 0.5 * ww, 1,
                                wall_c);
+            }
+        }
+    }
+
+    if (D == 3 && shapes.n) { /* triangles' edges, cylinders' rims and four lines along them */
+        camera3 cam;
+        camera_setup(&def->camera, box_lo, box_hi, g, &cam);
+        const double *pt = shapes.pts;
+        for (int k = 0; k < shapes.n; pt += 3 * shapes.nv[k], k++) {
+            const int nv = shapes.nv[k], close = nv == 3; /* a triangle */
+            double P0[2], P1[2], R, depth;
+            for (int i = 0; i + 1 < nv + close; i++) {
+                const int j = (i + 1) % nv;
+                if (project(&cam, pt + 3 * i, 0, &P0[0], &P0[1], &R, &depth) &&
+                    project(&cam, pt + 3 * j, 0, &P1[0], &P1[1], &R, &depth))
+                    canvas_segment(rc, PX(P0[0]), PY(P0[1]), PX(P1[0]), PY(P1[1]), 0.5 * ww, 1,
+                                   wall_c);
+            }
+            const int step = nv > 8 ? (nv - 1) / 4 : 1;
+            for (int i = 0; shapes.cyl[k] && i + 1 < nv; i += step) {
+                const double *b = pt + 3 * nv; /* the other rim, the same angles */
+                if (project(&cam, pt + 3 * i, 0, &P0[0], &P0[1], &R, &depth) &&
+                    project(&cam, b + 3 * i, 0, &P1[0], &P1[1], &R, &depth))
+                    canvas_segment(rc, PX(P0[0]), PY(P0[1]), PX(P1[0]), PY(P1[1]), 0.5 * ww, 1,
+                                   wall_c);
             }
         }
     }
@@ -586,6 +674,14 @@ core_status render_dem(render_context *rc, dem_scene *s, const render_grains_def
         canvas_segment(rc, PX(a[0]) + sx, PY(a[1]) + sy, PX(b[0]) + sx, PY(b[1]) + sy, ww, 1,
                        wall_c);
     }
+    /* Polylines and circles: a line along the surface, over the grains (a baffle inside a drum
+     * crosses them); their contact points lie within its half width of the surface. */
+    const double *pt = shapes.pts;
+    for (int k = 0; D == 2 && k < shapes.n; pt += 3 * shapes.nv[k], k++)
+        for (int i = 0; i + 1 < shapes.nv[k]; i++)
+            canvas_segment(rc, PX(pt[3 * i]), PY(pt[3 * i + 1]), PX(pt[3 * i + 3]),
+                           PY(pt[3 * i + 4]), 0.6 * ww, 1, wall_c);
+    shape_lines_free(&shapes);
     if (D == 2 && def->box) {
         rgba8 bc = rgba(150, 150, 150, 255);
         double l = ox - 0.5, rt = ox + bw + 0.5, tp = oy - 0.5, bt = oy + bh + 0.5;

@@ -101,6 +101,9 @@ typedef struct render_grains_def {
                                  * 3D: the outline of the plane's section of the box, with the
                                  * box's edges behind the grains (no depth test) */
     int nwalls;
+    bool shapes;                /* the scene's walls beyond planes (polylines, circles, meshes,
+                                 * cylinders) where they are now: 2D a line along the surface over
+                                 * the grains; 3D their edges and rims behind the spheres */
     const char *title;          /* UTF-8 or NULL, top left */
     const char *stamp;          /* UTF-8 or NULL, top right (e.g. "t = 0.125 s") */
     const char *colorbar_label; /* NULL: from the colour mode ("speed (m/s)", ...) */

@@ -46,6 +46,34 @@ else
 end
 print("ok")
 
+-- Tags alone (a LAMMPS data file whose ids have gaps) do run distributed: they travel with their
+-- particles, and the queries give them back. Files are written once (rank 0); every rank reads it.
+do
+  local mine = os.tmpname()
+  local path = grainlab.mpi.bcast(mine)
+  if mine ~= path then os.remove(mine) end
+  local f = assert(io.open(path, "w"))
+  f:write("gaps\n\n6 atoms\n1 atom types\n\n0 0.01 xlo xhi\n0 0.01 ylo yhi\n-0.001 0.001 zlo zhi\n\n",
+          "Atoms # sphere\n\n")
+  local ids = { 2, 5, 7, 9, 12, 40 }
+  for k, id in ipairs(ids) do
+    f:write(string.format("%d 1 0.001 2650 %.17g 0.005 0 0 0 0\n", id, 0.0008 + 0.0016 * (k - 1)))
+  end
+  f:write("\nVelocities\n\n")
+  for k, id in ipairs(ids) do f:write(string.format("%d %g 0 0 0 0 0\n", id, k % 2 == 0 and 0.3 or -0.3)) end
+  f:close()
+  grainlab.mpi.barrier() -- every rank waits for rank 0's file
+  local t = dem.read_lammps_data(path, { material = m })
+  grainlab.mpi.barrier() -- and rank 0 for every reader
+  os.remove(path)
+  t:add_wall{ point = { 0, 0 }, normal = { 1, 0 } }
+  t:add_wall{ point = { 0.01, 0 }, normal = { -1, 0 } }
+  local okt, errt = pcall(t.run, t, { steps = 400, dt = 2e-7 })
+  assert(okt, errt)
+  local tag = t:particles().tag
+  for k, id in ipairs(ids) do assert(tag[k] == id, "tag " .. k .. " after a distributed run: " .. tostring(tag[k])) end
+end
+
 -- A row of 20 disks on the floor of a 20 x 10 mm box with the walls given, disk `k` (0-based)
 -- launched along x at `speed`; the run must stop with an error containing `expect` at the same
 -- step on every rank. Returns the error and the step, as text (every rank checks rank 0's).

@@ -145,6 +145,32 @@ check.eq(#files, 1, "only the particles")
 expect("absent only_contacts.vtu")
 expect("absent only_walls.vtu")
 
+-- ---- Ids are tags: after a removal the indices shift, the id array (which ParaView and OVITO
+-- track a grain by) does not. Disk 1 leaves through the open side; the stack 3-4-5 rests on the
+-- floor, so the contacts name the particles too.
+do
+  local st = dem.scene{ dim = 2, box = { { 0, 0 }, { 0.02, 0.02 } }, gravity = { 0, -9.81 } }
+  st:add_wall{ point = { 0, 0 }, normal = { 0, 1 } }
+  st:add_disk{ pos = { 0.018, 0.015 }, radius = 0.001, vel = { 2, 0 } }  -- leaves through x+
+  st:add_disk{ pos = { 0.003, 0.015 }, radius = 0.001, vel = { -2, 0 } } -- leaves through x-
+  for k = 0, 2 do st:add_disk{ pos = { 0.01, 0.001 + 0.002 * k }, radius = 0.001 } end
+  st:contact{ normal = "linear", stiffness = 1e4, damping = "viscous", gamma_n = 0.05 }
+  st:outflow{ side = "x+" }
+  st:outflow{ side = "x-" }
+  st:run{ time = 0.02 }
+  local pt, ct = st:particles(), st:measure("contacts")
+  check.eq(pt.count, 3, "tags: two of five removed")
+  check.eq(pt.tag[1], 3, "tags: the first left is the third made")
+  check.eq(#ct.i, 3, "tags: floor-3, 3-4, 4-5 in contact")
+  st:write_vtk(P("tags.vtu"))
+  expect("open tags.vtu vtu 3 3")
+  for i = 1, pt.count do expect("point tags.vtu id %d 0 %d", i - 1, pt.tag[i]) end
+  for k = 1, #ct.i do
+    expect("cell tags_contacts.vtu i %d 0 %d", k - 1, pt.tag[ct.i[k]])
+    expect("cell tags_contacts.vtu j %d 0 %d", k - 1, ct.j[k] > 0 and pt.tag[ct.j[k]] or ct.j[k])
+  end
+end
+
 -- ---- Delaunay cells of the pile --------------------------------------------------------------
 local mesh = analysis.delaunay(s)
 s:drag(0)

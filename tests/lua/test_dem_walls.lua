@@ -18,7 +18,9 @@
 --  7. Newton's third law: disks in a rotating polygon, force (frictional: from the particles' total
 --     forces) and torque (frictionless: from the contact list) equal and opposite to round-off;
 --  8. 1 and 2 threads give the same bits for a wall with more than 4096 candidates (the kernel's
---     parallel loop), particles and wall load alike.
+--     parallel loop), particles and wall load alike;
+--  9. a turning flat wall (one segment, 2D; a two-triangle square, 3D): after t the contact
+--     normal is the first one turned by omega t (1e-12).
 local check = grainlab.check
 local g = 9.81
 
@@ -81,18 +83,19 @@ do
     s:add_polyline{ points = { { -0.5, 0 }, { 0, 0 } } }
     return s
   end
-  local c = 0.02 / math.sqrt(2)
+  -- 1 mm from the end point at 0.5 m/s: contact from 2 ms for about t_c = pi sqrt(m/k) = 1 ms
+  local c = (r + 1e-3) / math.sqrt(2)
   local s = scene(c, c, -v / math.sqrt(2), -v / math.sqrt(2))
-  s:run{ time = 0.1, dt = 1e-6 }
+  s:run{ time = 0.005, dt = 1e-6 }
   local P = s:particles()
   -- the direction exactly reversed; the speed within the step's energy error (Verlet, O(dt^2))
   check.near(P.vy[1] / P.vx[1], 1, 1e-12, "end point: bounces straight back (direction)")
   check.near(math.sqrt(P.vx[1] ^ 2 + P.vy[1] ^ 2), v, 1e-5, "end point: elastic (speed)")
   check.gt(P.vx[1], 0, "end point: moving away")
   -- off-axis: the normal is (x - e)/|x - e| whenever the disk touches the end point e = (0, 0)
-  s = scene(0.03, 0.004, -v, 0)
+  s = scene(r + 2e-3, 0.004, -v, 0)
   local seen, worst = 0, 0
-  s:run{ time = 0.1, dt = 1e-6, every = 1, on_step = function(sc)
+  s:run{ time = 0.006, dt = 1e-6, every = 1, on_step = function(sc)
     local C = sc:measure("contacts")
     if C.count > 0 then
       local Q = sc:particles()
@@ -114,7 +117,7 @@ do
     s:contact{ normal = "linear", stiffness = 1e5, damping = "viscous" }
     s:add_disk{ pos = { x, r }, radius = r }
     local w = wall(s)
-    s:run{ time = 0.2 }
+    s:run{ time = 0.05 } -- 50 contact times: the bounce is damped to round-off (e = 0.5)
     return s, w
   end
   local poly = function(s) return s:add_polyline{ points = { { -0.1, 0 }, { 0, 0 }, { 0.1, 0 } } } end
@@ -133,7 +136,7 @@ do
   s:contact{ normal = "linear", stiffness = 1e5, damping = "viscous" }
   s:add_disk{ pos = { 0, r * math.sqrt(2) + 1e-4 }, radius = r }
   local w = s:add_polyline{ points = { { -0.1, 0.1 }, { 0, 0 }, { 0.1, 0.1 } } }
-  s:run{ time = 0.3 }
+  s:run{ time = 0.06 }
   local C = s:measure("contacts")
   check.eq(C.count, 2, "concave corner: two contacts")
   check.near(C.fn[1], m * g / math.sqrt(2), 1e-6, "concave corner: each face m g / sqrt 2")
@@ -147,9 +150,9 @@ do
     local s = dem.scene{ dim = 3, box = { { -0.2, -0.2, -0.1 }, { 0.2, 0.2, 0.2 } },
                          gravity = { 0, 0, -g } }
     s:contact{ normal = "linear", stiffness = 1e5, damping = "viscous" }
-    s:add_sphere{ pos = { x, y, 0.03 }, radius = r }
+    s:add_sphere{ pos = { x, y, r + 2e-3 }, radius = r } -- lands at 0.2 m/s after 20 ms
     local w = wall(s)
-    s:run{ time = 0.5, dt = 1e-5 }
+    s:run{ time = 0.08, dt = 2e-5 }
     return s, w
   end
   local a, b, c, d = { -0.1, -0.1, 0 }, { 0.1, -0.1, 0 }, { 0.1, 0.1, 0 }, { -0.1, 0.1, 0 }
@@ -178,7 +181,7 @@ do
     s:contact{ normal = "linear", stiffness = 1e5, damping = "viscous" }
     s:add_sphere{ pos = pos, radius = r }
     local w = s:add_cylinder(cyl)
-    s:run{ time = 0.5, dt = 1e-5 }
+    s:run{ time = 0.06, dt = 2e-5 }
     return s, w
   end
   local s, w = scene({ 0.03, 0, -(R - r) + 1e-4 }, { center = { 0, 0, 0 }, radius = R, axis = { 1, 0, 0 } })
@@ -195,7 +198,7 @@ do
   s:add_sphere{ pos = { R + 0.3 * r, 0, 0.05 + r + 1e-4 }, radius = r }
   s:add_cylinder{ center = { 0, 0, 0 }, radius = R, axis = { 0, 0, 1 }, inside = false, length = 0.1 }
   local seen, worst = 0, 0
-  s:run{ time = 0.02, dt = 1e-5, every = 1, on_step = function(sc)
+  s:run{ time = 0.012, dt = 2e-5, every = 1, on_step = function(sc)
     local C = sc:measure("contacts")
     if C.count > 0 then
       local Q = sc:particles()
@@ -228,7 +231,7 @@ for _, law in ipairs{ "none", "coulomb_regularized" } do
       k = k + 1
     end
   end
-  s:run{ time = 0.1 }
+  s:run{ time = 0.05 } -- the lowest row reaches the floor
   local f, t = s:wall_load(w)
   for _ = 1, 200 do -- until the wall is touched (undamped disks bounce)
     if f[1] ~= 0 and f[2] ~= 0 then break end
@@ -272,7 +275,7 @@ do
     for k = 0, 4999 do -- resting on the floor, sliding to and fro
       s:add_disk{ pos = { 0.001 + 0.0022 * k, 0.001 }, radius = 0.001, vel = { 0.01 * math.sin(k), 0 } }
     end
-    s:run{ steps = 20, dt = 5e-6 }
+    s:run{ steps = 10, dt = 5e-6 }
     local f, t = s:wall_load(w)
     local P = s:particles()
     local out = { string.format("%a %a %a %a", f[1], f[2], t, s:wall_force(w)) }
@@ -284,5 +287,33 @@ do
   grainlab.threads(1)
   check.lt(fy, 0, "5000 candidates: the wall is loaded")
   check.eq(a, b, "5000 candidates: 1 and 2 threads give the same bits")
+end
+-- 9. -------------------------------------------------------------------------------------------
+-- A turning flat wall is a one-segment polyline (2D) or a two-triangle square (3D) turning about a
+-- point on it: after t its normal is the first one turned by omega t, and a frictionless grain
+-- lying on it sees that normal (1e-12).
+do
+  local r, om = 0.01, 0.5
+  local s = dem.scene{ dim = 2, box = { { -0.2, -0.2 }, { 0.2, 0.2 } }, gravity = { 0, -g } }
+  s:contact{ normal = "linear", stiffness = 1e5, damping = "viscous" }
+  s:add_disk{ pos = { 0, r }, radius = r }
+  s:add_polyline{ points = { { -0.15, 0 }, { 0.15, 0 } }, center = { 0, 0 }, omega = om }
+  s:run{ time = 0.2 }
+  local th, C = om * s:info().time, s:measure("contacts")
+  check.eq(C.count, 1, "turning segment: the disk lies on it")
+  check.near_abs(C.nx[1], -math.sin(th), 1e-12, "turning segment: normal x = -sin(omega t)")
+  check.near_abs(C.ny[1], math.cos(th), 1e-12, "turning segment: normal y = cos(omega t)")
+  check.lt(s:particles().x[1], -1e-3, "turning segment: the disk slides down the tilt")
+  local s3 = dem.scene{ dim = 3, box = { { -0.2, -0.2, -0.2 }, { 0.2, 0.2, 0.2 } }, gravity = { 0, 0, -g } }
+  s3:contact{ normal = "linear", stiffness = 1e5, damping = "viscous" }
+  s3:add_sphere{ pos = { 0.02, 0, r }, radius = r }
+  local a, b, c, d = { -0.15, -0.15, 0 }, { 0.15, -0.15, 0 }, { 0.15, 0.15, 0 }, { -0.15, 0.15, 0 }
+  s3:add_mesh{ triangles = { { a, b, c }, { a, c, d } }, center = { 0, 0, 0 }, omega = { om, 0, 0 } }
+  s3:run{ time = 0.2 }
+  th, C = om * s3:info().time, s3:measure("contacts")
+  check.eq(C.count, 1, "turning square: the sphere lies on it")
+  check.near_abs(C.nx[1], 0, 1e-12, "turning square: normal x = 0")
+  check.near_abs(C.ny[1], -math.sin(th), 1e-12, "turning square: normal y = -sin(omega t)")
+  check.near_abs(C.nz[1], math.cos(th), 1e-12, "turning square: normal z = cos(omega t)")
 end
 check.done()

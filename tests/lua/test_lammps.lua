@@ -197,5 +197,59 @@ walled:add_sphere{ pos = { 0.3, 0.3, 0.3 }, radius = 0.05 }
 check.eq(walled:particles().count, 2, "the scene still takes particles")
 walled:run{ steps = 5 }
 
+-- ---- ids are tags: after removals a dump and a data file give each atom its tag, and a data file
+-- with the gaps reads back with those tags (and writes the same file again) --------------------
+do
+  local function removed_scene()
+    local t = dem.scene{ dim = 2, box = { { 0, 0 }, { 0.02, 0.02 } } }
+    t:add_disk{ pos = { 0.018, 0.01 }, radius = 0.001, vel = { 2, 0 }, material = q }  -- leaves: x+
+    for k = 0, 3 do t:add_disk{ pos = { 0.004 + 0.003 * k, 0.005 }, radius = 0.001, material = q } end
+    t:add_disk{ pos = { 0.003, 0.015 }, radius = 0.001, vel = { -2, 0 }, material = q } -- leaves: x-
+    t:outflow{ side = "x+" }
+    t:outflow{ side = "x-" }
+    t:run{ time = 0.01 }
+    return t
+  end
+  local t = removed_scene()
+  local pt = t:particles()
+  check.eq(pt.count, 4, "ids: two of six removed")
+  check.eq(pt.tag[1], 2, "ids: the first left is the second made")
+  local pdump, pdata = path("tags.dump"), path("tags.data")
+  made[#made + 1], made[#made + 1] = pdump, pdata
+  t:write_lammps_dump(pdump)
+  local ids = {}
+  for id in slurp(pdump):match("ITEM: ATOMS[^\n]*\n(.*)"):gmatch("(%d+) [^\n]*\n") do ids[#ids + 1] = tonumber(id) end
+  check.eq(#ids, 4, "ids: four atoms in the dump")
+  for i = 1, 4 do check.eq(ids[i], pt.tag[i], "ids: dump atom " .. i .. " is its tag") end
+  t:write_lammps_data(pdata)
+  local text = slurp(pdata)
+  check.contains(text, "\nAtoms # sphere\n\n2 ", "ids: the data file's first atom is tag 2")
+  check.contains(text, "\nVelocities\n\n2 ", "ids: and its velocity line")
+  local back = dem.read_lammps_data(pdata)
+  local pb = back:particles()
+  check.eq(#(pb.tag or {}), 4, "ids: non-contiguous ids come back as tags")
+  for i = 1, 4 do check.eq(pb.tag[i], pt.tag[i], "ids: tag " .. i .. " round-trips") end
+  local again = path("tags2.data")
+  made[#made + 1] = again
+  back:write_lammps_data(again)
+  check.eq(slurp(again):match("\n.*"), text:match("\n.*"), "ids: the data file round-trips (all but the title's time)")
+  -- checkpoints keep the tags (a scene that has tags but no inserter or outflow)
+  local ck = path("tags.ckpt")
+  made[#made + 1] = ck
+  back:save(ck)
+  local loaded = dem.load(ck):particles()
+  for i = 1, 4 do check.eq(loaded.tag[i], pt.tag[i], "ids: tag " .. i .. " survives a checkpoint") end
+  -- a new particle takes a number above every id read
+  back:add_disk{ pos = { 0.01, 0.015 }, radius = 0.001 }
+  check.eq(back:particles().tag[5], 6, "ids: the next tag is above the largest id")
+  -- ids 1..n stay indices (no tags); an id that is a tag already is refused
+  check.is_true(dem.read_lammps_data(path("r2.data")):particles().tag == nil, "ids 1..n: no tags")
+  local full = dem.scene{ dim = 2, box = { { 0, 0 }, { 0.02, 0.02 } } }
+  for k = 1, 3 do full:add_disk{ pos = { 0.004 * k, 0.015 }, radius = 0.001 } end
+  check.errors(function() full:read_lammps_data(pdata) end,
+    "atom id 2 is already the tag of particle 2 of the scene", "ids: a clash is refused")
+  check.eq(full:particles().count, 3, "ids: nothing read after the clash")
+end
+
 for _, p in ipairs(made) do os.remove(p) end
 check.done()

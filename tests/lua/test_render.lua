@@ -271,6 +271,69 @@ do
   for yy = 1, 200 do for xx = 1, 200 do if a:pixel(xx, yy) ~= b:pixel(xx, yy) then diff = diff + 1 end end end
   check.gt(diff, 200, "3D: the floor wall's outline is drawn")
 end
+-- ---- walls beyond planes: polylines and circles along their surface, where they are now --------
+do
+  -- a drum (circle, R = 0.04) and a baffle turning at 2 rad/s about the centre: after 0.4 s the
+  -- baffle lies at 0.8 rad; one grain at rest in the middle, away from both
+  local sd = dem.scene{ dim = 2, box = { { -0.05, -0.05 }, { 0.05, 0.05 } }, gravity = { 0, 0 } }
+  sd:add_disk{ pos = { 0, -0.01 }, radius = 0.003 }
+  sd:add_cylinder{ center = { 0, 0 }, radius = 0.04, omega = 2 }
+  sd:add_polyline{ points = { { 0.015, 0 }, { 0.035, 0 } }, center = { 0, 0 }, omega = 2 }
+  sd:run{ time = 0.4, progress = false }
+  local function image(opts)
+    opts.width, opts.height = 400, 400
+    return render.image(sd, opts)
+  end
+  local frame = image{ show = { "box" }, walls = false }
+  local left, right, top, bottom = 400, 1, 400, 1
+  for i = 1, 400 do
+    if frame:pixel(i, 200) < 250 then left, right = math.min(left, i), math.max(right, i) end
+    if frame:pixel(200, i) < 250 then top, bottom = math.min(top, i), math.max(bottom, i) end
+  end
+  check.gt(right - left, 300, "shapes: box found")
+  local with, without = image{ show = {} }, image{ show = {}, walls = false }
+  -- the darkest pixel within 2 px of the image of (x, y)
+  local function dark(im, x, y)
+    local px = left + (x + 0.05) / 0.1 * (right - left)
+    local py = top + (0.05 - y) / 0.1 * (bottom - top)
+    local best = 255
+    for yy = math.floor(py) - 2, math.floor(py) + 2 do
+      for xx = math.floor(px) - 2, math.floor(px) + 2 do best = math.min(best, (im:pixel(xx, yy))) end
+    end
+    return best
+  end
+  local on, off = 0, 0
+  for k = 0, 35 do -- every 10 degrees around the circle
+    local a = math.rad(10 * k)
+    if dark(with, 0.04 * math.cos(a), 0.04 * math.sin(a)) < 120 then on = on + 1 end
+    if dark(without, 0.04 * math.cos(a), 0.04 * math.sin(a)) < 250 then off = off + 1 end
+  end
+  check.eq(on, 36, "shapes: the circle is drawn all round")
+  check.eq(off, 0, "shapes: walls = false draws no circle")
+  local now, before = 0, 0
+  for k = 0, 10 do -- along the baffle, where it is now (0.8 rad) and where it started (0 rad)
+    local rr = 0.015 + 0.002 * k
+    if dark(with, rr * math.cos(0.8), rr * math.sin(0.8)) < 120 then now = now + 1 end
+    if dark(with, rr, 0) < 250 then before = before + 1 end
+  end
+  check.eq(now, 11, "shapes: the turning polyline is drawn where it is now")
+  check.eq(before, 0, "shapes: and not where it was")
+  -- 3D: a mesh's edges and a cylinder's rims are drawn, not with walls = false
+  local s3 = dem.scene{ dim = 3, box = { { -1, -1, -1 }, { 1, 1, 1 } } }
+  s3:add_sphere{ pos = { 0, 0, 0.5 }, radius = 0.05 }
+  s3:add_mesh{ triangles = { { { 0, 0, 0 }, { 1, 0, 0 }, { 0, 1, 0 } } } }
+  local a = render.image(s3, { width = 200, height = 200, show = {} })
+  local b = render.image(s3, { width = 200, height = 200, show = {}, walls = false })
+  local function diff(u, v)
+    local n = 0
+    for yy = 1, 200 do for xx = 1, 200 do if u:pixel(xx, yy) ~= v:pixel(xx, yy) then n = n + 1 end end end
+    return n
+  end
+  check.gt(diff(a, b), 150, "3D: a triangle's edges are drawn")
+  s3:add_cylinder{ center = { 0, 0, 0 }, radius = 0.8, axis = { 0, 0, 1 }, length = 1 }
+  local c = render.image(s3, { width = 200, height = 200, show = {} })
+  check.gt(diff(c, a), 400, "3D: a cylinder's rims are drawn")
+end
 -- ---- grid fields and point clouds on plain arrays (MPM, DSMC) ----------------------------------
 do
   local fdir = os.tmpname()
