@@ -52,6 +52,7 @@
 --       [frequency=20] [ratio=4] [width=24] [depth=4] [t_max=200] [rise_from=2]
 --       [csv=out/brazil_nut.csv] [verbose=false]
 local figures = require("grainlab.figures")
+local pour = dofile((arg[0]:match("^(.*)/") or ".") .. "/pour.lua")
 
 local function int(v) return type(v) == "number" and math.tointeger(v) or nil end
 local packings = int(params.packings or 3)
@@ -127,17 +128,7 @@ local function pack(k, path)
               radius = { 0.8 * r, 1.2 * r }, material = mat, seed = seed + k - 1, attempts = 500 }
   local dt = s:timestep{ impact_velocity = 2 }.limit
   local function advance(T) s:run{ time = T, dt = dt, impact_velocity = 2, progress = false } end
-  local poured = 0
-  repeat
-    advance(0.1)
-    poured = poured + 0.1
-  until s:flow().inserted + s:flow().skipped >= n_small or poured > 2
-  assert(s:flow().skipped <= 0.01 * n_small,
-         string.format("brazil_nut: %d grains found no place to enter", s:flow().skipped))
-  s:drag(20)
-  advance(0.3)
-  s:drag(0)
-  advance(0.2)
+  pour(s, n_small, advance, "brazil_nut")
   s:save(path)
   local P = s:particles()
   -- the bed height: the mean over bins of 2 d of the highest small grain's top

@@ -36,6 +36,7 @@
 -- (a silo only as tall as it is wide drains at a rate that falls with the fill: reduced runs
 -- loosen `steady`)
 local figures = require("grainlab.figures")
+local pour = dofile((arg[0]:match("^(.*)/") or ".") .. "/pour.lua")
 
 local function int(v) return type(v) == "number" and math.tointeger(v) or nil end
 local n = int(params.n or 3000)
@@ -95,17 +96,7 @@ local function fill(D)
               radius = { rmin, rmax }, material = mat, seed = seed, attempts = 500 }
   local dt = s:timestep{ impact_velocity = 2 }.limit
   local function advance(T) s:run{ time = T, dt = dt, impact_velocity = 2, progress = false } end
-  local poured = 0
-  repeat
-    advance(0.1)
-    poured = poured + 0.1
-  until s:flow().inserted + s:flow().skipped >= n or poured > 2
-  local f = s:flow()
-  assert(f.skipped <= 0.01 * n, string.format("silo: %d grains found no place to enter", f.skipped))
-  s:drag(20)
-  advance(0.3)
-  s:drag(0)
-  advance(0.2)
+  pour(s, n, advance, "silo")
   local P = s:particles()
   local h = 0
   for i = 1, P.count do h = math.max(h, P.y[i] + P.radius[i]) end
