@@ -136,7 +136,7 @@ for _, e in ipairs(engines) do
     for k = 1, rounds do
       for q = 0, 2 do
         local mode = modes[(k + q - 1) % 3 + 1]
-        local before = select(3, grainlab.threads(mode[2]))
+        local before = select(3, grainlab.threads()) -- rate() sets the mode
         r[mode[1]] = r[mode[1]] + rate(step, n, mode[2]) / rounds
         local after = select(3, grainlab.threads())
         if mode[1] == "auto" then

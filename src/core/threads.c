@@ -180,12 +180,15 @@ int threads_tune_step(void)
             g.best_s = s;
         /* On all threads, a probe is worth its cost only when our threads waited for a core
          * (another process competes) or the step slowed down; on one, the other process may have
-         * gone: probe on schedule. */
-        const double w = waited_fn();
-        const bool competed = w < 0 || g.wait0 < 0 || w - g.wait0 > WAITED * win * g.choice;
-        g.wait0 = w;
+         * gone: probe on schedule (and the waiting is not read). */
+        bool competed = true;
+        if (g.choice == g.max) {
+            const double w = waited_fn();
+            competed = w < 0 || g.wait0 < 0 || w - g.wait0 > WAITED * win * g.choice;
+            g.wait0 = w;
+        }
         const bool slower = s > SLOWER * g.best_s;
-        if (!slower && (now < g.next || (g.choice == g.max && !competed)))
+        if (!slower && (now < g.next || !competed))
             return 0;
         g.probing = 1;
         g.st.probes++;

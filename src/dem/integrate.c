@@ -746,16 +746,15 @@ core_status dem_run(dem_scene *s, const dem_run_def *run, core_error *err)
     /* A DEM step gives the same bits on any thread count, so the tuner of a shared machine may
      * choose it (core/threads.h) once the step runs threaded (the loops' n > 4096). */
     threads_tune_begin(s, s->n > 4096);
-    if (comm_size() == 1) {
-        core_status st = run_steps(s, run, err);
-        threads_tune_end();
-        return st;
-    }
+    const bool multi = comm_size() > 1;
     comm_stats c0, c1; /* distributed: the time inside communication, for the stats */
-    comm_get_stats(&c0);
+    if (multi)
+        comm_get_stats(&c0);
     core_status st = run_steps(s, run, err);
-    comm_get_stats(&c1);
-    s->dstats.comm_s += c1.seconds - c0.seconds;
+    if (multi) {
+        comm_get_stats(&c1);
+        s->dstats.comm_s += c1.seconds - c0.seconds;
+    }
     threads_tune_end();
     return st;
 }
