@@ -50,6 +50,21 @@ typedef struct raw_hit {
     double dist, q[3];
 } raw_hit;
 
+/* The closest point is vertex i (at v), or on the edge i-j (from a at i to b at j) at a + t (b -
+ * a). */
+static inline void at_vertex(raw_hit *h, uint32_t i, const double *v)
+{
+    h->feat = FEAT_VERTEX, h->fa = i;
+    memcpy(h->q, v, sizeof h->q);
+}
+static inline void at_edge(raw_hit *h, uint32_t i, uint32_t j, const double *a, const double *b,
+                           double t)
+{
+    h->feat = FEAT_EDGE, h->fa = i, h->fb = j;
+    for (int d = 0; d < 3; d++)
+        h->q[d] = a[d] + t * (b[d] - a[d]);
+}
+
 static void seg_closest(const dem_shape *sh, uint32_t k, const double *p, raw_hit *h)
 {
     const uint32_t ia = sh->e[2 * k], ib = sh->e[2 * k + 1];
@@ -58,13 +73,11 @@ static void seg_closest(const dem_shape *sh, uint32_t k, const double *p, raw_hi
     const double ap[3] = {p[0] - a[0], p[1] - a[1], p[2] - a[2]};
     const double t = dot3(ap, ab) / dot3(ab, ab);
     h->elem = k;
-    if (t <= 0) { /* the end points exactly, so that two segments agree on a shared vertex */
-        h->feat = FEAT_VERTEX, h->fa = ia;
-        memcpy(h->q, a, sizeof h->q);
-    } else if (t >= 1) {
-        h->feat = FEAT_VERTEX, h->fa = ib;
-        memcpy(h->q, b, sizeof h->q);
-    } else {
+    if (t <= 0) /* the end points exactly, so that two segments agree on a shared vertex */
+        at_vertex(h, ia, a);
+    else if (t >= 1)
+        at_vertex(h, ib, b);
+    else {
         h->feat = FEAT_FACE;
         for (int d = 0; d < 3; d++)
             h->q[d] = a[d] + t * ab[d];
@@ -84,44 +97,32 @@ static void tri_closest(const dem_shape *sh, uint32_t k, const double *p, raw_hi
     h->elem = k;
     const double d1 = dot3(ab, ap), d2 = dot3(ac, ap);
     if (d1 <= 0 && d2 <= 0) {
-        h->feat = FEAT_VERTEX, h->fa = ia;
-        memcpy(h->q, a, sizeof h->q);
+        at_vertex(h, ia, a);
         return;
     }
     const double d3 = dot3(ab, bp), d4 = dot3(ac, bp);
     if (d3 >= 0 && d4 <= d3) {
-        h->feat = FEAT_VERTEX, h->fa = ib;
-        memcpy(h->q, b, sizeof h->q);
+        at_vertex(h, ib, b);
         return;
     }
     const double vc = d1 * d4 - d3 * d2;
     if (vc <= 0 && d1 >= 0 && d3 <= 0) {
-        const double v = d1 / (d1 - d3);
-        h->feat = FEAT_EDGE, h->fa = ia, h->fb = ib;
-        for (int d = 0; d < 3; d++)
-            h->q[d] = a[d] + v * ab[d];
+        at_edge(h, ia, ib, a, b, d1 / (d1 - d3));
         return;
     }
     const double d5 = dot3(ab, cp), d6 = dot3(ac, cp);
     if (d6 >= 0 && d5 <= d6) {
-        h->feat = FEAT_VERTEX, h->fa = ic;
-        memcpy(h->q, c, sizeof h->q);
+        at_vertex(h, ic, c);
         return;
     }
     const double vb = d5 * d2 - d1 * d6;
     if (vb <= 0 && d2 >= 0 && d6 <= 0) {
-        const double w = d2 / (d2 - d6);
-        h->feat = FEAT_EDGE, h->fa = ia, h->fb = ic;
-        for (int d = 0; d < 3; d++)
-            h->q[d] = a[d] + w * ac[d];
+        at_edge(h, ia, ic, a, c, d2 / (d2 - d6));
         return;
     }
     const double va = d3 * d6 - d5 * d4;
     if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) {
-        const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        h->feat = FEAT_EDGE, h->fa = ib, h->fb = ic;
-        for (int d = 0; d < 3; d++)
-            h->q[d] = b[d] + w * (c[d] - b[d]);
+        at_edge(h, ib, ic, b, c, (d4 - d3) / ((d4 - d3) + (d5 - d6)));
         return;
     }
     const double den = 1 / (va + vb + vc), v = vb * den, w = vc * den;
