@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "core/checkpoint.h"
+#include "dem/checkpoint_reader.h"
 #include "dem/dem_internal.h"
 
 /* ---- saving --------------------------------------------------------------------------------- */
@@ -249,66 +250,7 @@ core_status dem_save(const dem_scene *s, const char *path, const char *version, 
 
 /* ---- loading -------------------------------------------------------------------------------- */
 
-typedef struct reader {
-    ckpt_section sec;
-    core_error *err;
-    core_status st; /* sticky: the first failure */
-} reader;
-
-static uint32_t u32(reader *r)
-{
-    uint32_t v = 0;
-    if (!r->st)
-        r->st = ckpt_get_u32(&r->sec, &v, r->err);
-    return v;
-}
-
-static uint64_t u64(reader *r)
-{
-    uint64_t v = 0;
-    if (!r->st)
-        r->st = ckpt_get_u64(&r->sec, &v, r->err);
-    return v;
-}
-
-static int64_t i64(reader *r)
-{
-    int64_t v = 0;
-    if (!r->st)
-        r->st = ckpt_get_i64(&r->sec, &v, r->err);
-    return v;
-}
-
-static double f64(reader *r)
-{
-    double v = 0;
-    if (!r->st)
-        r->st = ckpt_get_f64(&r->sec, &v, r->err);
-    return v;
-}
-
-static void bytes(reader *r, void *out, size_t len)
-{
-    if (!r->st)
-        r->st = ckpt_get_bytes(&r->sec, out, len, r->err);
-}
-
-static void bad(reader *r, const char *what)
-{
-    if (!r->st)
-        r->st = core_fail(r->err, CORE_ERR_IO, "'%s' is corrupt (section '%s': %s)",
-                          ckpt_reader_path(r->sec.r), r->sec.tag, what);
-}
-
-/* n values into a new array of cap >= n entries. */
-static double *get_new(reader *r, size_t n, size_t cap)
-{
-    if (r->st)
-        return NULL;
-    double *a;
-    r->st = ckpt_get_new_f64s(&r->sec, n, cap, &a, r->err);
-    return a;
-}
+typedef dem_reader reader;
 
 static void get_into(reader *r, double **a, size_t n, size_t cap)
 {
@@ -743,7 +685,7 @@ static void read_all(reader *r, ckpt_reader *ck, const dem_boundary_restorer *re
     if (!r->st && ckpt_has(ck, "flow")) { /* inserters and outflows (flow.c) */
         open_section(r, ck, "flow");
         if (!r->st)
-            r->st = dem_flow_load(s, &r->sec, r->err);
+            r->st = dem_flow_load(s, r);
         close_section(r);
     }
     const char *wrong = r->st ? NULL : inconsistent(s, gear_ready, prev_ready, need_rebuild);

@@ -193,7 +193,8 @@ core_status dem_flow_adopt_tags(dem_scene *s, size_t first, const long long *ids
                                 core_error *err);
 void dem_flow_free(dem_scene *s);
 core_status dem_flow_save(const dem_scene *s, struct ckpt_writer *w, core_error *err);
-core_status dem_flow_load(dem_scene *s, struct ckpt_section *sec, core_error *err);
+struct dem_reader; /* dem/checkpoint_reader.h: the section being read, with its sticky status */
+core_status dem_flow_load(dem_scene *s, struct dem_reader *r);
 
 /* neighbor.c */
 /* The law parameters of two particles of material mat, radius r and mass m each. */

@@ -11,6 +11,7 @@
 #include "core/checkpoint.h"
 #include "core/comm.h"
 #include "core/rng.h"
+#include "dem/checkpoint_reader.h"
 #include "dem/dem_internal.h"
 
 typedef struct inserter {
@@ -807,149 +808,93 @@ core_status dem_flow_save(const dem_scene *s, ckpt_writer *w, core_error *err)
     return ckpt_section_end(w, err);
 }
 
-/* Readers with a sticky status, as checkpoint.c's. */
-typedef struct rd {
-    ckpt_section *sec;
-    core_error *err;
-    core_status st;
-} rd;
-
-static uint32_t get_u32(rd *r)
+core_status dem_flow_load(dem_scene *s, dem_reader *r)
 {
-    uint32_t v = 0;
-    if (!r->st)
-        r->st = ckpt_get_u32(r->sec, &v, r->err);
-    return v;
-}
-static uint64_t get_u64(rd *r)
-{
-    uint64_t v = 0;
-    if (!r->st)
-        r->st = ckpt_get_u64(r->sec, &v, r->err);
-    return v;
-}
-static int64_t get_i64(rd *r)
-{
-    int64_t v = 0;
-    if (!r->st)
-        r->st = ckpt_get_i64(r->sec, &v, r->err);
-    return v;
-}
-static double get_f64(rd *r)
-{
-    double v = 0;
-    if (!r->st)
-        r->st = ckpt_get_f64(r->sec, &v, r->err);
-    return v;
-}
-static void get_bytes(rd *r, void *out, size_t len)
-{
-    if (!r->st)
-        r->st = ckpt_get_bytes(r->sec, out, len, r->err);
-}
-static void corrupt(rd *r, const char *what)
-{
-    if (!r->st)
-        r->st = core_fail(r->err, CORE_ERR_IO, "'%s' is corrupt (section 'flow': %s)",
-                          ckpt_reader_path(r->sec->r), what);
-}
-/* An array of n doubles with its stored count, into a new allocation. */
-static double *get_f64s(rd *r, size_t n, size_t cap)
-{
-    if (r->st)
-        return NULL;
-    double *a;
-    r->st = ckpt_get_new_f64s(r->sec, n, cap, &a, r->err);
-    return a;
-}
-
-core_status dem_flow_load(dem_scene *s, ckpt_section *sec, core_error *err)
-{
-    rd r = {sec, err, CORE_OK};
-    if ((r.st = flow_on(s, err)))
-        return r.st;
+    core_error *err = r->err;
+    if ((r->st = flow_on(s, err)))
+        return r->st;
     dem_flow *f = s->flow;
-    f->next_tag = get_f64(&r);
-    double *tag = get_f64s(&r, s->n, s->cap);
+    f->next_tag = f64(r);
+    double *tag = get_new(r, s->n, s->cap);
     if (tag) {
         free(s->tag);
         s->tag = tag;
     }
-    uint64_t nins = get_u64(&r);
-    if (nins > sec->size / 64)
-        corrupt(&r, "bad inserter count");
-    if (!r.st && nins > 0) {
+    uint64_t nins = u64(r);
+    if (nins > r->sec.size / 64)
+        bad(r, "bad inserter count");
+    if (!r->st && nins > 0) {
         f->ins = calloc(nins, sizeof *f->ins);
         if (!f->ins)
             return core_fail(err, CORE_ERR_NOMEM, "out of memory loading a checkpoint");
         f->cap_ins = (int)nins;
     }
-    for (uint64_t q = 0; q < nins && !r.st; q++) {
+    for (uint64_t q = 0; q < nins && !r->st; q++) {
         inserter *in = &f->ins[f->nins++];
         dem_inserter_def *d = &in->def;
-        d->ball = (int)get_u32(&r);
-        get_bytes(&r, d->lo, sizeof d->lo);
-        get_bytes(&r, d->hi, sizeof d->hi);
-        get_bytes(&r, d->center, sizeof d->center);
-        d->extent = get_f64(&r);
-        d->rate = get_f64(&r);
-        d->count = (long)get_i64(&r);
-        d->mass = get_f64(&r);
-        uint32_t size = get_u32(&r);
+        d->ball = (int)u32(r);
+        bytes(r, d->lo, sizeof d->lo);
+        bytes(r, d->hi, sizeof d->hi);
+        bytes(r, d->center, sizeof d->center);
+        d->extent = f64(r);
+        d->rate = f64(r);
+        d->count = (long)i64(r);
+        d->mass = f64(r);
+        uint32_t size = u32(r);
         if (size > DEM_SIZE_DISCRETE)
-            corrupt(&r, "unknown size distribution");
+            bad(r, "unknown size distribution");
         d->size = (dem_size_law)size;
-        d->r0 = get_f64(&r);
-        d->r1 = get_f64(&r);
+        d->r0 = f64(r);
+        d->r1 = f64(r);
         size_t nr = 0;
-        if (!r.st)
-            r.st = ckpt_peek_count(sec, sec->size / 8, &nr, err);
-        in->radii = get_f64s(&r, nr, nr);
-        in->cum = get_f64s(&r, nr, nr);
+        if (!r->st)
+            r->st = ckpt_peek_count(&r->sec, r->sec.size / 8, &nr, err);
+        in->radii = get_new(r, nr, nr);
+        in->cum = get_new(r, nr, nr);
         d->nsizes = nr;
         d->radii = in->radii;
-        if (!r.st && (d->size == DEM_SIZE_DISCRETE) != (nr > 0))
-            corrupt(&r, "size distribution");
-        get_bytes(&r, d->velocity, sizeof d->velocity);
-        d->spread = get_f64(&r);
-        int64_t mat = get_i64(&r);
+        if (!r->st && (d->size == DEM_SIZE_DISCRETE) != (nr > 0))
+            bad(r, "size distribution");
+        bytes(r, d->velocity, sizeof d->velocity);
+        d->spread = f64(r);
+        int64_t mat = i64(r);
         if (mat < 0 || mat >= s->nmat)
-            corrupt(&r, "unknown material");
+            bad(r, "unknown material");
         d->material = (int)mat;
-        d->seed = get_u64(&r);
-        d->every = (long)get_i64(&r);
-        d->attempts = (int)get_i64(&r);
+        d->seed = u64(r);
+        d->every = (long)i64(r);
+        d->attempts = (int)i64(r);
         if (d->every < 1 || d->attempts < 1)
-            corrupt(&r, "bad event schedule");
-        if (!r.st)
-            r.st = ckpt_get_u64s(sec, in->rng.s, 4, err);
-        in->t0 = get_f64(&r);
-        in->next_step = (long)get_i64(&r);
-        in->c.count = (long)get_i64(&r);
-        in->c.mass = get_f64(&r);
-        in->c.skipped = (long)get_i64(&r);
-        in->c.events = (long)get_i64(&r);
-        in->done = (int)get_u32(&r);
+            bad(r, "bad event schedule");
+        if (!r->st)
+            r->st = ckpt_get_u64s(&r->sec, in->rng.s, 4, err);
+        in->t0 = f64(r);
+        in->next_step = (long)i64(r);
+        in->c.count = (long)i64(r);
+        in->c.mass = f64(r);
+        in->c.skipped = (long)i64(r);
+        in->c.events = (long)i64(r);
+        in->done = (int)u32(r);
     }
-    uint64_t nout = get_u64(&r);
-    if (nout > sec->size / 16)
-        corrupt(&r, "bad outflow count");
-    if (!r.st && nout > 0) {
+    uint64_t nout = u64(r);
+    if (nout > r->sec.size / 16)
+        bad(r, "bad outflow count");
+    if (!r->st && nout > 0) {
         f->out = calloc(nout, sizeof *f->out);
         if (!f->out)
             return core_fail(err, CORE_ERR_NOMEM, "out of memory loading a checkpoint");
         f->cap_out = (int)nout;
     }
-    for (uint64_t o = 0; o < nout && !r.st; o++) {
+    for (uint64_t o = 0; o < nout && !r->st; o++) {
         outflow *of = &f->out[f->nout++];
-        int64_t side = get_i64(&r);
+        int64_t side = i64(r);
         if (side < -1 || side >= 2 * s->dim)
-            corrupt(&r, "unknown side");
+            bad(r, "unknown side");
         of->def.side = (int)side;
-        get_bytes(&r, of->def.lo, sizeof of->def.lo);
-        get_bytes(&r, of->def.hi, sizeof of->def.hi);
-        of->c.count = (long)get_i64(&r);
-        of->c.mass = get_f64(&r);
+        bytes(r, of->def.lo, sizeof of->def.lo);
+        bytes(r, of->def.hi, sizeof of->def.hi);
+        of->c.count = (long)i64(r);
+        of->c.mass = f64(r);
     }
-    return r.st;
+    return r->st;
 }
