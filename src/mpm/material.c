@@ -43,7 +43,7 @@ double mpm_wave_speed(const mpm_material *m)
 double mpm_elastic_energy_density(const mpm_material *m, const double be[4])
 {
     double eps[3], dir[3];
-    if (!log_strains(be, eps, dir))
+    if (!log_strains(be, 0.5 * log(be[3]), eps, dir))
         return NAN;
     double ev = eps[0] + eps[1] + eps[2], e2 = 0;
     for (int i = 0; i < 3; i++) {

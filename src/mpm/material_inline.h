@@ -24,53 +24,64 @@ static inline void eig2(double a, double b, double c, double *l1, double *l2, do
     dir[2] = 0.5 * s2t;
 }
 
-/* Principal log strains of b_e (eps_i = ln(lambda_i) / 2) and the principal directions. */
-static inline bool log_strains(const double be[4], double eps[3], double dir[3])
+/* Principal log strains of b_e (eps_i = ln(lambda_i) / 2) and the principal directions; lz is
+ * ln(b_e,zz) / 2, the caller's (cached) value. lz > -inf is b_e,zz > 0. */
+static inline bool log_strains(const double be[3], double lz, double eps[3], double dir[3])
 {
     double l1, l2;
     eig2(be[0], be[1], be[2], &l1, &l2, dir);
-    if (!(l2 > 0) || !(be[3] > 0))
+    if (!(l2 > 0) || !(lz > -INFINITY))
         return false;
     eps[0] = 0.5 * log(l1);
     eps[1] = 0.5 * log(l2);
-    eps[2] = 0.5 * log(be[3]);
+    eps[2] = lz;
     return true;
 }
 
-/* mpm_material_update (mpm.h). */
-static inline bool material_update(const mpm_material *m, const double f[4], double be[4],
-                                   double *eps_p, double J, double sigma[4])
+/* mpm_material_update (mpm.h) with the out-of-plane stretch split off: be holds the in-plane
+ * b_e (xx, xy, yy); *lz is ln(b_e,zz) / 2, which only a plastic update changes (the zz stretch
+ * of plane strain is elastic-constant otherwise), so the caller caches it instead of taking a
+ * logarithm of b_e,zz every step. A plastic update sets *bzz and *lz = ln(*bzz) / 2 (the
+ * logarithm of the stored value, so a cache rebuilt from b_e,zz holds the same bits); an elastic
+ * one leaves both. Returns -1 (inverted), 0 (elastic) or 1 (plastic). */
+static inline int material_update_zz(const mpm_material *m, const double f[4], double be[3],
+                                     double *bzz, double *lz, double *eps_p, double J,
+                                     double sigma[4])
 {
     if (!(f[0] * f[3] - f[1] * f[2] > 0) || !(J > 0))
-        return false;
+        return -1;
     /* Trial b_e = f b_e f^T (in plane; plane strain keeps the zz stretch). */
     const double b00 = be[0], b01 = be[1], b11 = be[2];
     double t00 = f[0] * b00 + f[1] * b01, t01 = f[0] * b01 + f[1] * b11;
     double t10 = f[2] * b00 + f[3] * b01, t11 = f[2] * b01 + f[3] * b11;
-    double tr[4] = {t00 * f[0] + t01 * f[1], t00 * f[2] + t01 * f[3], t10 * f[2] + t11 * f[3],
-                    be[3]};
+    double tr[3] = {t00 * f[0] + t01 * f[1], t00 * f[2] + t01 * f[3], t10 * f[2] + t11 * f[3]};
     double eps[3], dir[3];
-    if (!log_strains(tr, eps, dir))
-        return false;
+    if (!log_strains(tr, *lz, eps, dir))
+        return -1;
     const double K = m->bulk, G = m->shear;
-    double ev = eps[0] + eps[1] + eps[2], e[3], en = 0;
+    double ev = eps[0] + eps[1] + eps[2], e[3], en2 = 0;
     for (int i = 0; i < 3; i++) {
         e[i] = eps[i] - ev / 3;
-        en += e[i] * e[i];
+        en2 += e[i] * e[i];
     }
-    en = sqrt(en);
     bool plastic = false;
-    if (m->model == MPM_VONMISES && en > 0) {
-        /* Radial return: f = |s| - sqrt(2/3) (yield + H eps_p) with s = 2 G e. */
-        const double k23 = sqrt(2.0 / 3.0);
-        double ftrial = 2 * G * en - k23 * (m->yield + m->hardening * *eps_p);
-        if (ftrial > 0) {
-            double dgamma = ftrial / (2 * G + 2.0 / 3.0 * m->hardening);
-            double scale = 1 - dgamma / en;
-            for (int i = 0; i < 3; i++)
-                e[i] *= scale;
-            *eps_p += k23 * dgamma;
-            plastic = true;
+    if (m->model == MPM_VONMISES) {
+        /* Radial return: f = |s| - sqrt(2/3) (yield + H eps_p) with s = 2 G e. A point whose
+         * (2 G |e|)^2 is below q^2 by more than any rounding (the margin 1e-9) is elastic without
+         * the square root; the others take the test as written, so the decision is the same. */
+        const double k23 = sqrt(2.0 / 3.0), G2 = 2 * G;
+        const double q = k23 * (m->yield + m->hardening * *eps_p);
+        if (!(G2 * G2 * en2 < q * q * (1 - 1e-9))) {
+            const double en = sqrt(en2);
+            double ftrial = G2 * en - q;
+            if (en > 0 && ftrial > 0) {
+                double dgamma = ftrial / (2 * G + 2.0 / 3.0 * m->hardening);
+                double scale = 1 - dgamma / en;
+                for (int i = 0; i < 3; i++)
+                    e[i] *= scale;
+                *eps_p += k23 * dgamma;
+                plastic = true;
+            }
         }
     }
     double tau[3];
@@ -86,7 +97,8 @@ static inline bool material_update(const mpm_material *m, const double f[4], dou
         be[0] = l1 * c2 + l2 * s2;
         be[1] = (l1 - l2) * csn;
         be[2] = l1 * s2 + l2 * c2;
-        be[3] = exp(2 * eps[2]);
+        *bzz = exp(2 * eps[2]);
+        *lz = 0.5 * log(*bzz);
     } else {
         be[0] = tr[0];
         be[1] = tr[1];
@@ -97,7 +109,15 @@ static inline bool material_update(const mpm_material *m, const double f[4], dou
     sigma[1] = (tau[0] * s2 + tau[1] * c2) * inv_j;
     sigma[2] = (tau[0] - tau[1]) * csn * inv_j;
     sigma[3] = tau[2] * inv_j;
-    return true;
+    return plastic;
+}
+
+/* mpm_material_update (mpm.h). */
+static inline bool material_update(const mpm_material *m, const double f[4], double be[4],
+                                   double *eps_p, double J, double sigma[4])
+{
+    double lz = 0.5 * log(be[3]);
+    return material_update_zz(m, f, be, &be[3], &lz, eps_p, J, sigma) >= 0;
 }
 
 #endif

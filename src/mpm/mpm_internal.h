@@ -61,6 +61,11 @@ struct mpm_scene {
     double *sig[4];         /* Cauchy stress: xx, yy, xy, zz */
     double *eps_p;
     double *ux, *uy;        /* displacement */
+    /* ln(b_e,zz) / 2 per point, a cache the step keeps (material_update_zz), not saved: built
+     * from b_e,zz at the start of a run unless lzz_ok (cleared wherever points or b_e are set
+     * outside the step) */
+    double *lzz;
+    bool lzz_ok;
     int *grain, *mat;
     /* stencil, MPM_STENCIL per point */
     int *sn;

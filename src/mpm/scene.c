@@ -205,7 +205,7 @@ static double **point_doubles(mpm_scene *s, int k)
     double **list[] = {&s->x,     &s->y,     &s->vx,     &s->vy,     &s->m,      &s->v0,
                        &s->F[0],  &s->F[1],  &s->F[2],   &s->F[3],   &s->be[0],  &s->be[1],
                        &s->be[2], &s->be[3], &s->sig[0], &s->sig[1], &s->sig[2], &s->sig[3],
-                       &s->eps_p, &s->ux,    &s->uy,     NULL};
+                       &s->eps_p, &s->ux,    &s->uy,     &s->lzz,    NULL};
     return list[k];
 }
 
@@ -541,6 +541,7 @@ long mpm_add_grain(mpm_scene *s, const mpm_grain_def *g, core_error *err)
     s->gstart[s->ngrains] = s->np;
     s->gcount[s->ngrains] = count;
     s->np = p;
+    s->lzz_ok = false;
     /* Nodes lighter than 1e-12 of the lightest point take no acceleration (no division blow-up). */
     if (s->m_min == 0 || 1e-12 * mass < s->m_min)
         s->m_min = 1e-12 * mass;
@@ -768,6 +769,7 @@ core_status mpm_hydrostatic(mpm_scene *s, size_t grain, core_error *err)
             s->sig[k][p] = sig[k];
         }
         s->eps_p[p] = eps;
+        s->lzz_ok = false;
     }
     return CORE_OK;
 }

@@ -1047,6 +1047,7 @@ static inline __attribute__((always_inline)) size_t constitutive_with(mpm_scene 
     const double *const sgx = s->sgx, *const sgy = s->sgy;
     double *const F0 = s->F[0], *const F1 = s->F[1], *const F2 = s->F[2], *const F3 = s->F[3];
     double *const b0 = s->be[0], *const b1 = s->be[1], *const b2 = s->be[2], *const b3 = s->be[3];
+    double *const lzz = s->lzz;
     double *const s0 = s->sig[0], *const s1 = s->sig[1], *const s2 = s->sig[2],
                   *const s3 = s->sig[3];
     double *const eps_p = s->eps_p;
@@ -1074,8 +1075,9 @@ static inline __attribute__((always_inline)) size_t constitutive_with(mpm_scene 
         F2[p] = G2;
         F3[p] = G3;
         const double J = G0 * G3 - G1 * G2;
-        double be[4] = {b0[p], b1[p], b2[p], b3[p]}, sig[4];
-        if (!material_update(&mats[mat[p]], f, be, &eps_p[p], J, sig)) {
+        /* b_e,zz and its logarithm are read and written by a plastic update only */
+        double be[3] = {b0[p], b1[p], b2[p]}, sig[4];
+        if (material_update_zz(&mats[mat[p]], f, be, &b3[p], &lzz[p], &eps_p[p], J, sig) < 0) {
             if (bad == (size_t)-1)
                 bad = p;
             continue;
@@ -1083,7 +1085,6 @@ static inline __attribute__((always_inline)) size_t constitutive_with(mpm_scene 
         b0[p] = be[0];
         b1[p] = be[1];
         b2[p] = be[2];
-        b3[p] = be[3];
         s0[p] = sig[0];
         s1[p] = sig[1];
         s2[p] = sig[2];
@@ -1166,6 +1167,11 @@ static core_status run_steps(mpm_scene *s, const mpm_run_def *run, long *done, c
     }
     if ((st = threads_setup(s, err)))
         return st;
+    if (!s->lzz_ok) {
+        for (size_t p = 0; p < s->np; p++)
+            s->lzz[p] = 0.5 * log(s->be[3][p]);
+        s->lzz_ok = true;
+    }
     s->sf = friction ? s->sv : s->sn;
     const double h = s->hx < s->hy ? s->hx : s->hy;
     mpm_timestep ts;
