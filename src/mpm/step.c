@@ -998,37 +998,63 @@ STAGE static void remap(mpm_scene *s, double dt, int t)
     nodal_velocity(s, dt, false);
 }
 
+/* The end-of-step check's bounds per axis: [lo, hi) of a periodic axis, [lo, hi] (the slack
+ * beyond the grid included) of another. Taken once per pass: inside the point loop, stores to
+ * the point arrays could alias the scene's fields, which would be reloaded at every point. */
+typedef struct {
+    double lo[2], hi[2];
+    bool periodic[2];
+} check_bounds;
+
+static inline check_bounds bounds_of(const mpm_scene *s)
+{
+    check_bounds b;
+    for (int a = 0; a < 2; a++) {
+        const double o = s->def.origin[a], L = s->def.size[a];
+        b.periodic[a] = s->def.periodic[a];
+        b.lo[a] = b.periodic[a] ? o : o - s->slack[a][0];
+        b.hi[a] = b.periodic[a] ? o + L : o + L + s->slack[a][1];
+    }
+    return b;
+}
+
+/* A coordinate outside its periodic axis wrapped back (rare: out of line). */
+static __attribute__((noinline, cold)) void wrap_axis(const mpm_scene *s, int a, double *c)
+{
+    const double o = s->def.origin[a], L = s->def.size[a];
+    *c -= L * floor((*c - o) / L);
+    if (*c >= o + L) /* rounding of a value just below o */
+        *c = o;
+}
+
 /* The end-of-step check of a point at (*x, *y) with velocity (vx, vy) and in-plane stress sig:
  * wraps it on periodic axes; true when it is non-finite or outside the grid on an axis that is
  * not periodic. */
-static inline bool point_bad_at(const mpm_scene *s, double *x, double *y, double vx, double vy,
-                                const double sig[3])
+static inline bool point_bad_at(const mpm_scene *s, const check_bounds *b, double *x, double *y,
+                                double vx, double vy, const double sig[3])
 {
     /* 0 * v is 0 for finite v and NaN for inf or NaN: one test for all seven */
     const double z = 0 * *x + 0 * *y + 0 * vx + 0 * vy + 0 * sig[0] + 0 * sig[1] + 0 * sig[2];
     if (!(z == 0))
         return true;
-    const mpm_scene_def *d = &s->def;
     double *c[2] = {x, y};
     bool bad = false;
     for (int a = 0; a < 2; a++) {
-        double o = d->origin[a], L = d->size[a];
-        if (d->periodic[a]) {
-            if (*c[a] < o || *c[a] >= o + L)
-                *c[a] -= L * floor((*c[a] - o) / L);
-            if (*c[a] >= o + L) /* rounding of a value just below o */
-                *c[a] = o;
-        } else if (*c[a] < o - s->slack[a][0] || *c[a] > o + L + s->slack[a][1]) {
+        const double v = *c[a];
+        if (b->periodic[a]) {
+            if (v < b->lo[a] || v >= b->hi[a])
+                wrap_axis(s, a, c[a]);
+        } else if (v < b->lo[a] || v > b->hi[a]) {
             bad = true;
         }
     }
     return bad;
 }
 
-static inline bool point_bad(mpm_scene *s, size_t p)
+static inline bool point_bad(mpm_scene *s, const check_bounds *b, size_t p)
 {
     const double sig[3] = {s->sig[0][p], s->sig[1][p], s->sig[2][p]};
-    return point_bad_at(s, &s->x[p], &s->y[p], s->vx[p], s->vy[p], sig);
+    return point_bad_at(s, b, &s->x[p], &s->y[p], s->vx[p], s->vy[p], sig);
 }
 
 /* Whether the first bad point (point_bad) is finite but outside the grid (1) or not (0). */
@@ -1060,6 +1086,7 @@ static inline __attribute__((always_inline)) size_t constitutive_with(mpm_scene 
     double *const x = s->x, *const y = s->y;
     const double *const pvx = s->vx, *const pvy = s->vy;
     const mpm_material *const mats = s->mats;
+    const check_bounds cb = bounds_of(s);
     const size_t pb = s->tp[t + 1];
     for (size_t p = s->tp[t]; p < pb; p++) {
         const int *n = &sf[ns * p];
@@ -1097,7 +1124,8 @@ static inline __attribute__((always_inline)) size_t constitutive_with(mpm_scene 
         s3[p] = sig[3];
         /* the end-of-step check, while the point is in cache (one pass and one parallel region
          * fewer per step) */
-        if (check && point_bad_at(s, &x[p], &y[p], pvx[p], pvy[p], sig) && first == (size_t)-1)
+        if (check && point_bad_at(s, &cb, &x[p], &y[p], pvx[p], pvy[p], sig) &&
+            first == (size_t)-1)
             first = p;
     }
     if (check)
@@ -1130,9 +1158,10 @@ static core_status unstable(const mpm_scene *s, size_t p, const char *what, cons
 static size_t check_points(mpm_scene *s)
 {
     size_t first = (size_t)-1;
+    const check_bounds cb = bounds_of(s);
 #pragma omp parallel for schedule(static) reduction(min : first) num_threads(s->nt) if (s->nt > 1)
     for (size_t p = 0; p < s->np; p++)
-        if (point_bad(s, p))
+        if (point_bad(s, &cb, p))
             first = p < first ? p : first;
     return first;
 }
