@@ -24,6 +24,29 @@ mpm_scene_def mpm_default_scene_def(void)
 
 static void *alloc_zero(size_t n, size_t size) { return calloc(n ? n : 1, size); }
 
+/* The arrays a loop walks together at the same index (the point arrays; the nodal arrays, whose
+ * grain entries the scatter accumulates into) each start k cache lines into their block, k their
+ * number below (STAGGER_*). Large blocks from malloc all begin at the same offset within a page,
+ * so element p of twenty arrays would fall into one set of the 8-way first-level cache (and a load
+ * 4 KiB apart from a pending store waits for it): measured on the MPM bench, the stress update's
+ * loop took a third longer with its four check arrays added than without. */
+enum { STAGGER_POINT = 0, STAGGER_INT = 24, STAGGER_STENCIL = 27, STAGGER_NODE = 30 };
+
+static size_t stagger(int k) { return (size_t)(k % 64) * 64; }
+
+static void *realloc_staggered(void *cur, size_t bytes, int k)
+{
+    char *base = cur ? (char *)cur - stagger(k) : NULL;
+    char *p = realloc(base, bytes + stagger(k));
+    return p ? p + stagger(k) : NULL;
+}
+
+static void free_staggered(void *cur, int k)
+{
+    if (cur)
+        free((char *)cur - stagger(k));
+}
+
 /* 1D shape function of the scene's kind at offset t (in cells) from its node. */
 static double shape1(const mpm_scene *s, double t)
 {
@@ -143,11 +166,14 @@ core_status mpm_create(const mpm_scene_def *def, mpm_scene **out, core_error *er
     s->nnodes = (size_t)s->nnx * (size_t)s->nny;
     double **fields[] = {&s->nm,  &s->npx, &s->npy, &s->nfx, &s->nfy,
                          &s->nvx, &s->nvy, &s->nax, &s->nay};
-    for (size_t k = 0; k < sizeof fields / sizeof *fields; k++)
-        if (!(*fields[k] = alloc_zero(s->nnodes, sizeof(double)))) {
+    for (size_t k = 0; k < sizeof fields / sizeof *fields; k++) {
+        const size_t bytes = (s->nnodes ? s->nnodes : 1) * sizeof(double);
+        if (!(*fields[k] = realloc_staggered(NULL, bytes, STAGGER_NODE + (int)k))) {
             mpm_destroy(s);
             return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu grid nodes", s->nnodes);
         }
+        memset(*fields[k], 0, bytes);
+    }
     if (!(s->nwall = alloc_zero(s->nnodes, 1)) || !(s->nwin = alloc_zero(s->nnodes, 1))) {
         mpm_destroy(s);
         return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu grid nodes", s->nnodes);
@@ -213,12 +239,14 @@ void mpm_destroy(mpm_scene *s)
 {
     if (!s)
         return;
-    double *fields[] = {s->nm,  s->npx, s->npy, s->nfx, s->nfy, s->nvx,
-                        s->nvy, s->nax, s->nay, s->sw,  s->sgx, s->sgy};
+    double *fields[] = {s->nm, s->npx, s->npy, s->nfx, s->nfy, s->nvx, s->nvy, s->nax, s->nay};
     for (size_t k = 0; k < sizeof fields / sizeof *fields; k++)
-        free(fields[k]);
+        free_staggered(fields[k], STAGGER_NODE + (int)k);
+    double *stencil[] = {s->sw, s->sgx, s->sgy};
+    for (int k = 0; k < 3; k++)
+        free_staggered(stencil[k], STAGGER_STENCIL + k);
     for (int k = 0; point_doubles(s, k); k++)
-        free(*point_doubles(s, k));
+        free_staggered(*point_doubles(s, k), STAGGER_POINT + k);
     free(s->nwall);
     free(s->nwin);
     free(s->nmx);
@@ -243,9 +271,9 @@ void mpm_destroy(mpm_scene *s)
     free(s->pny);
     free(s->ngr);
     free(s->sv);
-    free(s->grain);
-    free(s->mat);
-    free(s->sn);
+    free_staggered(s->grain, STAGGER_INT);
+    free_staggered(s->mat, STAGGER_INT + 1);
+    free_staggered(s->sn, STAGGER_INT + 2);
     free(s->mats);
     free(s->gstart);
     free(s->gcount);
@@ -296,25 +324,26 @@ static core_status reserve_points(mpm_scene *s, size_t n, core_error *err)
         cap *= 2;
     for (int k = 0; point_doubles(s, k); k++) {
         double **a = point_doubles(s, k);
-        double *p = realloc(*a, cap * sizeof(double));
+        double *p = realloc_staggered(*a, cap * sizeof(double), STAGGER_POINT + k);
         if (!p)
             return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu points", cap);
         *a = p;
     }
     int **ints[] = {&s->grain, &s->mat};
     for (int k = 0; k < 2; k++) {
-        int *p = realloc(*ints[k], cap * sizeof(int));
+        int *p = realloc_staggered(*ints[k], cap * sizeof(int), STAGGER_INT + k);
         if (!p)
             return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu points", cap);
         *ints[k] = p;
     }
-    int *sn = realloc(s->sn, cap * MPM_STENCIL * sizeof(int));
+    int *sn = realloc_staggered(s->sn, cap * MPM_STENCIL * sizeof(int), STAGGER_INT + 2);
     if (!sn)
         return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu points", cap);
     s->sn = sn;
     double **st[] = {&s->sw, &s->sgx, &s->sgy};
     for (int k = 0; k < 3; k++) {
-        double *p = realloc(*st[k], cap * MPM_STENCIL * sizeof(double));
+        double *p =
+            realloc_staggered(*st[k], cap * MPM_STENCIL * sizeof(double), STAGGER_STENCIL + k);
         if (!p)
             return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu points", cap);
         *st[k] = p;
@@ -585,6 +614,16 @@ double mpm_friction(const mpm_scene *s) { return s->contact == MPM_CONTACT_FRICT
         (a) = grown_;                                                                              \
     } while (0)
 
+/* GROW for the staggered arrays (number k). */
+#define GROW_STAGGERED(a, n, k)                                                                    \
+    do {                                                                                           \
+        void *grown_ = realloc_staggered((a), ((n) ? (n) : 1) * sizeof *(a), (k));                 \
+        if (!grown_)                                                                               \
+            return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu contact field entries",   \
+                             (size_t)(n));                                                         \
+        (a) = grown_;                                                                              \
+    } while (0)
+
 core_status mpm_contact_reserve(mpm_scene *s, core_error *err)
 {
     const size_t need = (size_t)s->ns * s->np, nn = s->nnodes;
@@ -601,15 +640,15 @@ core_status mpm_contact_reserve(mpm_scene *s, core_error *err)
     }
     if (need <= s->paircap && s->sv)
         return CORE_OK;
-    GROW(s->nm, nn + need);
-    GROW(s->npx, nn + need);
-    GROW(s->npy, nn + need);
-    GROW(s->nfx, nn + need);
-    GROW(s->nfy, nn + need);
-    GROW(s->nvx, nn + need);
-    GROW(s->nvy, nn + need);
-    GROW(s->nax, nn + need);
-    GROW(s->nay, nn + need);
+    GROW_STAGGERED(s->nm, nn + need, STAGGER_NODE + 0);
+    GROW_STAGGERED(s->npx, nn + need, STAGGER_NODE + 1);
+    GROW_STAGGERED(s->npy, nn + need, STAGGER_NODE + 2);
+    GROW_STAGGERED(s->nfx, nn + need, STAGGER_NODE + 3);
+    GROW_STAGGERED(s->nfy, nn + need, STAGGER_NODE + 4);
+    GROW_STAGGERED(s->nvx, nn + need, STAGGER_NODE + 5);
+    GROW_STAGGERED(s->nvy, nn + need, STAGGER_NODE + 6);
+    GROW_STAGGERED(s->nax, nn + need, STAGGER_NODE + 7);
+    GROW_STAGGERED(s->nay, nn + need, STAGGER_NODE + 8);
     GROW(s->pnode, need);
     GROW(s->pgrain, need);
     GROW(s->pin, need);

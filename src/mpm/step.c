@@ -1124,8 +1124,7 @@ static inline __attribute__((always_inline)) size_t constitutive_with(mpm_scene 
         s3[p] = sig[3];
         /* the end-of-step check, while the point is in cache (one pass and one parallel region
          * fewer per step) */
-        if (check && point_bad_at(s, &cb, &x[p], &y[p], pvx[p], pvy[p], sig) &&
-            first == (size_t)-1)
+        if (check && point_bad_at(s, &cb, &x[p], &y[p], pvx[p], pvy[p], sig) && first == (size_t)-1)
             first = p;
     }
     if (check)
