@@ -1,10 +1,14 @@
 /* MPM kernels without Lua: the single-point constitutive update against closed forms (Hencky
- * uniaxial strain, von Mises yield and hardening slope, rigid rotation), and the scene's refusals
- * of bad input. */
+ * uniaxial strain, von Mises yield and hardening slope, rigid rotation), the scene's refusals
+ * of bad input, and a continuation after mpm_hydrostatic on a scene that has run. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
 #include <cmocka.h>
 
 #include "mpm/mpm.h"
@@ -192,6 +196,78 @@ static void test_friction(void **state)
     assert_true(fabs(pb[1]) < 1e-9 * fabs(p0[0]));
 }
 
+/* A yielding plastic block, 2 steps, then mpm_hydrostatic (which sets b_e, its zz stretch too
+ * since the compression yields), then 5 steps: the same bits as with a save and a load before
+ * the 5 steps. The step caches ln(b_e,zz) per point; a load rebuilds the cache from b_e,zz, so a
+ * stale cache after mpm_hydrostatic would show here. */
+static void hydro_run(bool reload, double out[][5], size_t *np)
+{
+    core_error err;
+    mpm_scene_def def = mpm_default_scene_def();
+    def.cells[0] = 12;
+    def.cells[1] = 12;
+    def.size[0] = 1.2;
+    def.size[1] = 1.2;
+    def.gravity[1] = -10;
+    mpm_scene *s;
+    assert_int_equal(mpm_create(&def, &s, &err), CORE_OK);
+    mpm_material m = {.model = MPM_VONMISES, .density = 1000, .shear = 1e6, .bulk = 3e6,
+                      .yield = 10, .hardening = 0};
+    assert_int_equal(mpm_add_material(s, &m, &err), 0);
+    mpm_grain_def g = mpm_default_grain_def();
+    g.shape = MPM_RECT;
+    g.lo[0] = 0.2;
+    g.lo[1] = 0.05;
+    g.hi[0] = 1.0;
+    g.hi[1] = 0.85;
+    assert_int_equal(mpm_add_grain(s, &g, &err), 0);
+    mpm_run_def run = mpm_default_run_def();
+    run.steps = 2;
+    run.dt = 1e-4;
+    long done;
+    assert_int_equal(mpm_run(s, &run, &done, &err), CORE_OK);
+    assert_int_equal(mpm_hydrostatic(s, 0, &err), CORE_OK);
+    mpm_points pts;
+    mpm_get_points(s, &pts);
+    double ep = 0;
+    for (size_t i = 0; i < mpm_point_count(s); i++)
+        ep += pts.eps_p[i];
+    assert_true(ep > 0); /* the compression yielded: b_e,zz is no longer 1 */
+    if (reload) {
+        char path[256];
+        const char *dir = getenv("TMPDIR");
+        snprintf(path, sizeof path, "%s/grainlab_mpm_hydro_%ld.ckpt", dir ? dir : "/tmp",
+                 (long)getpid());
+        assert_int_equal(mpm_save(s, path, "test", &err), CORE_OK);
+        mpm_destroy(s);
+        assert_int_equal(mpm_load(path, &s, &err), CORE_OK);
+        remove(path);
+    }
+    run.steps = 5;
+    assert_int_equal(mpm_run(s, &run, &done, &err), CORE_OK);
+    mpm_get_points(s, &pts);
+    *np = mpm_point_count(s);
+    assert_true(*np <= 1024);
+    for (size_t i = 0; i < *np; i++) {
+        const double v[5] = {pts.x[i], pts.y[i], pts.sigma[0][i], pts.sigma[1][i],
+                             pts.sigma[3][i]};
+        memcpy(out[i], v, sizeof v);
+    }
+    mpm_destroy(s);
+}
+
+static void test_hydrostatic_after_run(void **state)
+{
+    (void)state;
+    static double a[1024][5], b[1024][5];
+    size_t na, nb;
+    hydro_run(false, a, &na);
+    hydro_run(true, b, &nb);
+    assert_int_equal(na, nb);
+    assert_true(na > 0);
+    assert_memory_equal(a, b, na * sizeof a[0]);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -200,6 +276,7 @@ int main(void)
         cmocka_unit_test(test_rotation),
         cmocka_unit_test(test_bad_input),
         cmocka_unit_test(test_friction),
+        cmocka_unit_test(test_hydrostatic_after_run),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
