@@ -625,6 +625,7 @@ core_status dem_domain_start(dem_scene *s, core_error *err)
                         wl->cand[m2++] = i;
                 }
                 wl->ncand = m2;
+                wl->cand_par_ok = 0;
                 double *c = realloc(wl->cand_fn, (wl->cap_cand ? wl->cap_cand : 1) * sizeof *c);
                 if (!c)
                     st = core_fail(err, CORE_ERR_NOMEM, "cannot allocate wall candidates");
@@ -1137,7 +1138,7 @@ core_status dem_replicate(dem_scene *s, core_error *err)
         size_t nw = bw / (2 * sizeof *acw);
         qsort(acw, nw, 2 * sizeof *acw, cmp_u32x2); /* by wall, then id */
         for (int w = 0; w < s->nwalls; w++)
-            s->walls[w].ncand = 0;
+            s->walls[w].ncand = 0, s->walls[w].cand_par_ok = 0;
         for (size_t k = 0; k < nw && !st; k++) {
             dem_wall *wl = &s->walls[acw[2 * k]];
             if (wl->ncand == wl->cap_cand) {

@@ -449,6 +449,7 @@ static core_status compact(dem_scene *s, const unsigned char *gone, core_error *
             if (wl->cand[e] < n && map[wl->cand[e]] != UINT32_MAX)
                 wl->cand[w++] = map[wl->cand[e]];
         wl->ncand = w;
+        wl->cand_par_ok = 0;
         if (wl->shape) { /* a wall beyond planes keeps its candidates in its shape (walls.c) */
             dem_shape *sh = wl->shape;
             w = 0;

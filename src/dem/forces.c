@@ -3,6 +3,7 @@
  * moments they produce (Eq. 1.4). Pair forces go to per-pair storage, then each particle gathers
  * its own in a fixed order: no atomics, and the same sums for any number of threads. */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "dem/dem_internal.h"

@@ -426,14 +426,17 @@ static double kick_drift_2d(dem_scene *s, double h, double dt, int rot)
     const double ylo = s->periodic[1] ? -DBL_MAX : s->lo[1];
     const double yhi = s->periodic[1] ? DBL_MAX : s->hi[1];
     double m = 0, x0 = DBL_MAX, x1 = -DBL_MAX, y0 = DBL_MAX, y1 = -DBL_MAX;
-    if (gh && rot)
-        KICK_DRIFT_2D_LOOP(1, 1);
-    else if (gh)
+    if (gh)
         KICK_DRIFT_2D_LOOP(1, 0);
-    else if (rot)
-        KICK_DRIFT_2D_LOOP(0, 1);
     else
         KICK_DRIFT_2D_LOOP(0, 0);
+    if (rot) {
+#pragma omp parallel for simd schedule(static) if (n > 4096)
+        for (long i = 0; i < n; i++) {
+            w[i] += h * tq[i] * ii[i];
+            a[i] += dt * w[i];
+        }
+    }
     s->suspect |= (x0 < xlo) | (x1 > xhi) | (y0 < ylo) | (y1 > yhi);
     return m;
 }

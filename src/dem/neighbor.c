@@ -481,6 +481,7 @@ core_status dem_build_pairs(dem_scene *s, core_error *err)
             continue;
         }
         wl->ncand = 0;
+        wl->cand_par_ok = 0;
         for (size_t i = 0; i < n; i++) {
             if (s->ghost && s->ghost[i])
                 continue; /* distributed: walls act on owned particles only */

@@ -52,6 +52,8 @@ void dem_invalidate(dem_scene *s, int list)
     s->watch_on = 0; /* the energy may change from outside: a new reference */
     if (list)
         s->need_rebuild = 1;
+    for (int w = 0; w < s->nwalls; w++) /* laws, materials or masses may have changed */
+        s->walls[w].cand_par_ok = 0;
 }
 
 core_status dem_alloc_array(double **a, size_t n, core_error *err)
@@ -116,7 +118,7 @@ void dem_destroy(dem_scene *s)
     for (int w = 0; w < s->nwalls; w++) {
         for (int d = 0; d < DEM_HIST; d++)
             free(s->walls[w].hist[d]);
-        free(s->walls[w].cand);
+        free(s->walls[w].cand), free(s->walls[w].cand_par);
         dem_shape_free(s->walls[w].shape);
     }
     free(s->walls), free(s->mats);
