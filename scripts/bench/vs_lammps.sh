@@ -126,7 +126,7 @@ echo "mean pair: T = $T s, m_eff = $MEFF kg -> LAMMPS eta_n0 = $ETA; mindlin k_t
 # E / (2 (1 - nu^2)) as pair granular does: the wall gets E (1 - nu) / (1 - nu^2) = E / (1 + nu)
 # so that its contacts have grainlab's (and pair granular's) E* = E / (2 (1 - nu^2)).
 EWALL=$(awk 'BEGIN { printf "%.17g", 30e9 / 1.3 }')
-lammps_input() { # $1 = eta_n0, $2 = damping model, $3 = run line(s)
+lammps_input() { # $1 = eta_n0, $2 = damping model, $3 = run line(s), $4 = a line after read_data
   cat <<LMPIN
 units           si
 atom_style      sphere
@@ -135,6 +135,7 @@ boundary        f f p
 newton          off
 comm_modify     vel yes
 read_data       $DATA
+${4:-}
 neighbor        0.0001 bin
 neigh_modify    delay 0 every 1 check yes
 pair_style      granular
@@ -173,8 +174,11 @@ compare springs 0 velocity 100
 # ---- timing: A B A B ... ----------------------------------------------------------------------
 # LAMMPS: the "Loop time" of its log (the run's steps, no setup), contacts from compute
 # contact/atom at the last step; grainlab: s:run's wall time, s:measure("coordination").
+# On several ranks LAMMPS cuts the box into equal slabs by default; the pile fills the lower part
+# of its box, so one rank held most of it (2 ranks: 8.6 s against 6.0 s balanced). `balance`
+# (shift) gives each rank an equal share of the particles, as a LAMMPS user would.
 lammps_input "$ETA" viscoelastic "thermo $STEPS
-run $STEPS" > "$OUT/in.time"
+run $STEPS" "balance         1.0 shift xy 10 1.05" > "$OUT/in.time"
 load() { uptime | sed 's/.*load average: //; s/,.*//'; }
 # CPU time the hypervisor gave to other guests ("steal", /proc/stat) during a run, as a percentage
 # of the machine's CPU time: on a virtual machine a quiet load average can hide a host that runs

@@ -364,6 +364,7 @@ core_status dem_shape_candidates(dem_scene *s, dem_wall *wl, core_error *err)
     const int D = s->dim;
     sh->ncand = 0;
     wl->ncand = 0;
+    wl->cand_par_ok = 0;
     for (size_t i = 0; i < s->n; i++) {
         const double x[3] = {s->x[0][i], s->x[1][i], D == 3 ? s->x[2][i] : 0};
         const double lim = s->r[i] + s->skin;

@@ -1,8 +1,8 @@
--- The vectorised 2D pair kernel (src/dem/forces_dim.inc, pair_lanes_2) against the scalar one
--- (pair_one), bit for bit. A scene without periodic axes takes the vectorised loop; the same scene
+-- The vectorised pair kernels (src/dem/forces_dim.inc, pair_lanes_2 and pair_lanes_3) against the
+-- scalar one (pair_one), bit for bit, in 2D and 3D. A scene without periodic axes takes the vectorised loop; the same scene
 -- with x periodic takes the scalar loop of the same laws, and its minimum image changes nothing
 -- while no pair reaches across the seam (dx - L * nearbyint(dx / L) = dx - 0 = dx exactly). So a
--- cluster of disks that implodes in the middle of a wide box must follow the same trajectory to
+-- cluster of disks (spheres) that implodes in the middle of a wide box must follow the same trajectory to
 -- the last bit in both scenes, for every law the vectorised loop covers: Hertz and linear, no,
 -- viscous and (with Hertz) Brilliantov damping, no tangential law and the Cundall-Strack spring (with a low
 -- friction so that contacts slide at the Coulomb cap, and the spring's unloading rescale).
@@ -12,19 +12,28 @@ grainlab.threads(1)
 local mat = grainlab.material{ density = 2650, young = 1e8, poisson = 0.3, friction = 0.1,
                                restitution = 0.6 }
 
--- side x side disks on a jittered lattice around the centre of a 0.4 m box, moving inwards.
-local function cluster(periodic, contact)
-  local s = dem.scene{ dim = 2, box = { { 0, 0 }, { 0.4, 0.4 } }, gravity = { 0, 0 },
-                       periodic = { periodic, false } }
+-- side^dim disks (spheres) on a jittered lattice around the centre of a 0.4 m box, moving inwards.
+local function cluster(dim, periodic, contact)
+  local lo, hi, per, g = {}, {}, {}, {}
+  for d = 1, dim do lo[d], hi[d], per[d], g[d] = 0, 0.4, d == 1 and periodic, 0 end
+  local s = dem.scene{ dim = dim, box = { lo, hi }, gravity = g, periodic = per }
   s:contact(contact)
   local rng = grainlab.rng{ seed = 7 }
-  local side, a = 16, 2.1e-3
-  for ix = 0, side - 1 do
-    for iy = 0, side - 1 do
-      local x = 0.2 + (ix - side / 2) * a + rng:uniform(-1e-4, 1e-4)
-      local y = 0.2 + (iy - side / 2) * a + rng:uniform(-1e-4, 1e-4)
-      s:add_disk{ pos = { x, y }, radius = rng:uniform(0.8e-3, 1e-3), material = mat,
-                  vel = { -(x - 0.2) * 300 + rng:normal(0, 0.1), -(y - 0.2) * 300 + rng:normal(0, 0.1) } }
+  local side, a = dim == 2 and 16 or 7, 2.1e-3
+  local idx = {}
+  for d = 1, dim do idx[d] = 0 end
+  for _ = 1, side ^ dim do
+    local pos, vel = {}, {}
+    for d = 1, dim do
+      pos[d] = 0.2 + (idx[d] - side / 2) * a + rng:uniform(-1e-4, 1e-4)
+      vel[d] = -(pos[d] - 0.2) * 300 + rng:normal(0, 0.1)
+    end
+    local add = dim == 2 and s.add_disk or s.add_sphere
+    add(s, { pos = pos, radius = rng:uniform(0.8e-3, 1e-3), material = mat, vel = vel })
+    for d = 1, dim do -- odometer
+      idx[d] = idx[d] + 1
+      if idx[d] < side then break end
+      idx[d] = 0
     end
   end
   return s
@@ -45,25 +54,30 @@ for _, normal in ipairs{ "hertz", "linear" } do
   end
 end
 
-for _, law in ipairs(laws) do
-  local a, b = cluster(false, law.contact), cluster(true, law.contact)
-  local dt = a:timestep().dt_auto
-  local zmax = 0
-  for _ = 1, 6 do
-    a:run{ steps = 250, dt = dt, progress = false }
-    b:run{ steps = 250, dt = dt, progress = false }
-    zmax = math.max(zmax, a:measure("coordination").z)
-  end
-  local pa, pb = a:particles(), b:particles()
-  local differ, spread = 0, 0
-  for i = 1, pa.count do
-    for _, k in ipairs{ "x", "y", "vx", "vy", "fx", "fy" } do
-      if pa[k][i] ~= pb[k][i] then differ = differ + 1 end
+for _, dim in ipairs{ 2, 3 } do
+  for _, law in ipairs(laws) do
+    local name = dim .. "D " .. law.name
+    local a, b = cluster(dim, false, law.contact), cluster(dim, true, law.contact)
+    local dt = a:timestep().dt_auto
+    local zmax = 0
+    for _ = 1, 6 do
+      a:run{ steps = 250, dt = dt, progress = false }
+      b:run{ steps = 250, dt = dt, progress = false }
+      zmax = math.max(zmax, a:measure("coordination").z)
     end
-    spread = math.max(spread, math.abs(pa.x[i] - 0.2), math.abs(pa.y[i] - 0.2))
+    local pa, pb = a:particles(), b:particles()
+    local keys = dim == 2 and { "x", "y", "vx", "vy", "fx", "fy" }
+                 or { "x", "y", "z", "vx", "vy", "vz", "fx", "fy", "fz" }
+    local differ, spread = 0, 0
+    for i = 1, pa.count do
+      for _, k in ipairs(keys) do
+        if pa[k][i] ~= pb[k][i] then differ = differ + 1 end
+      end
+      spread = math.max(spread, math.abs(pa.x[i] - 0.2), math.abs(pa.y[i] - 0.2))
+    end
+    check.gt(zmax, 1, name .. ": the cluster is in contact (mean coordination)")
+    check.lt(spread, 0.15, name .. ": no pair near the seam (largest offset from the centre, m)")
+    check.eq(differ, 0, name .. ": values that differ between the two kernels")
   end
-  check.gt(zmax, 1, law.name .. ": the cluster is in contact (mean coordination)")
-  check.lt(spread, 0.15, law.name .. ": no pair near the seam (largest offset from the centre, m)")
-  check.eq(differ, 0, law.name .. ": values that differ between the two kernels")
 end
 check.done()
