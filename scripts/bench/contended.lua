@@ -17,6 +17,7 @@
 --          far), Hertz + Brilliantov + Cundall-Strack, dt = 1e-7 s.
 --   mpm  : the shear of bench/mpm_shear.lua (369 grains, ~74,000 points, frictional contact),
 --          `mpm_warm` warm cycles.
+--   mpm_noslip : the same with the single centre-of-mass field (noslip; not in the default list).
 --   dsmc : `dsmc_n` disks (default 10^6) of the cooling benchmark (bench/dsmc_cooling.lua).
 -- Every measurement runs for about `seconds` s of wall time (default 5), in `rounds` rounds
 -- (default 2) of the three modes with their order rotated, each mode a fresh start: the auto
@@ -69,7 +70,7 @@ function scenes.dem()
   return function(steps) s:run{ steps = steps, dt = 1e-7, progress = false } end, n,
          string.format("%d disks, %.2f contacts per particle", n, z)
 end
-function scenes.mpm()
+local function mpm_shear(model)
   local L, v, cells = 1.2e-3, 100, 150
   local dt = 0.8 * L / v / 25124
   local pk = grainlab.pack.slab{ size = L, n = 369, diameter = { 31e-6, 57e-6, 250e-6 }, seed = 5 }
@@ -84,12 +85,15 @@ function scenes.mpm()
     if pk.x[i] - pk.r[i] < h then m:prescribe(g, { 0, 0 })
     elseif pk.x[i] + pk.r[i] > L - h then m:prescribe(g, { 0, v }) end
   end
-  m:contact{ model = "friction", mu = 0.3 }
+  if model == "friction" then m:contact{ model = "friction", mu = 0.3 } end
   m:run{ steps = math.tointeger(params.mpm_warm or 50), dt = dt, progress = false }
   local np = m:info().points
   return function(steps) m:run{ steps = steps, dt = dt, progress = false } end, np,
-         string.format("%d points, %d grains, frictional contact", np, #pk.x)
+         string.format("%d points, %d grains, %s contact", np, #pk.x,
+                       model == "friction" and "frictional" or "noslip")
 end
+function scenes.mpm() return mpm_shear("friction") end
+function scenes.mpm_noslip() return mpm_shear("noslip") end
 function scenes.dsmc()
   local n = math.tointeger(params.dsmc_n or 1000000)
   local nu, R = 0.003, 1e-3
@@ -124,7 +128,7 @@ end
 local ok = true -- every rate finite and positive
 local metrics, lines = { processors = P, busy_processes = busy, seconds_per_measurement = seconds }, {}
 for _, e in ipairs(engines) do
-  assert(scenes[e], "engines: dem, mpm, dsmc; got " .. e)
+  assert(scenes[e], "engines: dem, mpm, mpm_noslip, dsmc; got " .. e)
   local step, n, what = scenes[e]()
   lines[#lines + 1] = string.format("%s: %s", e, what)
   for _, cond in ipairs({ "quiet", "contended" }) do

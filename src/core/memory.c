@@ -3,6 +3,21 @@
 #include <stdlib.h>
 #include <unistd.h>
 
+static size_t stagger(int k) { return (size_t)(k % 64) * 64; }
+
+void *core_realloc_staggered(void *cur, size_t bytes, int k)
+{
+    char *base = cur ? (char *)cur - stagger(k) : NULL;
+    char *p = realloc(base, (bytes ? bytes : 1) + stagger(k));
+    return p ? p + stagger(k) : NULL;
+}
+
+void core_free_staggered(void *cur, int k)
+{
+    if (cur)
+        free((char *)cur - stagger(k));
+}
+
 double core_memory_budget(void)
 {
     const char *env = getenv("GRAINLAB_MEMORY_LIMIT");

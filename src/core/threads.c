@@ -102,6 +102,12 @@ int threads_auto(void)
     return !g.fixed;
 }
 
+int threads_max(void)
+{
+    init();
+    return g.max;
+}
+
 /* Seconds the process's threads have waited on a run queue (ready, another task on the core),
  * from Linux's /proc/self/task/<tid>/schedstat (run, wait, slices); -1 where there is none. */
 static double waited(void)

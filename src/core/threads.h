@@ -18,6 +18,11 @@ void threads_set_auto(void);
 /* 1 in auto mode, 0 when the count was fixed. */
 int threads_auto(void);
 
+/* The count outside the tuner's choices: in auto mode all processors (what the tuner compares
+ * one thread with), else the fixed count. A decomposition that must give the same bits whatever
+ * count the tuner picks is made for this many parts (the MPM noslip transfers' chunks). */
+int threads_max(void);
+
 /* Processors available to this process. */
 int threads_available(void);
 

@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "core/checkpoint.h"
+#include "core/memory.h"
 #include "dem/checkpoint_reader.h"
 #include "dem/dem_internal.h"
 
@@ -259,6 +260,27 @@ static void get_into(reader *r, double **a, size_t n, size_t cap)
         free(*a);
         *a = v;
     }
+}
+
+/* get_into for the step's staggered particle arrays (dem_alloc_hot, number k): the values are
+ * copied into a staggered block. */
+static void get_hot(reader *r, double **a, size_t n, size_t cap, int k)
+{
+    double *v = get_new(r, n, cap);
+    if (!v)
+        return;
+    if ((r->st = dem_alloc_hot(a, cap, k, r->err)) == CORE_OK)
+        memcpy(*a, v, n * sizeof *v);
+    free(v);
+}
+
+static void get_opt_hot(reader *r, double **a, size_t n, size_t cap, int k)
+{
+    uint32_t present = u32(r);
+    if (present > 1)
+        bad(r, "bad presence flag");
+    if (present && !r->st)
+        get_hot(r, a, n, cap, k);
 }
 
 static void get_opt(reader *r, double **a, size_t n, size_t cap)
@@ -562,15 +584,15 @@ static void read_all(reader *r, ckpt_reader *ck, const dem_boundary_restorer *re
     s->n = n;
     s->cap = cap;
     for (int d = 0; d < D; d++) {
-        get_into(r, &s->x[d], n, cap);
-        get_into(r, &s->v[d], n, cap);
-        get_into(r, &s->f[d], n, cap);
-        get_into(r, &s->x_build[d], n, cap);
+        get_hot(r, &s->x[d], n, cap, DEM_HOT_X + d);
+        get_hot(r, &s->v[d], n, cap, DEM_HOT_V + d);
+        get_hot(r, &s->f[d], n, cap, DEM_HOT_F + d);
+        get_hot(r, &s->x_build[d], n, cap, DEM_HOT_XB + d);
     }
-    get_into(r, &s->r, n, cap);
-    get_into(r, &s->m, n, cap);
-    get_into(r, &s->inv_m, n, cap);
-    get_into(r, &s->inv_inertia, n, cap);
+    get_hot(r, &s->r, n, cap, DEM_HOT_R);
+    get_hot(r, &s->m, n, cap, DEM_HOT_M);
+    get_hot(r, &s->inv_m, n, cap, DEM_HOT_INV_M);
+    get_hot(r, &s->inv_inertia, n, cap, DEM_HOT_INV_I);
     s->mat = malloc(cap * sizeof *s->mat);
     s->flags = malloc(cap);
     if (!s->mat || !s->flags) {
@@ -589,10 +611,10 @@ static void read_all(reader *r, ckpt_reader *ck, const dem_boundary_restorer *re
         bad(r, "flag array length");
     bytes(r, s->flags, n);
     for (int d = d0; d < 3; d++) {
-        get_opt(r, &s->w[d], n, cap);
-        get_opt(r, &s->tq[d], n, cap);
+        get_opt_hot(r, &s->w[d], n, cap, DEM_HOT_W + d);
+        get_opt_hot(r, &s->tq[d], n, cap, DEM_HOT_TQ + d);
     }
-    get_opt(r, &s->angle, n, cap);
+    get_opt_hot(r, &s->angle, n, cap, DEM_HOT_ANGLE);
     for (int d = 0; d < D; d++) {
         get_opt(r, &s->fext[d], n, cap);
         get_opt(r, &s->x_ref[d], n, cap);

@@ -173,6 +173,7 @@ static inline size_t dem_gid(const dem_scene *s, size_t i) { return s->gid ? s->
 typedef struct dem_parray {
     void **p;
     size_t size;
+    int hot; /* >= 0: a staggered array of that number (DEM_HOT_*), resized as such */
 } dem_parray;
 int dem_particle_arrays(dem_scene *s, dem_parray *a);
 int dem_max_particle_arrays(const dem_scene *s);
@@ -289,6 +290,24 @@ static inline int dem_hist_width(const dem_scene *s) { return dem_rolling_slots(
 void dem_invalidate(dem_scene *s, int list);
 core_status dem_ensure_rotation(dem_scene *s, core_error *err);
 core_status dem_alloc_array(double **a, size_t n, core_error *err);
+/* The particle arrays the step's passes walk together (positions, velocities, forces, build
+ * positions, spins, torques, angles, radii, masses, inverse masses and inertias) start staggered
+ * in their blocks (core_realloc_staggered, number k below): allocated by dem_alloc_hot (scene.c,
+ * checkpoint.c), freed by core_free_staggered with the same number, never by free. */
+enum {
+    DEM_HOT_X = 0, /* x[d]: 0..2 */
+    DEM_HOT_V = 3,
+    DEM_HOT_F = 6,
+    DEM_HOT_XB = 9,
+    DEM_HOT_W = 12,
+    DEM_HOT_TQ = 15,
+    DEM_HOT_ANGLE = 18,
+    DEM_HOT_R,
+    DEM_HOT_M,
+    DEM_HOT_INV_M,
+    DEM_HOT_INV_I
+};
+core_status dem_alloc_hot(double **a, size_t n, int k, core_error *err);
 
 /* boundary.c: pressure tractions, the minimal-boundary penalty, springs and ties, added after
  * the contact forces; the update of the edges every `every` steps (called by dem_run). */

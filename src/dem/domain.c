@@ -33,6 +33,7 @@
 
 #include "core/clock.h"
 #include "core/comm.h"
+#include "core/memory.h"
 #include "dem/dem_internal.h"
 
 /* When to rebalance. A step takes as long as its busiest rank: an imbalance b = max/mean owned
@@ -169,31 +170,32 @@ typedef dem_parray parray;
 static int particle_arrays(dem_scene *s, parray *a)
 {
     int n = 0;
-#define ADD(ptr, sz)                                                                               \
+#define ADD_HOT(ptr, sz, hot)                                                                      \
     do {                                                                                           \
         if (ptr)                                                                                   \
-            a[n++] = (parray){(void **)&(ptr), (sz)};                                              \
+            a[n++] = (parray){(void **)&(ptr), (sz), (hot)};                                       \
     } while (0)
+#define ADD(ptr, sz) ADD_HOT(ptr, sz, -1)
     for (int d = 0; d < 3; d++) {
-        ADD(s->x[d], sizeof(double));
-        ADD(s->v[d], sizeof(double));
-        ADD(s->f[d], sizeof(double));
-        ADD(s->x_build[d], sizeof(double));
+        ADD_HOT(s->x[d], sizeof(double), DEM_HOT_X + d);
+        ADD_HOT(s->v[d], sizeof(double), DEM_HOT_V + d);
+        ADD_HOT(s->f[d], sizeof(double), DEM_HOT_F + d);
+        ADD_HOT(s->x_build[d], sizeof(double), DEM_HOT_XB + d);
         ADD(s->fext[d], sizeof(double));
         ADD(s->x_ref[d], sizeof(double));
         ADD(s->x_prev[d], sizeof(double));
-        ADD(s->w[d], sizeof(double));
-        ADD(s->tq[d], sizeof(double));
+        ADD_HOT(s->w[d], sizeof(double), DEM_HOT_W + d);
+        ADD_HOT(s->tq[d], sizeof(double), DEM_HOT_TQ + d);
         for (int k = 0; k < 6; k++) {
             ADD(s->gear[k][d], sizeof(double));
             ADD(s->gear_w[k][d], sizeof(double));
         }
     }
-    ADD(s->r, sizeof(double));
-    ADD(s->m, sizeof(double));
-    ADD(s->inv_m, sizeof(double));
-    ADD(s->inv_inertia, sizeof(double));
-    ADD(s->angle, sizeof(double));
+    ADD_HOT(s->r, sizeof(double), DEM_HOT_R);
+    ADD_HOT(s->m, sizeof(double), DEM_HOT_M);
+    ADD_HOT(s->inv_m, sizeof(double), DEM_HOT_INV_M);
+    ADD_HOT(s->inv_inertia, sizeof(double), DEM_HOT_INV_I);
+    ADD_HOT(s->angle, sizeof(double), DEM_HOT_ANGLE);
     ADD(s->mat, sizeof(int));
     ADD(s->flags, sizeof(unsigned char));
     ADD(s->tag, sizeof(double));
@@ -201,6 +203,7 @@ static int particle_arrays(dem_scene *s, parray *a)
         for (int k = 0; k < DEM_HIST; k++)
             ADD(s->walls[w].hist[k], sizeof(double));
 #undef ADD
+#undef ADD_HOT
     return n;
 }
 
@@ -243,7 +246,8 @@ static core_status resize(dem_scene *s, const parray *a, int na, size_t n, int l
     if (cap == 0)
         cap = 1;
     for (int k = 0; k < na; k++) {
-        void *q = realloc(*a[k].p, cap * a[k].size);
+        void *q = a[k].hot >= 0 ? core_realloc_staggered(*a[k].p, cap * a[k].size, a[k].hot)
+                                : realloc(*a[k].p, cap * a[k].size);
         if (!q)
             return core_fail(err, CORE_ERR_NOMEM, "cannot allocate %zu particles", cap);
         *a[k].p = q;

@@ -3,6 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/memory.h"
 #include "dem/dem_internal.h"
 
 dem_scene_def dem_default_scene_def(void)
@@ -54,6 +55,15 @@ void dem_invalidate(dem_scene *s, int list)
         s->need_rebuild = 1;
     for (int w = 0; w < s->nwalls; w++) /* laws, materials or masses may have changed */
         s->walls[w].cand_par_ok = 0;
+}
+
+core_status dem_alloc_hot(double **a, size_t n, int k, core_error *err)
+{
+    double *p = core_realloc_staggered(*a, (n ? n : 1) * sizeof *p, k);
+    if (!p)
+        return core_fail(err, CORE_ERR_NOMEM, "cannot allocate %zu values", n);
+    *a = p;
+    return CORE_OK;
 }
 
 core_status dem_alloc_array(double **a, size_t n, core_error *err)
@@ -108,13 +118,19 @@ void dem_destroy(dem_scene *s)
     dem_clear_boundary(s);
     dem_flow_free(s);
     for (int d = 0; d < 3; d++) {
-        free(s->x[d]), free(s->v[d]), free(s->f[d]), free(s->w[d]), free(s->tq[d]);
-        free(s->x_build[d]), free(s->x_ref[d]), free(s->x_prev[d]), free(s->fext[d]);
+        core_free_staggered(s->x[d], DEM_HOT_X + d), core_free_staggered(s->v[d], DEM_HOT_V + d);
+        core_free_staggered(s->f[d], DEM_HOT_F + d), core_free_staggered(s->w[d], DEM_HOT_W + d);
+        core_free_staggered(s->tq[d], DEM_HOT_TQ + d);
+        core_free_staggered(s->x_build[d], DEM_HOT_XB + d);
+        free(s->x_ref[d]), free(s->x_prev[d]), free(s->fext[d]);
         for (int k = 0; k < 6; k++)
             free(s->gear[k][d]), free(s->gear_w[k][d]);
     }
-    free(s->r), free(s->m), free(s->inv_m), free(s->inv_inertia), free(s->mat), free(s->flags);
-    free(s->angle);
+    core_free_staggered(s->r, DEM_HOT_R), core_free_staggered(s->m, DEM_HOT_M);
+    core_free_staggered(s->inv_m, DEM_HOT_INV_M);
+    core_free_staggered(s->inv_inertia, DEM_HOT_INV_I);
+    free(s->mat), free(s->flags);
+    core_free_staggered(s->angle, DEM_HOT_ANGLE);
     for (int w = 0; w < s->nwalls; w++) {
         for (int d = 0; d < DEM_HIST; d++)
             free(s->walls[w].hist[d]);
@@ -262,13 +278,13 @@ static core_status grow(dem_scene *s, size_t need, core_error *err)
         cap *= 2;
     core_status st = CORE_OK;
     for (int d = 0; d < s->dim && st == CORE_OK; d++) {
-        st = dem_alloc_array(&s->x[d], cap, err);
+        st = dem_alloc_hot(&s->x[d], cap, DEM_HOT_X + d, err);
         if (st == CORE_OK)
-            st = dem_alloc_array(&s->v[d], cap, err);
+            st = dem_alloc_hot(&s->v[d], cap, DEM_HOT_V + d, err);
         if (st == CORE_OK)
-            st = dem_alloc_array(&s->f[d], cap, err);
+            st = dem_alloc_hot(&s->f[d], cap, DEM_HOT_F + d, err);
         if (st == CORE_OK)
-            st = dem_alloc_array(&s->x_build[d], cap, err);
+            st = dem_alloc_hot(&s->x_build[d], cap, DEM_HOT_XB + d, err);
         if (st == CORE_OK && s->x_ref[d])
             st = dem_alloc_array(&s->x_ref[d], cap, err);
         if (st == CORE_OK && s->x_prev[d])
@@ -285,9 +301,9 @@ static core_status grow(dem_scene *s, size_t need, core_error *err)
     }
     for (int d = 0; d < 3 && st == CORE_OK; d++) {
         if (s->w[d])
-            st = dem_alloc_array(&s->w[d], cap, err);
+            st = dem_alloc_hot(&s->w[d], cap, DEM_HOT_W + d, err);
         if (st == CORE_OK && s->tq[d])
-            st = dem_alloc_array(&s->tq[d], cap, err);
+            st = dem_alloc_hot(&s->tq[d], cap, DEM_HOT_TQ + d, err);
         for (int k = 0; k < 6 && st == CORE_OK; k++)
             if (s->gear_w[k][d])
                 st = dem_alloc_array(&s->gear_w[k][d], cap, err);
@@ -301,17 +317,17 @@ static core_status grow(dem_scene *s, size_t need, core_error *err)
                 }
     }
     if (st == CORE_OK && s->angle)
-        st = dem_alloc_array(&s->angle, cap, err);
+        st = dem_alloc_hot(&s->angle, cap, DEM_HOT_ANGLE, err);
     if (st == CORE_OK && s->tag)
         st = dem_alloc_array(&s->tag, cap, err);
     if (st == CORE_OK)
-        st = dem_alloc_array(&s->r, cap, err);
+        st = dem_alloc_hot(&s->r, cap, DEM_HOT_R, err);
     if (st == CORE_OK)
-        st = dem_alloc_array(&s->m, cap, err);
+        st = dem_alloc_hot(&s->m, cap, DEM_HOT_M, err);
     if (st == CORE_OK)
-        st = dem_alloc_array(&s->inv_m, cap, err);
+        st = dem_alloc_hot(&s->inv_m, cap, DEM_HOT_INV_M, err);
     if (st == CORE_OK)
-        st = dem_alloc_array(&s->inv_inertia, cap, err);
+        st = dem_alloc_hot(&s->inv_inertia, cap, DEM_HOT_INV_I, err);
     if (st != CORE_OK)
         return st;
     int *mat = realloc(s->mat, cap * sizeof *mat);
@@ -338,13 +354,13 @@ core_status dem_ensure_rotation(dem_scene *s, core_error *err)
     size_t cap = s->cap ? s->cap : 1;
     int d0 = s->dim == 2 ? 2 : 0;
     for (int d = d0; d < 3; d++) {
-        if (dem_alloc_array(&s->w[d], cap, err) || dem_alloc_array(&s->tq[d], cap, err))
+        if (dem_alloc_hot(&s->w[d], cap, DEM_HOT_W + d, err) || dem_alloc_hot(&s->tq[d], cap, DEM_HOT_TQ + d, err))
             return err ? err->status : CORE_ERR_NOMEM;
         memset(s->w[d], 0, cap * sizeof(double));
         memset(s->tq[d], 0, cap * sizeof(double));
     }
     if (s->dim == 2) {
-        if (dem_alloc_array(&s->angle, cap, err))
+        if (dem_alloc_hot(&s->angle, cap, DEM_HOT_ANGLE, err))
             return err ? err->status : CORE_ERR_NOMEM;
         memset(s->angle, 0, cap * sizeof(double));
     }

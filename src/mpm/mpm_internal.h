@@ -101,11 +101,17 @@ struct mpm_scene {
 
     /* threads: nt contiguous point ranges [tp[t], tp[t+1]) aligned to grains (tg[t] the first
      * grain of range t), so that a grain's points, its per-grain field entries and the nodes
-     * only it touches belong to one thread; per-thread scratch: marks (nt x nnodes) and the
-     * noslip transfer's node buffers (nt - 1 x 5 x nnodes) */
+     * only it touches belong to one thread; per-thread scratch: marks (nt x nnodes) */
     int nt, ntcap;
     size_t *tp, *tg, *tq, *tc;
     int *tmark;
+    /* The noslip transfers' chunks: nc grain-aligned point ranges [cp[c], cp[c+1]); thread t
+     * scatters chunks t, t + nt, ... each into its own node arrays (chunk 0: the scene's, chunk c
+     * > 0: tbuf's (c - 1)-th 5 x nnodes block), added up in chunk order. nc is the processor
+     * count in auto mode whatever the thread count of the moment (so the tuner may run a noslip
+     * step on one thread: the same bits), else the thread count. */
+    int nc, nccap;
+    size_t *cp;
     double *tbuf;
 
     mpm_contact_model contact;

@@ -285,6 +285,7 @@ void mpm_destroy(mpm_scene *s)
     free(s->tc);
     free(s->tmark);
     free(s->tbuf);
+    free(s->cp);
     free(s);
 }
 

@@ -46,20 +46,67 @@ void mpm_timings(const mpm_scene *s, double seconds[MPM_NSTAGES], long *steps)
         }                                                                                          \
     } while (0)
 
-/* Threads: every parallel region runs s->nt threads, thread t on points [tp[t], tp[t+1]). The
- * ranges and all reductions are fixed for a thread count, so results are the same bits run
- * after run (and differ from another thread count only by summation order). */
+/* n grain-aligned ranges of about np / n points each: range t is points [tp[t], tp[t+1]), its
+ * first grain tg[t] (tg may be NULL). */
+static void grain_ranges(const mpm_scene *s, int n, size_t *tp, size_t *tg)
+{
+    size_t g = 0, gprev = 0;
+    tp[0] = 0;
+    if (tg)
+        tg[0] = 0;
+    for (int t = 1; t < n; t++) {
+        const size_t want = s->np * (size_t)t / (size_t)n;
+        while (g < s->ngrains && s->gstart[g] + s->gcount[g] <= want)
+            g++;
+        if (g < s->ngrains && want - s->gstart[g] > s->gstart[g] + s->gcount[g] - want)
+            g++; /* the boundary nearer to the target */
+        if (g <= gprev)
+            g = gprev + 1 < s->ngrains ? gprev + 1 : s->ngrains;
+        gprev = g;
+        if (tg)
+            tg[t] = g;
+        tp[t] = g < s->ngrains ? s->gstart[g] : s->np;
+    }
+    if (tg)
+        tg[n] = s->ngrains;
+    tp[n] = s->np;
+}
+
+/* A thread or chunk count for this scene: n within [1, min(64, grains)], 1 below 8192 points. */
+static int clamp_count(const mpm_scene *s, int n)
+{
+    if (s->np < 8192)
+        n = 1;
+    if (n > 64)
+        n = 64;
+    if (n > (int)s->ngrains)
+        n = (int)s->ngrains;
+    return n < 1 ? 1 : n;
+}
+
+/* Threads: every parallel region runs s->nt threads, thread t on points [tp[t], tp[t+1]); the
+ * noslip transfers scatter by chunks (mpm_internal.h). The ranges and all reductions are fixed
+ * for a thread count (friction: for any thread count; noslip: for a chunk count), so results are
+ * the same bits run after run. */
 static core_status threads_setup(mpm_scene *s, core_error *err)
 {
-    int nt = threads_get();
-    if (s->np < 8192)
-        nt = 1;
-    if (nt > 64)
-        nt = 64;
-    if (nt > (int)s->ngrains)
-        nt = (int)s->ngrains;
-    if (nt < 1)
-        nt = 1;
+    const int nt = clamp_count(s, threads_get());
+    const int nc = s->contact == MPM_CONTACT_FRICTION
+                       ? 1
+                       : clamp_count(s, threads_max());
+    if (nc > s->nccap || !s->cp) {
+        size_t *a = realloc(s->cp, (size_t)(nc + 1) * sizeof *a);
+        if (!a)
+            return core_fail(err, CORE_ERR_NOMEM, "out of memory for %d chunks", nc);
+        s->cp = a;
+        free(s->tbuf);
+        s->tbuf = nc > 1 ? malloc((size_t)(nc - 1) * 5 * s->nnodes * sizeof *s->tbuf) : NULL;
+        if (nc > 1 && !s->tbuf)
+            return core_fail(err, CORE_ERR_NOMEM, "out of memory for %d chunks", nc);
+        s->nccap = nc;
+    }
+    s->nc = nc;
+    grain_ranges(s, nc, s->cp, NULL);
     if (nt > s->ntcap || !s->tp) {
         size_t **ranges[4] = {&s->tp, &s->tg, &s->tq, &s->tc};
         for (int r = 0; r < 4; r++) {
@@ -69,33 +116,15 @@ static core_status threads_setup(mpm_scene *s, core_error *err)
             *ranges[r] = a;
         }
         free(s->tmark);
-        free(s->tbuf);
         s->tmark = malloc((size_t)nt * s->nnodes * sizeof *s->tmark);
-        s->tbuf = nt > 1 ? malloc((size_t)(nt - 1) * 5 * s->nnodes * sizeof *s->tbuf) : NULL;
-        if (!s->tmark || (nt > 1 && !s->tbuf))
+        if (!s->tmark)
             return core_fail(err, CORE_ERR_NOMEM, "out of memory for %d threads", nt);
         for (size_t i = 0; i < (size_t)nt * s->nnodes; i++)
             s->tmark[i] = -1;
         s->ntcap = nt;
     }
     s->nt = nt;
-    /* grain-aligned ranges with about np / nt points each */
-    s->tg[0] = 0;
-    s->tp[0] = 0;
-    size_t g = 0;
-    for (int t = 1; t < nt; t++) {
-        const size_t want = s->np * (size_t)t / (size_t)nt;
-        while (g < s->ngrains && s->gstart[g] + s->gcount[g] <= want)
-            g++;
-        if (g < s->ngrains && want - s->gstart[g] > s->gstart[g] + s->gcount[g] - want)
-            g++; /* the boundary nearer to the target */
-        if (g <= s->tg[t - 1])
-            g = s->tg[t - 1] + 1 < s->ngrains ? s->tg[t - 1] + 1 : s->ngrains;
-        s->tg[t] = g;
-        s->tp[t] = g < s->ngrains ? s->gstart[g] : s->np;
-    }
-    s->tg[nt] = s->ngrains;
-    s->tp[nt] = s->np;
+    grain_ranges(s, nt, s->tp, s->tg);
     return CORE_OK;
 }
 
@@ -304,38 +333,40 @@ static void to_grid_range(const mpm_scene *s, size_t pa, size_t pb, double *cons
     }
 }
 
-/* The nodal arrays of thread t: the scene's for t = 0, else its buffer (n arrays of nn). */
-static void thread_arrays(mpm_scene *s, int t, double *const main[], int n, double *out[])
+/* The nodal arrays of noslip chunk c: the scene's for c = 0, else its buffer (n arrays of nn). */
+static void chunk_arrays(mpm_scene *s, int c, double *const main[], int n, double *out[])
 {
     for (int k = 0; k < n; k++)
-        out[k] = t == 0 ? main[k] : s->tbuf + ((size_t)(t - 1) * 5 + (size_t)k) * s->nnodes;
+        out[k] = c == 0 ? main[k] : s->tbuf + ((size_t)(c - 1) * 5 + (size_t)k) * s->nnodes;
 }
 
-/* Adds the threads' buffers to the nodal arrays, in thread order (inside the parallel region,
- * after every thread has scattered). */
+/* Adds the chunks' buffers to the nodal arrays, in chunk order (inside the parallel region,
+ * after every chunk has been scattered): node by node the same sums on any thread count. */
 static void reduce_buffers(mpm_scene *s, double *const main[], int n)
 {
-    if (s->nt == 1)
+    if (s->nc == 1)
         return;
     const size_t nn = s->nnodes;
 #pragma omp barrier
 #pragma omp for schedule(static)
     for (size_t i = 0; i < nn; i++)
-        for (int u = 1; u < s->nt; u++)
+        for (int u = 1; u < s->nc; u++)
             for (int k = 0; k < n; k++)
                 main[k][i] += s->tbuf[((size_t)(u - 1) * 5 + (size_t)k) * nn + i];
 }
 
-/* The centre-of-mass transfer (noslip), inside the parallel region: each thread scatters its
- * points into its own arrays, then they are added up. */
+/* The centre-of-mass transfer (noslip), inside the parallel region: thread t scatters its chunks'
+ * points into their arrays, then they are added up. */
 static void to_grid(mpm_scene *s, int t)
 {
     double *const main[5] = {s->nm, s->npx, s->npy, s->nfx, s->nfy};
-    double *f[5];
-    thread_arrays(s, t, main, 5, f);
-    for (int k = 0; k < 5; k++)
-        memset(f[k], 0, s->nnodes * sizeof(double));
-    to_grid_range(s, s->tp[t], s->tp[t + 1], f);
+    for (int c = t; c < s->nc; c += s->nt) {
+        double *f[5];
+        chunk_arrays(s, c, main, 5, f);
+        for (int k = 0; k < 5; k++)
+            memset(f[k], 0, s->nnodes * sizeof(double));
+        to_grid_range(s, s->cp[c], s->cp[c + 1], f);
+    }
     reduce_buffers(s, main, 5);
 }
 
@@ -921,30 +952,13 @@ STAGE static void nodal_velocity(mpm_scene *s, double dt, bool decide)
     }
 }
 
-/* Scatters a per-point vector into the entries each point feeds (sf: its grain's entry at shared
- * nodes, the centre of mass elsewhere) of the arrays a, b: momentum m_p v_p (force = false) or
- * the internal force and gravity (Eq. 7) from the current stress (force = true); at shared nodes
- * the centre of mass then takes the sum of the grains' entries. Inside the parallel region. With
- * friction every entry a point feeds belongs to its thread (its grain's, or a node only its grain
- * touches); noslip scatters into thread buffers. */
+/* scatter_sf_with's points [pa, pb) into the arrays f[0], f[1]. */
 static inline __attribute__((always_inline)) void
-scatter_sf_with(mpm_scene *s, int t, double *a, double *b, bool force, const int ns)
+scatter_sf_range(const mpm_scene *s, size_t pa, size_t pb, double *const f[2], bool force,
+                 const int ns)
 {
-    const size_t nn = s->nnodes, ne = s->nnodes + s->npairs;
-    const bool friction = s->contact == MPM_CONTACT_FRICTION;
     const double gx0 = s->def.gravity[0], gy0 = s->def.gravity[1];
-    double *const main[2] = {a, b};
-    double *f[2] = {a, b};
-    if (friction) {
-#pragma omp for schedule(static)
-        for (size_t i = 0; i < ne; i++)
-            a[i] = b[i] = 0;
-    } else {
-        thread_arrays(s, t, main, 2, f);
-        memset(f[0], 0, nn * sizeof(double));
-        memset(f[1], 0, nn * sizeof(double));
-    }
-    for (size_t p = s->tp[t]; p < s->tp[t + 1]; p++) {
+    for (size_t p = pa; p < pb; p++) {
         const double m = s->m[p];
         double A = m * s->vx[p], B = m * s->vy[p], sxx = 0, syy = 0, sxy = 0;
         if (force) {
@@ -967,18 +981,42 @@ scatter_sf_with(mpm_scene *s, int t, double *a, double *b, bool force, const int
                 f[1][n[k]] -= sxy * gx[k] + syy * gy[k];
             }
     }
-    if (friction) {
+}
+
+/* Scatters a per-point vector into the entries each point feeds (sf: its grain's entry at shared
+ * nodes, the centre of mass elsewhere) of the arrays a, b: momentum m_p v_p (force = false) or
+ * the internal force and gravity (Eq. 7) from the current stress (force = true); at shared nodes
+ * the centre of mass then takes the sum of the grains' entries. Inside the parallel region. With
+ * friction every entry a point feeds belongs to its thread (its grain's, or a node only its grain
+ * touches); noslip scatters by chunks (to_grid). */
+static inline __attribute__((always_inline)) void
+scatter_sf_with(mpm_scene *s, int t, double *a, double *b, bool force, const int ns)
+{
+    const size_t nn = s->nnodes, ne = s->nnodes + s->npairs;
+    double *const main[2] = {a, b};
+    if (s->contact != MPM_CONTACT_FRICTION) {
+        for (int c = t; c < s->nc; c += s->nt) {
+            double *f[2];
+            chunk_arrays(s, c, main, 2, f);
+            memset(f[0], 0, nn * sizeof(double));
+            memset(f[1], 0, nn * sizeof(double));
+            scatter_sf_range(s, s->cp[c], s->cp[c + 1], f, force, ns);
+        }
+        reduce_buffers(s, main, 2);
+        return;
+    }
+#pragma omp for schedule(static)
+    for (size_t i = 0; i < ne; i++)
+        a[i] = b[i] = 0;
+    scatter_sf_range(s, s->tp[t], s->tp[t + 1], main, force, ns);
 #pragma omp barrier
 #pragma omp master
-        for (size_t q = 0; q < s->npairs; q++)
-            if (s->ngr[s->pnode[q]] > 1) {
-                a[s->pnode[q]] += a[nn + q];
-                b[s->pnode[q]] += b[nn + q];
-            }
+    for (size_t q = 0; q < s->npairs; q++)
+        if (s->ngr[s->pnode[q]] > 1) {
+            a[s->pnode[q]] += a[nn + q];
+            b[s->pnode[q]] += b[nn + q];
+        }
 #pragma omp barrier
-    } else {
-        reduce_buffers(s, main, 2);
-    }
 }
 
 /* scatter_sf_with with ns = 4 (linear shapes) a constant: the stencil loops unroll. */
@@ -1169,11 +1207,11 @@ static core_status run_steps(mpm_scene *s, const mpm_run_def *run, long *done, c
 
 core_status mpm_run(mpm_scene *s, const mpm_run_def *run, long *done, core_error *err)
 {
-    /* With frictional contact a step gives the same bits on any thread count (every grain's
-     * nodal entries are built by one thread and packed in grain order), so the tuner of a shared
-     * machine may choose it (core/threads.h); noslip adds the threads' node buffers, whose
-     * summation order follows the count: it keeps all processors. */
-    threads_tune_begin(s, s->contact == MPM_CONTACT_FRICTION && s->np >= 8192);
+    /* A step gives the same bits on any thread count the tuner may choose (core/threads.h):
+     * with frictional contact every grain's nodal entries are built by one thread and packed in
+     * grain order; noslip scatters by chunks whose number is fixed in auto mode (all
+     * processors) and adds them in chunk order. */
+    threads_tune_begin(s, s->np >= 8192);
     core_status st = run_steps(s, run, done, err);
     threads_tune_end();
     return st;
