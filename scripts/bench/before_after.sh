@@ -2,7 +2,7 @@
 # Before and after, side by side (issue 16): the three engines' benchmarks run by two grainlab
 # checkouts on the same machine, alternating (old new old new ...), each checkout with its own
 # bench scripts (the scenes are the same; a newer script may call what an older binary lacks).
-#   scripts/bench/before_after.sh OLD_CHECKOUT NEW_CHECKOUT [reps=2]
+#   scripts/bench/before_after.sh OLD_CHECKOUT NEW_CHECKOUT [reps=2] [engines=mpm,dem,dsmc]
 # Each checkout must be built in its build/. Benches (their defaults but shorter runs), each on 1
 # and then 2 threads in one process:
 #   mpm  : bench/mpm_shear.lua cycles=200 warm=50 (74,079 points, 369 grains, friction)
@@ -14,11 +14,12 @@
 set -eu
 OLD=$1 NEW=$2
 shift 2
-REPS=2
+REPS=2 ENGINES="mpm dem dsmc"
 for a in "$@"; do
   case $a in
     reps=*) REPS=${a#reps=} ;;
-    *) echo "before_after.sh: unknown argument '$a' (reps=)" >&2; exit 2 ;;
+    engines=*) ENGINES=$(echo "${a#engines=}" | tr ',' ' ') ;;
+    *) echo "before_after.sh: unknown argument '$a' (reps=, engines=)" >&2; exit 2 ;;
   esac
 done
 for d in "$OLD" "$NEW"; do
@@ -46,7 +47,7 @@ run() {
       t = $1; sub(/^particle_steps_per_s_/, "", t); sub(/_threads$/, "", t); print e, t, s, $2, l }' |
     tee -a "$LOG"
 }
-for e in mpm dem dsmc; do
+for e in $ENGINES; do
   r=1
   while [ "$r" -le "$REPS" ]; do
     run "$OLD" old $e
@@ -58,7 +59,7 @@ echo
 echo "| engine | threads | before | after | after / before |"
 echo "|---|---:|---:|---:|---:|"
 med() { sort -g | awk '{ a[NR] = $1 } END { print a[int((NR + 1) / 2)] }'; }
-for e in mpm dem dsmc; do
+for e in $ENGINES; do
   for t in 1 2; do
     o=$(awk -v e=$e -v t=$t '$1 == e && $2 == t && $3 == "old" { print $4 }' "$LOG" | med)
     n=$(awk -v e=$e -v t=$t '$1 == e && $2 == t && $3 == "new" { print $4 }' "$LOG" | med)
