@@ -618,13 +618,6 @@ STAGE static void grain_normals(mpm_scene *s, int t)
 {
     const double ox = s->def.origin[0], oy = s->def.origin[1];
     int *mark = s->tmark + (size_t)t * s->nnodes;
-    /* locals: the stores into pnx, pny could alias fields of s, which would be reloaded. No
-     * test for a marked node among the nine before the sums: nearly every point of this dense
-     * packing has one (the test cost more than the sums it saved) */
-    const double ihx = s->inv_hx, ihy = s->inv_hy;
-    const double *const x = s->x, *const y = s->y, *const pm = s->m;
-    double *const pnx = s->pnx, *const pny = s->pny;
-    const int nnx = s->nnx;
     {
         /* Eq. 24 with linear transfers: each grain's B-spline mass gradient at its shared pairs,
          * from the points whose 3 x 3 B-spline nodes include one of them. */
@@ -643,29 +636,30 @@ STAGE static void grain_normals(mpm_scene *s, int t)
             if (shared)
                 for (size_t p = p0; p < p1; p++) {
                     double wx[3], dx[3], wy[3], dy[3];
-                    const int bi = bspline((x[p] - ox) * ihx, wx, dx);
-                    const int bj = bspline((y[p] - oy) * ihy, wy, dy);
+                    const int bi = bspline((s->x[p] - ox) * s->inv_hx, wx, dx);
+                    const int bj = bspline((s->y[p] - oy) * s->inv_hy, wy, dy);
                     int I[3], J[3];
+                    bool any = false;
                     for (int a = 0; a < 3; a++) {
                         I[a] = node_of(s, 0, bi + a);
                         J[a] = node_of(s, 1, bj + a);
                     }
-                    /* m dx_a and m wx_a once a point: (m dx_a) wy_b ihx is the product as
-                     * written before, factor by factor from the left */
-                    const double m = pm[p];
-                    const double mdx[3] = {m * dx[0], m * dx[1], m * dx[2]};
-                    const double mwx[3] = {m * wx[0], m * wx[1], m * wx[2]};
+                    for (int b = 0; b < 3 && !any; b++)
+                        for (int a = 0; a < 3 && !any; a++)
+                            any = I[a] >= 0 && J[b] >= 0 && mark[J[b] * s->nnx + I[a]] >= 0;
+                    if (!any)
+                        continue;
+                    const double m = s->m[p];
                     for (int b = 0; b < 3; b++) {
                         if (J[b] < 0)
                             continue;
-                        const int *row = &mark[J[b] * nnx];
                         for (int a = 0; a < 3; a++) {
                             if (I[a] < 0)
                                 continue;
-                            const int r = row[I[a]];
+                            const int r = mark[J[b] * s->nnx + I[a]];
                             if (r >= 0) {
-                                pnx[r] += mdx[a] * wy[b] * ihx;
-                                pny[r] += mwx[a] * dy[b] * ihy;
+                                s->pnx[r] += m * dx[a] * wy[b] * s->inv_hx;
+                                s->pny[r] += m * wx[a] * dy[b] * s->inv_hy;
                             }
                         }
                     }
