@@ -26,27 +26,12 @@ static void *alloc_zero(size_t n, size_t size) { return calloc(n ? n : 1, size);
 
 /* The arrays a loop walks together at the same index (the point arrays; the nodal arrays, whose
  * grain entries the scatter accumulates into) each start k cache lines into their block, k their
- * number below (STAGGER_*). Large blocks from malloc all begin at the same offset within a page,
- * so element p of twenty arrays would fall into one set of the 8-way first-level cache. On the
- * MPM bench the stress update's first-level misses went from 13.9 to 3.1 per point (cachegrind)
- * and its time halved; before, its loop took a third longer with its four check arrays than
- * without them. */
+ * number below (STAGGER_*; core_realloc_staggered, src/core/memory.h). Large blocks from malloc
+ * all begin at the same offset within a page, so element p of twenty arrays would fall into one
+ * set of the 8-way first-level cache. On the MPM bench the stress update's first-level misses
+ * went from 13.9 to 3.1 per point (cachegrind) and its time halved; before, its loop took a third
+ * longer with its four check arrays than without them. */
 enum { STAGGER_POINT = 0, STAGGER_INT = 24, STAGGER_STENCIL = 27, STAGGER_NODE = 30 };
-
-static size_t stagger(int k) { return (size_t)(k % 64) * 64; }
-
-static void *realloc_staggered(void *cur, size_t bytes, int k)
-{
-    char *base = cur ? (char *)cur - stagger(k) : NULL;
-    char *p = realloc(base, bytes + stagger(k));
-    return p ? p + stagger(k) : NULL;
-}
-
-static void free_staggered(void *cur, int k)
-{
-    if (cur)
-        free((char *)cur - stagger(k));
-}
 
 /* 1D shape function of the scene's kind at offset t (in cells) from its node. */
 static double shape1(const mpm_scene *s, double t)
@@ -169,7 +154,7 @@ core_status mpm_create(const mpm_scene_def *def, mpm_scene **out, core_error *er
                          &s->nvx, &s->nvy, &s->nax, &s->nay};
     for (size_t k = 0; k < sizeof fields / sizeof *fields; k++) {
         const size_t bytes = (s->nnodes ? s->nnodes : 1) * sizeof(double);
-        if (!(*fields[k] = realloc_staggered(NULL, bytes, STAGGER_NODE + (int)k))) {
+        if (!(*fields[k] = core_realloc_staggered(NULL, bytes, STAGGER_NODE + (int)k))) {
             mpm_destroy(s);
             return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu grid nodes", s->nnodes);
         }
@@ -242,12 +227,12 @@ void mpm_destroy(mpm_scene *s)
         return;
     double *fields[] = {s->nm, s->npx, s->npy, s->nfx, s->nfy, s->nvx, s->nvy, s->nax, s->nay};
     for (size_t k = 0; k < sizeof fields / sizeof *fields; k++)
-        free_staggered(fields[k], STAGGER_NODE + (int)k);
+        core_free_staggered(fields[k], STAGGER_NODE + (int)k);
     double *stencil[] = {s->sw, s->sgx, s->sgy};
     for (int k = 0; k < 3; k++)
-        free_staggered(stencil[k], STAGGER_STENCIL + k);
+        core_free_staggered(stencil[k], STAGGER_STENCIL + k);
     for (int k = 0; point_doubles(s, k); k++)
-        free_staggered(*point_doubles(s, k), STAGGER_POINT + k);
+        core_free_staggered(*point_doubles(s, k), STAGGER_POINT + k);
     free(s->nwall);
     free(s->nwin);
     free(s->nmx);
@@ -272,9 +257,9 @@ void mpm_destroy(mpm_scene *s)
     free(s->pny);
     free(s->ngr);
     free(s->sv);
-    free_staggered(s->grain, STAGGER_INT);
-    free_staggered(s->mat, STAGGER_INT + 1);
-    free_staggered(s->sn, STAGGER_INT + 2);
+    core_free_staggered(s->grain, STAGGER_INT);
+    core_free_staggered(s->mat, STAGGER_INT + 1);
+    core_free_staggered(s->sn, STAGGER_INT + 2);
     free(s->mats);
     free(s->gstart);
     free(s->gcount);
@@ -326,26 +311,26 @@ static core_status reserve_points(mpm_scene *s, size_t n, core_error *err)
         cap *= 2;
     for (int k = 0; point_doubles(s, k); k++) {
         double **a = point_doubles(s, k);
-        double *p = realloc_staggered(*a, cap * sizeof(double), STAGGER_POINT + k);
+        double *p = core_realloc_staggered(*a, cap * sizeof(double), STAGGER_POINT + k);
         if (!p)
             return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu points", cap);
         *a = p;
     }
     int **ints[] = {&s->grain, &s->mat};
     for (int k = 0; k < 2; k++) {
-        int *p = realloc_staggered(*ints[k], cap * sizeof(int), STAGGER_INT + k);
+        int *p = core_realloc_staggered(*ints[k], cap * sizeof(int), STAGGER_INT + k);
         if (!p)
             return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu points", cap);
         *ints[k] = p;
     }
-    int *sn = realloc_staggered(s->sn, cap * MPM_STENCIL * sizeof(int), STAGGER_INT + 2);
+    int *sn = core_realloc_staggered(s->sn, cap * MPM_STENCIL * sizeof(int), STAGGER_INT + 2);
     if (!sn)
         return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu points", cap);
     s->sn = sn;
     double **st[] = {&s->sw, &s->sgx, &s->sgy};
     for (int k = 0; k < 3; k++) {
         double *p =
-            realloc_staggered(*st[k], cap * MPM_STENCIL * sizeof(double), STAGGER_STENCIL + k);
+            core_realloc_staggered(*st[k], cap * MPM_STENCIL * sizeof(double), STAGGER_STENCIL + k);
         if (!p)
             return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu points", cap);
         *st[k] = p;
@@ -619,7 +604,7 @@ double mpm_friction(const mpm_scene *s) { return s->contact == MPM_CONTACT_FRICT
 /* GROW for the staggered arrays (number k). */
 #define GROW_STAGGERED(a, n, k)                                                                    \
     do {                                                                                           \
-        void *grown_ = realloc_staggered((a), ((n) ? (n) : 1) * sizeof *(a), (k));                 \
+        void *grown_ = core_realloc_staggered((a), ((n) ? (n) : 1) * sizeof *(a), (k));            \
         if (!grown_)                                                                               \
             return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu contact field entries",   \
                              (size_t)(n));                                                         \
