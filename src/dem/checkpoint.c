@@ -263,15 +263,11 @@ static void get_into(reader *r, double **a, size_t n, size_t cap)
 }
 
 /* get_into for the step's staggered particle arrays (dem_alloc_hot, number k): the values are
- * copied into a staggered block. */
+ * read into the staggered block itself. */
 static void get_hot(reader *r, double **a, size_t n, size_t cap, int k)
 {
-    double *v = get_new(r, n, cap);
-    if (!v)
-        return;
-    if ((r->st = dem_alloc_hot(a, cap, k, r->err)) == CORE_OK)
-        memcpy(*a, v, n * sizeof *v);
-    free(v);
+    if (!r->st && (r->st = dem_alloc_hot(a, cap, k, r->err)) == CORE_OK)
+        r->st = ckpt_get_f64s(&r->sec, *a, n, r->err);
 }
 
 static void get_opt_hot(reader *r, double **a, size_t n, size_t cap, int k)

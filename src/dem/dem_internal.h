@@ -29,10 +29,11 @@ typedef struct dem_wall {
     uint32_t *cand;        /* particles within r + skin of the wall at the last list build */
     double *cand_fn;       /* distributed runs: each candidate's normal force (domain.c) */
     size_t ncand, cap_cand;
-    double *cand_par;      /* the planes' loop: k, gamma, mu of each candidate (3 per candidate),
-                            * computed once per candidate list; cand_par_ok = 0 whenever the list
-                            * or the laws change (law_parameters solves the Brilliantov damping
-                            * time per call: per contact and step it was 3 % of a pile's step) */
+    double *cand_par;      /* k, gamma, mu of each candidate (3 per candidate; a plane's cand,
+                            * a shaped wall's shape candidates), computed once per candidate list;
+                            * cand_par_ok = 0 whenever the list or the laws change (law_parameters
+                            * solves the Brilliantov damping time per call: per contact and step
+                            * it was 3 % of a pile's step) */
     int cand_par_ok;
     double point_build[3]; /* the wall's point at the last list build (skin test) */
     double fn;             /* normal force the wall exerts on the particles, last evaluation */
