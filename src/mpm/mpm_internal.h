@@ -90,6 +90,12 @@ struct mpm_scene {
     mpm_contact_options opt;
     double *pnx, *pny;      /* sum_p m_p G_pi over the grain: its outward normal direction */
     int *ngr;               /* grains touching node i (nnodes) */
+    /* Each node's pairs in pair order, rebuilt every step (step.c, pair_chains): nhead, the
+     * node's first pair or -1 (nnodes); pnext, the next pair at the same node or -1; pshared:
+     * pair q is at a node of two or more grains. The threads add up a node's pairs along its
+     * chain, each over its own range of nodes, so that no pass over all pairs is serial. */
+    int *nhead, *pnext;
+    unsigned char *pshared;
     double *tgx, *tgy;      /* sum_p m_p G_pi over all grains (nnodes) */
     int *sv;                /* ns per point: the friction sf */
 

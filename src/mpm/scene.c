@@ -256,6 +256,9 @@ void mpm_destroy(mpm_scene *s)
     free(s->pnx);
     free(s->pny);
     free(s->ngr);
+    free(s->nhead);
+    free(s->pnext);
+    free(s->pshared);
     free(s->sv);
     core_free_staggered(s->grain, STAGGER_INT);
     core_free_staggered(s->mat, STAGGER_INT + 1);
@@ -619,6 +622,7 @@ core_status mpm_contact_reserve(mpm_scene *s, core_error *err)
                          s->np);
     if (!s->ndp) {
         GROW(s->ngr, nn);
+        GROW(s->nhead, nn);
         GROW(s->tgx, nn);
         GROW(s->tgy, nn);
         GROW(s->tvol, nn);
@@ -645,6 +649,8 @@ core_status mpm_contact_reserve(mpm_scene *s, core_error *err)
     GROW(s->pcy, need);
     GROW(s->pnx, need);
     GROW(s->pny, need);
+    GROW(s->pnext, need);
+    GROW(s->pshared, need);
     GROW(s->sv, need);
     s->paircap = need;
     return CORE_OK;
