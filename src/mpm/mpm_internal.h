@@ -104,7 +104,12 @@ struct mpm_scene {
      * only it touches belong to one thread; per-thread scratch: marks (nt x nnodes) */
     int nt, ntcap;
     size_t *tp, *tg, *tq, *tc;
-    int *tmark;
+    int *tmark;             /* nt x (nnodes + 1), the last of each -1 */
+    unsigned char *tnear;   /* nt x nnodes, zero outside grain_normals */
+    /* per-thread scratch of the frictional scatter: one record per (grain, node) pair of the
+     * grain being scattered (its sums, see grain_scatter), reccap records per thread */
+    struct mpm_pair_rec *trec;
+    size_t reccap;
     /* The noslip transfers' chunks: nc grain-aligned point ranges [cp[c], cp[c+1]); thread t
      * scatters chunks t, t + nt, ... each into its own node arrays (chunk 0: the scene's, chunk c
      * > 0: tbuf's (c - 1)-th 5 x nnodes block), added up in chunk order. nc is the processor

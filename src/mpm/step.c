@@ -24,6 +24,17 @@
 /* The step's stages stay separate functions so that a profiler (callgrind) counts each. */
 #define STAGE __attribute__((noinline))
 
+/* Two doubles in one SSE2 register (GCC/Clang vector extension): each lane does exactly the
+ * scalar arithmetic, so a vector sum gives the bits of the two scalar ones. */
+typedef double v2d __attribute__((vector_size(16)));
+
+/* The sums of one (grain, node) pair while its grain is scattered (grain_scatter), as pairs of
+ * lanes: (mass, momentum x), (momentum y, volume), (force x, force y), (mass gradient x, y); one
+ * cache line per pair. */
+struct mpm_pair_rec {
+    v2d mpx, pyv, f, n;
+};
+
 enum { T_STENCIL, T_P2G, T_NORMALS, T_GRID, T_CONTACT, T_G2P, T_REMAP, T_MATERIAL, T_CHECK };
 const char *const mpm_stage_names[MPM_NSTAGES] = {"stencil", "p2g",   "normals",  "grid", "contact",
                                                   "g2p",     "remap", "material", "check"};
@@ -116,15 +127,37 @@ static core_status threads_setup(mpm_scene *s, core_error *err)
             *ranges[r] = a;
         }
         free(s->tmark);
-        s->tmark = malloc((size_t)nt * s->nnodes * sizeof *s->tmark);
+        /* per thread nnodes + 1 marks: the last stays -1 (grain_scatter) */
+        s->tmark = malloc((size_t)nt * (s->nnodes + 1) * sizeof *s->tmark);
         if (!s->tmark)
             return core_fail(err, CORE_ERR_NOMEM, "out of memory for %d threads", nt);
-        for (size_t i = 0; i < (size_t)nt * s->nnodes; i++)
+        for (size_t i = 0; i < (size_t)nt * (s->nnodes + 1); i++)
             s->tmark[i] = -1;
+        free(s->tnear);
+        s->tnear = calloc((size_t)nt * s->nnodes, 1);
+        if (!s->tnear)
+            return core_fail(err, CORE_ERR_NOMEM, "out of memory for %d threads", nt);
         s->ntcap = nt;
+        s->reccap = 0; /* the records below are per thread */
     }
     s->nt = nt;
     grain_ranges(s, nt, s->tp, s->tg);
+    if (s->contact == MPM_CONTACT_FRICTION) {
+        /* a grain has at most ns pairs per point */
+        size_t gmax = 1;
+        for (size_t g = 0; g < s->ngrains; g++)
+            gmax = s->gcount[g] > gmax ? s->gcount[g] : gmax;
+        const size_t need = (size_t)s->ns * gmax;
+        if (need > s->reccap) {
+            free(s->trec);
+            const size_t bytes = (size_t)s->ntcap * (need + 1) * sizeof(struct mpm_pair_rec);
+            s->trec = aligned_alloc(64, (bytes + 63) / 64 * 64);
+            s->reccap = s->trec ? need : 0;
+            if (!s->trec)
+                return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu contact records",
+                                 need);
+        }
+    }
     return CORE_OK;
 }
 
@@ -473,8 +506,8 @@ STAGE static void apply_walls_pairs(mpm_scene *s, double *vx, double *vy, bool d
  * points; the centre-of-mass entries are their sums (Eqs. 5-7 over all points), so no separate
  * transfer is needed. pnx, pny hold the gradient of the grain's mass field at the node, outward:
  * sum_p m_p grad N_i(x_p) over the grain, with the transfer's shape functions or (normals
- * 'averaged' and 'own' with linear transfers) with quadratic B-splines (Eq. 24) in a second pass
- * that visits only the points within reach of a shared node. tgx, tgy at a shared node: the sum
+ * 'averaged' and 'own' with linear transfers) with quadratic B-splines (Eq. 24), read at shared
+ * nodes only. tgx, tgy at a shared node: the sum
  * of its grains' gradients, so that 2 g - g_all of two grains are exactly opposite. A point moves
  * with its grain's field at nodes shared by two or more grains and with the centre-of-mass node
  * elsewhere, so an isolated grain evolves exactly as with noslip. */
@@ -494,16 +527,21 @@ static void move_pairs(mpm_scene *s, size_t to, size_t from, size_t n)
 }
 
 /* Inside the parallel region; thread t takes its grains. Their pairs are first written from
- * ns * tp[t] (a grain has at most ns pairs per point), then packed in thread order. */
+ * ns * tp[t] (a grain has at most ns pairs per point), then packed in thread order. A grain's
+ * pairs are numbered in the order its points first touch their nodes; while the grain is
+ * scattered, their sums build up in the thread's records (one cache line per pair, two sums per
+ * SSE2 operation, mark[i] the record of node i), and are then copied into the nodal and pair
+ * arrays. */
 static inline __attribute__((always_inline)) void
 grain_scatter_with(mpm_scene *s, int t, const int ns, const bool volumes, const bool spline_normals)
 {
     const size_t nn = s->nnodes;
     const double gx0 = s->def.gravity[0], gy0 = s->def.gravity[1];
-    int *mark = s->tmark + (size_t)t * nn;
+    int *const mark = s->tmark + (size_t)t * (nn + 1);
+    struct mpm_pair_rec *const rec = s->trec + (size_t)t * (s->reccap + 1) + 1;
     const size_t base = (size_t)ns * s->tp[t];
-    /* the grain entries (pair r at nn + r of the nodal arrays) and the point arrays as locals:
-     * the stores below cannot change them, and the compiler need not reload them */
+    /* the arrays as locals: the stores below cannot change them, and the compiler need not
+     * reload them */
     double *const pm = s->nm + nn, *const ppx = s->npx + nn, *const ppy = s->npy + nn;
     double *const pfx = s->nfx + nn, *const pfy = s->nfy + nn;
     double *const pnx = s->pnx, *const pny = s->pny, *const pvol = s->pvol;
@@ -511,46 +549,61 @@ grain_scatter_with(mpm_scene *s, int t, const int ns, const bool volumes, const 
     const double *const xm = s->m, *const vx = s->vx, *const vy = s->vy, *const v0 = s->v0;
     const double *const F0 = s->F[0], *const F1 = s->F[1], *const F2 = s->F[2], *const F3 = s->F[3];
     const double *const s0 = s->sig[0], *const s1 = s->sig[1], *const s2 = s->sig[2];
+    const v2d grav = {gx0, gy0};
     size_t q = base;
     for (size_t g = s->tg[t]; g < s->tg[t + 1]; g++) {
-        const size_t p0 = s->gstart[g], p1 = p0 + s->gcount[g], q0 = q;
+        const size_t p0 = s->gstart[g], p1 = p0 + s->gcount[g];
+        int nr = 0; /* the grain's pairs so far: records [0, nr), pairs q .. q + nr - 1 */
         for (size_t p = p0; p < p1; p++) {
             stencil_range(s, p, p + 1, ns); /* in cache for the scatter below */
             const double m = xm[p], px = m * vx[p], py = m * vy[p];
             const double V = v0[p] * (F0[p] * F3[p] - F1[p] * F2[p]);
             const double sxx = V * s0[p], syy = V * s1[p], sxy = V * s2[p];
-            const double fgx = m * gx0, fgy = m * gy0;
+            /* the lanes: m w, p_x w | p_y w, V w | w m g - sigma V G (Eq. 7) | m G (linear
+             * normals) */
+            const v2d mpx = {m, px}, pyv = {py, V}, fg = {m * grav[0], m * grav[1]};
+            const v2d sa = {sxx, sxy}, sb = {sxy, syy}, mm = {m, m};
             const int *n = &s->sn[ns * p];
             const double *w = &s->sw[ns * p], *gx = &s->sgx[ns * p], *gy = &s->sgy[ns * p];
             int *sv = &s->sv[ns * p];
             for (int k = 0; k < ns; k++) {
                 const int i = n[k];
+                const v2d wk = {w[k], w[k]}, gxk = {gx[k], gx[k]}, gyk = {gy[k], gy[k]};
                 int r = mark[i];
                 if (r < 0) {
-                    r = (int)q++;
+                    r = nr++;
                     mark[i] = r;
-                    pnode[r] = i;
-                    pgrain[r] = (int)g;
-                    pm[r] = ppx[r] = ppy[r] = pfx[r] = pfy[r] = 0;
-                    pnx[r] = pny[r] = pvol[r] = 0;
+                    pnode[q + (size_t)r] = i;
+                    pgrain[q + (size_t)r] = (int)g;
+                    rec[r] = (struct mpm_pair_rec){{0, 0}, {0, 0}, {0, 0}, {0, 0}};
                 }
-                const double wk = w[k];
-                pm[r] += wk * m;
-                ppx[r] += wk * px;
-                ppy[r] += wk * py;
-                pfx[r] += wk * fgx - (sxx * gx[k] + sxy * gy[k]);
-                pfy[r] += wk * fgy - (sxy * gx[k] + syy * gy[k]);
+                struct mpm_pair_rec *const e = &rec[r];
+                e->mpx += wk * mpx;
                 if (volumes)
-                    pvol[r] += wk * V;
+                    e->pyv += wk * pyv;
+                else
+                    e->pyv[0] += w[k] * py;
+                e->f += wk * fg - (sa * gxk + sb * gyk);
                 if (!spline_normals) {
-                    pnx[r] += m * gx[k];
-                    pny[r] += m * gy[k];
+                    const v2d gk = {gx[k], gy[k]};
+                    e->n += mm * gk;
                 }
-                sv[k] = r; /* the pair, renumbered after packing */
+                sv[k] = (int)q + r; /* the pair, renumbered after packing */
             }
         }
-        for (size_t r = q0; r < q; r++)
-            mark[pnode[r]] = -1;
+        for (int r = 0; r < nr; r++) {
+            const size_t e = q + (size_t)r;
+            mark[pnode[e]] = -1;
+            pm[e] = rec[r].mpx[0];
+            ppx[e] = rec[r].mpx[1];
+            ppy[e] = rec[r].pyv[0];
+            pvol[e] = rec[r].pyv[1];
+            pfx[e] = rec[r].f[0];
+            pfy[e] = rec[r].f[1];
+            pnx[e] = rec[r].n[0];
+            pny[e] = rec[r].n[1];
+        }
+        q += (size_t)nr;
     }
     s->tc[t] = q - base;
 }
@@ -612,62 +665,114 @@ STAGE static void grain_stencil(mpm_scene *s, int t)
     }
 }
 
-/* Eq. 24 with linear transfers: thread t's grains' B-spline mass gradients at their shared pairs.
- */
+/* The B-spline base node of grid coordinate xi on axis a (the first of bspline's three), or -1. */
+static inline int spline_base(const mpm_scene *s, int a, double xi)
+{
+    return node_of(s, a, ifloor(xi - 0.5));
+}
+
+/* Sets (v = 1) or clears (v = 0) near[] at the B-spline base nodes of the points whose 3 x 3
+ * nodes include node i: the bases up to two nodes below i on each axis. */
+static inline void mark_bases(const mpm_scene *s, unsigned char *near, int i, unsigned char v)
+{
+    const int nnx = s->nnx, I = i % nnx, J = i / nnx;
+    for (int b = 0; b < 3; b++) {
+        int Jb = J - b;
+        if (Jb < 0) {
+            if (!s->def.periodic[1])
+                break;
+            Jb += s->nny;
+        }
+        for (int a = 0; a < 3; a++) {
+            int Ib = I - a;
+            if (Ib < 0) {
+                if (!s->def.periodic[0])
+                    break;
+                Ib += nnx;
+            }
+            near[Jb * nnx + Ib] = v;
+        }
+    }
+}
+
+/* Eq. 24 with linear transfers: thread t's grains' B-spline mass gradients at their shared
+ * pairs, from the points whose 3 x 3 B-spline nodes include one of them (in point order, into
+ * the records, two components per SSE2 operation). near[] flags the B-spline bases of such
+ * points, so a point far from every shared node of its grain costs one lookup. */
 STAGE static void grain_normals(mpm_scene *s, int t)
 {
+    const size_t nn = s->nnodes;
     const double ox = s->def.origin[0], oy = s->def.origin[1];
-    int *mark = s->tmark + (size_t)t * s->nnodes;
-    {
-        /* Eq. 24 with linear transfers: each grain's B-spline mass gradient at its shared pairs,
-         * from the points whose 3 x 3 B-spline nodes include one of them. */
-        size_t r0 = s->tq[t];
-        for (size_t g = s->tg[t]; g < s->tg[t + 1]; g++) {
-            const size_t p0 = s->gstart[g], p1 = p0 + s->gcount[g];
-            size_t r1 = r0;
-            bool shared = false;
-            while (r1 < s->tq[t + 1] && s->pgrain[r1] == (int)g) {
-                if (s->ngr[s->pnode[r1]] > 1) {
-                    mark[s->pnode[r1]] = (int)r1;
-                    shared = true;
-                }
-                r1++;
+    const double ihx = s->inv_hx, ihy = s->inv_hy;
+    const v2d ih = {ihx, ihy};
+    const int nnx = s->nnx, skip = (int)nn; /* mark[nn] = -1 always */
+    int *const mark = s->tmark + (size_t)t * (nn + 1);
+    unsigned char *const near = s->tnear + (size_t)t * nn;
+    /* rec[-1]: a dummy record for the nodes that are not shared pairs of the grain */
+    struct mpm_pair_rec *const rec = s->trec + (size_t)t * (s->reccap + 1) + 1;
+    const double *const xs = s->x, *const ys = s->y, *const xm = s->m;
+    size_t r0 = s->tq[t];
+    for (size_t g = s->tg[t]; g < s->tg[t + 1]; g++) {
+        const size_t p0 = s->gstart[g], p1 = p0 + s->gcount[g];
+        size_t r1 = r0;
+        bool shared = false;
+        while (r1 < s->tq[t + 1] && s->pgrain[r1] == (int)g) {
+            const int i = s->pnode[r1];
+            if (s->ngr[i] > 1) {
+                mark[i] = (int)(r1 - r0);
+                rec[r1 - r0].n = (v2d){0, 0};
+                mark_bases(s, near, i, 1);
+                shared = true;
             }
-            if (shared)
-                for (size_t p = p0; p < p1; p++) {
-                    double wx[3], dx[3], wy[3], dy[3];
-                    const int bi = bspline((s->x[p] - ox) * s->inv_hx, wx, dx);
-                    const int bj = bspline((s->y[p] - oy) * s->inv_hy, wy, dy);
-                    int I[3], J[3];
-                    bool any = false;
-                    for (int a = 0; a < 3; a++) {
-                        I[a] = node_of(s, 0, bi + a);
-                        J[a] = node_of(s, 1, bj + a);
-                    }
-                    for (int b = 0; b < 3 && !any; b++)
-                        for (int a = 0; a < 3 && !any; a++)
-                            any = I[a] >= 0 && J[b] >= 0 && mark[J[b] * s->nnx + I[a]] >= 0;
-                    if (!any)
-                        continue;
-                    const double m = s->m[p];
+            r1++;
+        }
+        if (shared)
+            for (size_t p = p0; p < p1; p++) {
+                const double xi = (xs[p] - ox) * ihx, eta = (ys[p] - oy) * ihy;
+                const int Ib = spline_base(s, 0, xi), Jb = spline_base(s, 1, eta);
+                if (Ib >= 0 && Jb >= 0 && !near[Jb * nnx + Ib])
+                    continue;
+                double wx[3], dx[3], wy[3], dy[3];
+                const int bi = bspline(xi, wx, dx), bj = bspline(eta, wy, dy);
+                const double m = xm[p];
+                int I[3];
+                v2d ma[3];
+                for (int a = 0; a < 3; a++) {
+                    I[a] = node_of(s, 0, bi + a);
+                    ma[a] = (v2d){m * dx[a], m * wx[a]};
+                }
+                int J[3];
+                for (int b = 0; b < 3; b++)
+                    J[b] = node_of(s, 1, bj + b);
+                /* lanes x, y: m dx_a wy_b / h_x and m wx_a dy_b / h_y, in the scalar order */
+                if ((I[0] | I[1] | I[2] | J[0] | J[1] | J[2]) >= 0) {
                     for (int b = 0; b < 3; b++) {
-                        if (J[b] < 0)
-                            continue;
-                        for (int a = 0; a < 3; a++) {
-                            if (I[a] < 0)
-                                continue;
-                            const int r = mark[J[b] * s->nnx + I[a]];
-                            if (r >= 0) {
-                                s->pnx[r] += m * dx[a] * wy[b] * s->inv_hx;
-                                s->pny[r] += m * wx[a] * dy[b] * s->inv_hy;
-                            }
-                        }
+                        const int *const row = mark + (size_t)J[b] * (size_t)nnx;
+                        const v2d wb = {wy[b], dy[b]};
+                        for (int a = 0; a < 3; a++)
+                            rec[row[I[a]]].n += ma[a] * wb * ih;
+                    }
+                    continue;
+                }
+                /* near the edge of the grid: a node outside reads the mark of an untouched one */
+                for (int b = 0; b < 3; b++) {
+                    const v2d wb = {wy[b], dy[b]};
+                    for (int a = 0; a < 3; a++) {
+                        const int r = mark[J[b] < 0 || I[a] < 0 ? skip : J[b] * nnx + I[a]];
+                        rec[r].n += ma[a] * wb * ih;
                     }
                 }
-            for (size_t r = r0; r < r1; r++)
-                mark[s->pnode[r]] = -1;
-            r0 = r1;
+            }
+        for (size_t r = r0; r < r1; r++) {
+            const int i = s->pnode[r];
+            if (s->ngr[i] > 1) {
+                s->pnx[r] = rec[r - r0].n[0];
+                s->pny[r] = rec[r - r0].n[1];
+                mark[i] = -1;
+                mark_bases(s, near, i, 0);
+            }
         }
+        r0 = r1;
     }
 }
 
@@ -697,7 +802,6 @@ STAGE static void grain_sums(mpm_scene *s)
 static void grain_fields(mpm_scene *s, int t, double *tlp)
 {
     double tl = *tlp;
-    const bool spline_normals = s->opt.normals != MPM_NORMALS_LINEAR && s->ns != 9;
     grain_scatter(s, t);
 #pragma omp barrier
 #pragma omp master
@@ -708,7 +812,7 @@ static void grain_fields(mpm_scene *s, int t, double *tlp)
 #pragma omp barrier
     grain_stencil(s, t);
     STAGE_DONE(T_P2G); /* no barrier: the normals need none, so this is thread 0's own time */
-    if (spline_normals)
+    if (s->opt.normals != MPM_NORMALS_LINEAR && s->ns != 9)
         grain_normals(s, t);
 #pragma omp barrier
 #pragma omp master
