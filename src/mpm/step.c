@@ -199,14 +199,29 @@ core_status mpm_timestep_info(const mpm_scene *s, double cfl, mpm_timestep *out,
     return CORE_OK;
 }
 
-/* Node index of grid node gi on axis a (ghost layers and periodic wrap), or -1 outside. */
-static inline int node_of(const mpm_scene *s, int a, int gi)
+/* One grid axis as axis_node needs it, taken into locals once per pass: the loops store ints
+ * (stencils, marks), which could alias the scene's int fields, so reading those inside them
+ * would reload these at every call. */
+typedef struct {
+    int n, ghost, nodes;
+    bool periodic;
+} grid_axis;
+
+static inline grid_axis axis_of(const mpm_scene *s, int a)
 {
-    const int n = s->def.cells[a];
-    if (s->def.periodic[a])
-        return gi < 0 ? gi + n : (gi >= n ? gi - n : gi);
-    const int I = gi + s->gl[a], nn = a ? s->nny : s->nnx;
-    return I >= 0 && I < nn ? I : -1;
+    return (grid_axis){.n = s->def.cells[a],
+                       .ghost = s->gl[a],
+                       .nodes = a ? s->nny : s->nnx,
+                       .periodic = s->def.periodic[a]};
+}
+
+/* Node index of grid node gi on axis ax (ghost layers and periodic wrap), or -1 outside. */
+static inline int axis_node(grid_axis ax, int gi)
+{
+    if (ax.periodic)
+        return gi < 0 ? gi + ax.n : (gi >= ax.n ? gi - ax.n : gi);
+    const int I = gi + ax.ghost;
+    return I >= 0 && I < ax.nodes ? I : -1;
 }
 
 /* floor(x) as an int for finite x in int range (grid coordinates): a truncation and a
@@ -241,6 +256,7 @@ static inline __attribute__((always_inline)) void stencil_range(mpm_scene *s, si
     const double ox = s->def.origin[0], oy = s->def.origin[1];
     const int nx = s->def.cells[0], ny = s->def.cells[1], nnx = s->nnx;
     const double ihx = s->inv_hx, ihy = s->inv_hy;
+    const grid_axis ax = axis_of(s, 0), ay = axis_of(s, 1);
     for (size_t p = pa; p < pb; p++) {
         const double xi = (s->x[p] - ox) * ihx, eta = (s->y[p] - oy) * ihy;
         int *n = &s->sn[ns * p];
@@ -250,9 +266,9 @@ static inline __attribute__((always_inline)) void stencil_range(mpm_scene *s, si
             const int bi = bspline(xi, wx, dx), bj = bspline(eta, wy, dy);
             int k = 0;
             for (int b = 0; b < 3; b++) {
-                const int J = node_of(s, 1, bj + b);
+                const int J = axis_node(ay, bj + b);
                 for (int a = 0; a < 3; a++, k++) {
-                    n[k] = J * nnx + node_of(s, 0, bi + a);
+                    n[k] = J * nnx + axis_node(ax, bi + a);
                     w[k] = wx[a] * wy[b];
                     gx[k] = dx[a] * wy[b] * ihx;
                     gy[k] = wx[a] * dy[b] * ihy;
@@ -270,8 +286,8 @@ static inline __attribute__((always_inline)) void stencil_range(mpm_scene *s, si
         if (j < 0)
             j = 0;
         const double fx = xi - i, fy = eta - j;
-        const int i0 = node_of(s, 0, i), i1 = node_of(s, 0, i + 1);
-        const int j0 = node_of(s, 1, j), j1 = node_of(s, 1, j + 1);
+        const int i0 = axis_node(ax, i), i1 = axis_node(ax, i + 1);
+        const int j0 = axis_node(ay, j), j1 = axis_node(ay, j + 1);
         n[0] = j0 * nnx + i0;
         n[1] = j0 * nnx + i1;
         n[2] = j1 * nnx + i0;
@@ -665,10 +681,10 @@ STAGE static void grain_stencil(mpm_scene *s, int t)
     }
 }
 
-/* The B-spline base node of grid coordinate xi on axis a (the first of bspline's three), or -1. */
-static inline int spline_base(const mpm_scene *s, int a, double xi)
+/* The B-spline base node of grid coordinate xi on axis ax (the first of bspline's three), or -1. */
+static inline int spline_base(grid_axis ax, double xi)
 {
-    return node_of(s, a, ifloor(xi - 0.5));
+    return axis_node(ax, ifloor(xi - 0.5));
 }
 
 /* Sets (v = 1) or clears (v = 0) near[] at the B-spline base nodes of the points whose 3 x 3
@@ -706,6 +722,7 @@ STAGE static void grain_normals(mpm_scene *s, int t)
     const double ihx = s->inv_hx, ihy = s->inv_hy;
     const v2d ih = {ihx, ihy};
     const int nnx = s->nnx, skip = (int)nn; /* mark[nn] = -1 always */
+    const grid_axis ax = axis_of(s, 0), ay = axis_of(s, 1);
     int *const mark = s->tmark + (size_t)t * (nn + 1);
     unsigned char *const near = s->tnear + (size_t)t * nn;
     /* rec[-1]: a dummy record for the nodes that are not shared pairs of the grain */
@@ -729,7 +746,7 @@ STAGE static void grain_normals(mpm_scene *s, int t)
         if (shared)
             for (size_t p = p0; p < p1; p++) {
                 const double xi = (xs[p] - ox) * ihx, eta = (ys[p] - oy) * ihy;
-                const int Ib = spline_base(s, 0, xi), Jb = spline_base(s, 1, eta);
+                const int Ib = spline_base(ax, xi), Jb = spline_base(ay, eta);
                 if (Ib >= 0 && Jb >= 0 && !near[Jb * nnx + Ib])
                     continue;
                 double wx[3], dx[3], wy[3], dy[3];
@@ -738,12 +755,12 @@ STAGE static void grain_normals(mpm_scene *s, int t)
                 int I[3];
                 v2d ma[3];
                 for (int a = 0; a < 3; a++) {
-                    I[a] = node_of(s, 0, bi + a);
+                    I[a] = axis_node(ax, bi + a);
                     ma[a] = (v2d){m * dx[a], m * wx[a]};
                 }
                 int J[3];
                 for (int b = 0; b < 3; b++)
-                    J[b] = node_of(s, 1, bj + b);
+                    J[b] = axis_node(ay, bj + b);
                 /* lanes x, y: m dx_a wy_b / h_x and m wx_a dy_b / h_y, in the scalar order */
                 if ((I[0] | I[1] | I[2] | J[0] | J[1] | J[2]) >= 0) {
                     for (int b = 0; b < 3; b++) {
