@@ -35,6 +35,12 @@ struct mpm_pair_rec {
     v2d mpx, pyv, f, n;
 };
 
+/* A point's factors of those sums: (m, m v_x), (m v_y, V), m g, (sigma_xx, sigma_xy) V and
+ * (sigma_xy, sigma_yy) V. */
+struct mpm_point_fac {
+    v2d mpx, pyv, fg, sa, sb;
+};
+
 enum { T_STENCIL, T_P2G, T_NORMALS, T_GRID, T_CONTACT, T_G2P, T_REMAP, T_MATERIAL, T_CHECK };
 const char *const mpm_stage_names[MPM_NSTAGES] = {"stencil", "p2g",   "normals",  "grid", "contact",
                                                   "g2p",     "remap", "material", "check"};
@@ -138,7 +144,7 @@ static core_status threads_setup(mpm_scene *s, core_error *err)
         if (!s->tnear)
             return core_fail(err, CORE_ERR_NOMEM, "out of memory for %d threads", nt);
         s->ntcap = nt;
-        s->reccap = 0; /* the records below are per thread */
+        s->reccap = s->faccap = 0; /* the records below are per thread */
     }
     s->nt = nt;
     grain_ranges(s, nt, s->tp, s->tg);
@@ -156,6 +162,15 @@ static core_status threads_setup(mpm_scene *s, core_error *err)
             if (!s->trec)
                 return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu contact records",
                                  need);
+        }
+        if (gmax > s->faccap) {
+            free(s->tfac);
+            const size_t bytes = (size_t)s->ntcap * gmax * sizeof(struct mpm_point_fac);
+            s->tfac = aligned_alloc(64, (bytes + 63) / 64 * 64);
+            s->faccap = s->tfac ? gmax : 0;
+            if (!s->tfac)
+                return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu contact records",
+                                 gmax);
         }
     }
     return CORE_OK;
@@ -566,19 +581,27 @@ grain_scatter_with(mpm_scene *s, int t, const int ns, const bool volumes, const 
     const double *const F0 = s->F[0], *const F1 = s->F[1], *const F2 = s->F[2], *const F3 = s->F[3];
     const double *const s0 = s->sig[0], *const s1 = s->sig[1], *const s2 = s->sig[2];
     const v2d grav = {gx0, gy0};
+    struct mpm_point_fac *const fac = s->tfac + (size_t)t * s->faccap;
     size_t q = base;
     for (size_t g = s->tg[t]; g < s->tg[t + 1]; g++) {
         const size_t p0 = s->gstart[g], p1 = p0 + s->gcount[g];
-        int nr = 0; /* the grain's pairs so far: records [0, nr), pairs q .. q + nr - 1 */
+        /* three passes over the grain's points (in cache), each with few live pointers: the
+         * stencils, each point's factors, the sums */
+        stencil_range(s, p0, p1, ns);
         for (size_t p = p0; p < p1; p++) {
-            stencil_range(s, p, p + 1, ns); /* in cache for the scatter below */
             const double m = xm[p], px = m * vx[p], py = m * vy[p];
             const double V = v0[p] * (F0[p] * F3[p] - F1[p] * F2[p]);
             const double sxx = V * s0[p], syy = V * s1[p], sxy = V * s2[p];
-            /* the lanes: m w, p_x w | p_y w, V w | w m g - sigma V G (Eq. 7) | m G (linear
-             * normals) */
-            const v2d mpx = {m, px}, pyv = {py, V}, fg = {m * grav[0], m * grav[1]};
-            const v2d sa = {sxx, sxy}, sb = {sxy, syy}, mm = {m, m};
+            /* the lanes: m w, p_x w | p_y w, V w | w m g - sigma V G (Eq. 7) */
+            fac[p - p0] = (struct mpm_point_fac){.mpx = {m, px},
+                                                 .pyv = {py, V},
+                                                 .fg = {m * grav[0], m * grav[1]},
+                                                 .sa = {sxx, sxy},
+                                                 .sb = {sxy, syy}};
+        }
+        int nr = 0; /* the grain's pairs so far: records [0, nr), pairs q .. q + nr - 1 */
+        for (size_t p = p0; p < p1; p++) {
+            const struct mpm_point_fac *const f = &fac[p - p0];
             const int *n = &s->sn[ns * p];
             const double *w = &s->sw[ns * p], *gx = &s->sgx[ns * p], *gy = &s->sgy[ns * p];
             int *sv = &s->sv[ns * p];
@@ -594,14 +617,14 @@ grain_scatter_with(mpm_scene *s, int t, const int ns, const bool volumes, const 
                     rec[r] = (struct mpm_pair_rec){{0, 0}, {0, 0}, {0, 0}, {0, 0}};
                 }
                 struct mpm_pair_rec *const e = &rec[r];
-                e->mpx += wk * mpx;
+                e->mpx += wk * f->mpx;
                 if (volumes)
-                    e->pyv += wk * pyv;
+                    e->pyv += wk * f->pyv;
                 else
-                    e->pyv[0] += w[k] * py;
-                e->f += wk * fg - (sa * gxk + sb * gyk);
+                    e->pyv[0] += w[k] * f->pyv[0];
+                e->f += wk * f->fg - (f->sa * gxk + f->sb * gyk);
                 if (!spline_normals) {
-                    const v2d gk = {gx[k], gy[k]};
+                    const v2d mm = {f->mpx[0], f->mpx[0]}, gk = {gx[k], gy[k]};
                     e->n += mm * gk;
                 }
                 sv[k] = (int)q + r; /* the pair, renumbered after packing */
