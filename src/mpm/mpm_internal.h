@@ -112,6 +112,7 @@ struct mpm_scene {
     size_t reccap;
     struct mpm_point_fac *tfac; /* and the factors of a grain's points, faccap per thread */
     size_t faccap;
+    size_t *gps, *gpc, gpcap; /* grain g's pairs: gpc[g] from tq[its thread] + gps[g] */
     /* The noslip transfers' chunks: nc grain-aligned point ranges [cp[c], cp[c+1]); thread t
      * scatters chunks t, t + nt, ... each into its own node arrays (chunk 0: the scene's, chunk c
      * > 0: tbuf's (c - 1)-th 5 x nnodes block), added up in chunk order. nc is the processor

@@ -270,6 +270,8 @@ void mpm_destroy(mpm_scene *s)
     free(s->tc);
     free(s->tmark);
     free(s->trec);
+    free(s->gps);
+    free(s->gpc);
     free(s->tfac);
     free(s->tnear);
     free(s->tbuf);

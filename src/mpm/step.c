@@ -163,6 +163,17 @@ static core_status threads_setup(mpm_scene *s, core_error *err)
                 return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu contact records",
                                  need);
         }
+        if (s->ngrains > s->gpcap) {
+            size_t **per_grain[2] = {&s->gps, &s->gpc};
+            for (int k = 0; k < 2; k++) {
+                size_t *a = realloc(*per_grain[k], s->ngrains * sizeof *a);
+                if (!a)
+                    return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu grains",
+                                     s->ngrains);
+                *per_grain[k] = a;
+            }
+            s->gpcap = s->ngrains;
+        }
         if (gmax > s->faccap) {
             free(s->tfac);
             const size_t bytes = (size_t)s->ntcap * gmax * sizeof(struct mpm_point_fac);
@@ -600,6 +611,7 @@ grain_scatter_with(mpm_scene *s, int t, const int ns, const bool volumes, const 
                                                  .sb = {sxy, syy}};
         }
         int nr = 0; /* the grain's pairs so far: records [0, nr), pairs q .. q + nr - 1 */
+        s->gps[g] = q - base;
         for (size_t p = p0; p < p1; p++) {
             const struct mpm_point_fac *const f = &fac[p - p0];
             const int *n = &s->sn[ns * p];
@@ -643,6 +655,7 @@ grain_scatter_with(mpm_scene *s, int t, const int ns, const bool volumes, const 
             pny[e] = rec[r].n[1];
         }
         q += (size_t)nr;
+        s->gpc[g] = (size_t)nr;
     }
     s->tc[t] = q - base;
 }
@@ -751,20 +764,24 @@ STAGE static void grain_normals(mpm_scene *s, int t)
     /* rec[-1]: a dummy record for the nodes that are not shared pairs of the grain */
     struct mpm_pair_rec *const rec = s->trec + (size_t)t * (s->reccap + 1) + 1;
     const double *const xs = s->x, *const ys = s->y, *const xm = s->m;
-    size_t r0 = s->tq[t];
-    for (size_t g = s->tg[t]; g < s->tg[t + 1]; g++) {
+    /* grains in any order, by any thread: a grain's normals are its own (its pairs, in its
+     * points' order), and the threads' loads differ (the shared nodes are not evenly spread) */
+#pragma omp for schedule(dynamic, 4) nowait
+    for (size_t g = 0; g < s->ngrains; g++) {
         const size_t p0 = s->gstart[g], p1 = p0 + s->gcount[g];
-        size_t r1 = r0;
+        int u = 0; /* the thread that scattered the grain, whose pairs start at tq[u] */
+        while (g >= s->tg[u + 1])
+            u++;
+        const size_t r0 = s->tq[u] + s->gps[g], r1 = r0 + s->gpc[g];
         bool shared = false;
-        while (r1 < s->tq[t + 1] && s->pgrain[r1] == (int)g) {
-            const int i = s->pnode[r1];
+        for (size_t r = r0; r < r1; r++) {
+            const int i = s->pnode[r];
             if (s->ngr[i] > 1) {
-                mark[i] = (int)(r1 - r0);
-                rec[r1 - r0].n = (v2d){0, 0};
+                mark[i] = (int)(r - r0);
+                rec[r - r0].n = (v2d){0, 0};
                 mark_bases(s, near, i, 1);
                 shared = true;
             }
-            r1++;
         }
         if (shared)
             for (size_t p = p0; p < p1; p++) {
@@ -812,7 +829,6 @@ STAGE static void grain_normals(mpm_scene *s, int t)
                 mark_bases(s, near, i, 0);
             }
         }
-        r0 = r1;
     }
 }
 
