@@ -702,21 +702,6 @@ STAGE static void grain_pack(mpm_scene *s)
     }
 }
 
-/* Thread t's points' stencil entries: the grain's pair at shared nodes, else the node. */
-STAGE static void grain_stencil(mpm_scene *s, int t)
-{
-    const size_t nn = s->nnodes;
-    const int ns = s->ns;
-    const size_t base = (size_t)ns * s->tp[t];
-    {
-        const long shift = (long)base - (long)s->tq[t];
-        for (size_t e = (size_t)ns * s->tp[t]; e < (size_t)ns * s->tp[t + 1]; e++) {
-            const int i = s->sn[e];
-            s->sv[e] = s->ngr[i] < 2 ? i : (int)(nn + (size_t)((long)s->sv[e] - shift));
-        }
-    }
-}
-
 /* The B-spline base node of grid coordinate xi on axis ax (the first of bspline's three), or -1. */
 static inline int spline_base(grid_axis ax, double xi)
 {
@@ -747,12 +732,16 @@ static inline void mark_bases(const mpm_scene *s, unsigned char *near, int i, un
     }
 }
 
-/* Eq. 24 with linear transfers: thread t's grains' B-spline mass gradients at their shared
- * pairs, from the points whose 3 x 3 B-spline nodes include one of them (in point order, into
- * the records, two components per SSE2 operation). near[] flags the B-spline bases of such
- * points, so a point far from every shared node of its grain costs one lookup. */
-STAGE static void grain_normals(mpm_scene *s, int t)
+/* After the packing, each grain (in any order, by any thread t): its points' stencil entries
+ * (sv: the grain's pair at shared nodes, else the node) and, with spline normals (Eq. 24 with
+ * linear transfers), its B-spline mass gradients at its shared pairs, from the points whose 3 x 3
+ * B-spline nodes include one of them (in point order, into the records, two components per SSE2
+ * operation). near[] flags the B-spline bases of such points, so a point far from every shared
+ * node of its grain costs one lookup. */
+static inline __attribute__((always_inline)) void grain_finish_with(mpm_scene *s, int t,
+                                                                    const bool spline)
 {
+    const int ns = s->ns;
     const size_t nn = s->nnodes;
     const double ox = s->def.origin[0], oy = s->def.origin[1];
     const double ihx = s->inv_hx, ihy = s->inv_hy;
@@ -773,6 +762,14 @@ STAGE static void grain_normals(mpm_scene *s, int t)
         while (g >= s->tg[u + 1])
             u++;
         const size_t r0 = s->tq[u] + s->gps[g], r1 = r0 + s->gpc[g];
+        /* sv holds the pairs as scattered, from ns * tp[u] */
+        const long shift = (long)((size_t)ns * s->tp[u]) - (long)s->tq[u];
+        for (size_t e = (size_t)ns * p0; e < (size_t)ns * p1; e++) {
+            const int i = s->sn[e];
+            s->sv[e] = s->ngr[i] < 2 ? i : (int)(nn + (size_t)((long)s->sv[e] - shift));
+        }
+        if (!spline)
+            continue;
         bool shared = false;
         for (size_t r = r0; r < r1; r++) {
             const int i = s->pnode[r];
@@ -832,6 +829,15 @@ STAGE static void grain_normals(mpm_scene *s, int t)
     }
 }
 
+/* grain_finish_with with the normals' choice a constant. */
+STAGE static void grain_finish(mpm_scene *s, int t)
+{
+    if (s->opt.normals != MPM_NORMALS_LINEAR && s->ns != 9)
+        grain_finish_with(s, t, true);
+    else
+        grain_finish_with(s, t, false);
+}
+
 /* At shared nodes: the sum of the grains' gradients and nodal volumes (one thread). */
 STAGE static void grain_sums(mpm_scene *s)
 {
@@ -866,10 +872,8 @@ static void grain_fields(mpm_scene *s, int t, double *tlp)
         grain_pack(s);
     }
 #pragma omp barrier
-    grain_stencil(s, t);
-    STAGE_DONE(T_P2G); /* no barrier: the normals need none, so this is thread 0's own time */
-    if (s->opt.normals != MPM_NORMALS_LINEAR && s->ns != 9)
-        grain_normals(s, t);
+    STAGE_DONE(T_P2G);
+    grain_finish(s, t);
 #pragma omp barrier
 #pragma omp master
     grain_sums(s);
