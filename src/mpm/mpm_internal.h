@@ -109,6 +109,7 @@ struct mpm_scene {
     /* per-thread scratch of the frictional scatter: one record per (grain, node) pair of the
      * grain being scattered (its sums, see grain_scatter), reccap records per thread */
     struct mpm_pair_rec *trec;
+    int *tfin;              /* and reccap ints: a grain's pairs' final stencil entries */
     size_t reccap;
     struct mpm_point_fac *tfac; /* and the factors of a grain's points, faccap per thread */
     size_t faccap;

@@ -270,6 +270,7 @@ void mpm_destroy(mpm_scene *s)
     free(s->tc);
     free(s->tmark);
     free(s->trec);
+    free(s->tfin);
     free(s->gps);
     free(s->gpc);
     free(s->tfac);

@@ -158,8 +158,10 @@ static core_status threads_setup(mpm_scene *s, core_error *err)
             free(s->trec);
             const size_t bytes = (size_t)s->ntcap * (need + 1) * sizeof(struct mpm_pair_rec);
             s->trec = aligned_alloc(64, (bytes + 63) / 64 * 64);
-            s->reccap = s->trec ? need : 0;
-            if (!s->trec)
+            free(s->tfin);
+            s->tfin = malloc((size_t)s->ntcap * need * sizeof *s->tfin);
+            s->reccap = s->trec && s->tfin ? need : 0;
+            if (!s->trec || !s->tfin)
                 return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu contact records",
                                  need);
         }
@@ -752,6 +754,7 @@ static inline __attribute__((always_inline)) void grain_finish_with(mpm_scene *s
     unsigned char *const near = s->tnear + (size_t)t * nn;
     /* rec[-1]: a dummy record for the nodes that are not shared pairs of the grain */
     struct mpm_pair_rec *const rec = s->trec + (size_t)t * (s->reccap + 1) + 1;
+    int *const fin = s->tfin + (size_t)t * s->reccap;
     const double *const xs = s->x, *const ys = s->y, *const xm = s->m;
     /* grains in any order, by any thread: a grain's normals are its own (its pairs, in its
      * points' order), and the threads' loads differ (the shared nodes are not evenly spread) */
@@ -762,24 +765,23 @@ static inline __attribute__((always_inline)) void grain_finish_with(mpm_scene *s
         while (g >= s->tg[u + 1])
             u++;
         const size_t r0 = s->tq[u] + s->gps[g], r1 = r0 + s->gpc[g];
-        /* sv holds the pairs as scattered, from ns * tp[u] */
-        const long shift = (long)((size_t)ns * s->tp[u]) - (long)s->tq[u];
-        for (size_t e = (size_t)ns * p0; e < (size_t)ns * p1; e++) {
-            const int i = s->sn[e];
-            s->sv[e] = s->ngr[i] < 2 ? i : (int)(nn + (size_t)((long)s->sv[e] - shift));
-        }
-        if (!spline)
-            continue;
+        /* each pair's final entry, then the points' entries through it (sv holds the pairs
+         * as scattered: the grain's from ns * tp[u] + gps[g]) */
         bool shared = false;
         for (size_t r = r0; r < r1; r++) {
             const int i = s->pnode[r];
-            if (s->ngr[i] > 1) {
+            const bool sh = s->ngr[i] > 1;
+            fin[r - r0] = sh ? (int)(nn + r) : i;
+            if (spline && sh) {
                 mark[i] = (int)(r - r0);
                 rec[r - r0].n = (v2d){0, 0};
                 mark_bases(s, near, i, 1);
                 shared = true;
             }
         }
+        const size_t sv0 = (size_t)ns * s->tp[u] + s->gps[g];
+        for (size_t e = (size_t)ns * p0; e < (size_t)ns * p1; e++)
+            s->sv[e] = fin[(size_t)s->sv[e] - sv0];
         if (shared)
             for (size_t p = p0; p < p1; p++) {
                 const double xi = (xs[p] - ox) * ihx, eta = (ys[p] - oy) * ihy;
