@@ -1029,12 +1029,12 @@ STAGE static void contact_correct(mpm_scene *s, int th, double *vx, double *vy, 
     }
     if (!s->opt.conserve)
         return;
-    /* each node's sums over its corrected pairs, in pair order */
 #pragma omp barrier
 #pragma omp for schedule(static)
     for (size_t i = 0; i < nn; i++) {
         if (s->ngr[i] < 2)
             continue;
+        /* the node's sums over its corrected pairs, in pair order */
         double px = 0, py = 0, m = 0;
         bool any = false;
         for (int r = s->nhead[i]; r >= 0; r = s->pnext[r])
