@@ -96,6 +96,10 @@ struct mpm_scene {
      * chain, each over its own range of nodes, so that no pass over all pairs is serial. */
     int *nhead, *pnext;
     unsigned char *pshared;
+    /* The pairs at shared nodes in pair order, thread t's (tsh[t] of them) at slist[tq[t]...]:
+     * the contact loops split this list evenly (the shared nodes are not evenly spread over the
+     * threads' grains). */
+    int *slist;
     double *tgx, *tgy;      /* sum_p m_p G_pi over all grains (nnodes) */
     int *sv;                /* ns per point: the friction sf */
 
@@ -109,7 +113,7 @@ struct mpm_scene {
      * grain of range t), so that a grain's points, its per-grain field entries and the nodes
      * only it touches belong to one thread; per-thread scratch: marks (nt x nnodes) */
     int nt, ntcap;
-    size_t *tp, *tg, *tq, *tc;
+    size_t *tp, *tg, *tq, *tc, *tsh;
     int *tmark;             /* nt x (nnodes + 1), the last of each -1 */
     unsigned char *tnear;   /* nt x nnodes, zero outside grain_normals */
     /* per-thread scratch of the frictional scatter: one record per (grain, node) pair of the
