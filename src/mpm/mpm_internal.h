@@ -66,6 +66,9 @@ struct mpm_scene {
      * outside the step) */
     double *lzz;
     bool lzz_ok;
+    /* the stress update one point at a time, for the tests: the reference of its lanes
+     * (constitutive in step.c); false (calloc) otherwise */
+    bool stress_scalar;
     int *grain, *mat;
     /* stencil, MPM_STENCIL per point */
     int *sn;
