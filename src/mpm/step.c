@@ -869,6 +869,10 @@ STAGE static void contact_update(mpm_scene *s, double dt)
     contact_correct(s, s->nax, s->nay, true, dt);
 }
 
+/* Two doubles in the lanes of one SSE2 register (GCC's vector extension; NEON on arm64, scalar
+ * code elsewhere): each lane's arithmetic is the IEEE operation of the scalar code. */
+typedef double v2d __attribute__((vector_size(16)));
+
 /* Step 3: positions (Eq. 10) and velocities (Eq. 11, blended with PIC) of thread t's points; a
  * prescribed grain's points keep its velocity exactly. */
 static inline __attribute__((always_inline)) void to_points_with(mpm_scene *s, double dt, int t,
@@ -884,14 +888,15 @@ static inline __attribute__((always_inline)) void to_points_with(mpm_scene *s, d
     for (size_t p = s->tp[t]; p < pb; p++) {
         const int *n = &sf[ns * p];
         const double *w = &sw[ns * p];
-        double dvx = 0, dvy = 0, ax = 0, ay = 0;
+        /* x and y in the two lanes of a vector (v2d): each lane's sums in the scalar order */
+        v2d a = {0, 0}, dv = {0, 0};
         for (int k = 0; k < ns; k++) {
             const int i = n[k];
-            ax += w[k] * nax[i];
-            ay += w[k] * nay[i];
-            dvx += w[k] * (nax[i] - nvx[i]);
-            dvy += w[k] * (nay[i] - nvy[i]);
+            const v2d wk = {w[k], w[k]}, na = {nax[i], nay[i]}, nv = {nvx[i], nvy[i]};
+            a += wk * na;
+            dv += wk * (na - nv);
         }
+        const double ax = a[0], ay = a[1], dvx = dv[0], dvy = dv[1];
         x[p] += dt * ax;
         y[p] += dt * ay;
         ux[p] += dt * ax;
@@ -1115,11 +1120,11 @@ static inline bool point_suspect(const check_bounds *b, double x, double y, doub
  * return, b_e and sigma, with a flag on each point a lane cannot finish (possibly plastic, or one
  * the end-of-step check must look at); (D) the flagged points, scalar, in order. Each lane does
  * material_update_zz's operations in its order through the same helpers, and IEEE arithmetic is
- * the same per lane as scalar, so the bits are the scalar update's. A block with an inverted
- * point, or with points of more than one material, takes (B)-(D) one point at a time
- * (finish_point), as material_update_zz does. With s->stress_scalar, (A2)-(D) are point_scalar
+ * the same per lane as scalar, so the bits are the scalar update's. (C) runs over the block's
+ * runs of points of one material. A block with an inverted point takes (B)-(D) one point at a
+ * time (finish_point), as material_update_zz does. With s->stress_scalar, (A2)-(D) are point_scalar
  * instead: the reference tests/mpm/test_mpm_lanes.c compares the lanes with. */
-enum { CB = 16 };
+enum { CB = 64 };
 typedef struct {
     double f[4][CB], tr[3][CB], dir[3][CB], lg[2][CB], J[CB];
     double flag[CB]; /* 1 or 0: doubles, which SSE2 selects as lanes (64-bit integers not) */
@@ -1249,16 +1254,19 @@ lane_elastic(cblock *T, int j, size_t p, const mpm_material *m, const check_boun
     return f;
 }
 
-/* The loop of (C), with vm and chk constants; returns the number of flagged points. */
+/* The loop of (C) over points ja..jb-1 of the block, of one material m, with vm and chk
+ * constants; returns the number of flagged points. */
 static inline __attribute__((always_inline)) double
-pass_elastic(cblock *T, int nb, size_t p0, const mpm_material *m, const check_bounds *cb,
+pass_elastic(cblock *T, int ja, int jb, size_t p0, const mpm_material *m, const check_bounds *cb,
              const elastic_ctx *E, const bool vm, const bool chk)
 {
+    /* local copies, which the stores cannot alias: held in registers, not reloaded */
     const elastic_ctx e = *E;
+    const mpm_material mc = *m;
     double any = 0; /* a sum of 0s and 1s: exact in any order */
 #pragma omp simd reduction(+ : any)
-    for (int j = 0; j < nb; j++)
-        any += lane_elastic(T, j, p0 + (size_t)j, m, cb, &e, vm, chk);
+    for (int j = ja; j < jb; j++)
+        any += lane_elastic(T, j, p0 + (size_t)j, &mc, cb, &e, vm, chk);
     return any;
 }
 
@@ -1299,26 +1307,25 @@ static inline __attribute__((always_inline)) size_t constitutive_with(mpm_scene 
     for (size_t p0 = s->tp[t]; p0 < pe; p0 += CB) {
         const int nb = pe - p0 < CB ? (int)(pe - p0) : CB;
         /* (A1) */
-        const int m0 = mat[p0];
-        bool one = true;
         for (int j = 0; j < nb; j++) {
             const size_t p = p0 + (size_t)j;
             const int *n = &sf[ns * p];
             const double *gx = &sgx[ns * p], *gy = &sgy[ns * p];
-            double L[4] = {0, 0, 0, 0};
+            /* {L_xx, L_yx} and {L_xy, L_yy} in the lanes of two vectors (v2d), each lane's sum
+             * in the scalar order */
+            v2d Lx = {0, 0}, Ly = {0, 0};
             for (int k = 0; k < ns; k++) {
                 const int i = n[k];
-                L[0] += vx[i] * gx[k];
-                L[1] += vx[i] * gy[k];
-                L[2] += vy[i] * gx[k];
-                L[3] += vy[i] * gy[k];
+                const v2d v = {vx[i], vy[i]}, gxk = {gx[k], gx[k]}, gyk = {gy[k], gy[k]};
+                Lx += v * gxk;
+                Ly += v * gyk;
             }
-            T.f[0][j] = 1 + dt * L[0];
-            T.f[1][j] = dt * L[1];
-            T.f[2][j] = dt * L[2];
-            T.f[3][j] = 1 + dt * L[3];
-            one &= mat[p] == m0;
-            __asm__(""); /* keeps the loop scalar: SSE2's emulated gathers cost more */
+            const v2d dx = dt * Lx, dy = dt * Ly;
+            T.f[0][j] = 1 + dx[0];
+            T.f[1][j] = dy[0];
+            T.f[2][j] = dx[1];
+            T.f[3][j] = 1 + dy[1];
+            __asm__(""); /* keeps the loop over the points scalar: SSE2 has no gather */
         }
         if (s->stress_scalar) {
             for (int j = 0; j < nb; j++) {
@@ -1332,7 +1339,7 @@ static inline __attribute__((always_inline)) size_t constitutive_with(mpm_scene 
 #pragma omp simd reduction(+ : nok)
         for (int j = 0; j < nb; j++)
             nok += lane_trial(&T, j, p0 + (size_t)j, F0, F1, F2, F3, b0, b1, b2, lzz);
-        if (__builtin_expect(nok != nb || !one, 0)) {
+        if (__builtin_expect(nok != nb, 0)) {
             /* (B)-(D) one point at a time */
             for (int j = 0; j < nb; j++) {
                 const size_t p = p0 + (size_t)j;
@@ -1351,13 +1358,19 @@ static inline __attribute__((always_inline)) size_t constitutive_with(mpm_scene 
             T.lg[0][j] = log(T.lg[0][j]);
             T.lg[1][j] = log(T.lg[1][j]);
         }
-        /* (C) */
-        const mpm_material *const m = &mats[m0];
-        const bool vm = m->model == MPM_VONMISES;
-        const double any = vm ? (chk ? pass_elastic(&T, nb, p0, m, &cb, &E, true, true)
-                                     : pass_elastic(&T, nb, p0, m, &cb, &E, true, false))
-                              : (chk ? pass_elastic(&T, nb, p0, m, &cb, &E, false, true)
-                                     : pass_elastic(&T, nb, p0, m, &cb, &E, false, false));
+        /* (C), by runs of points of one material */
+        double any = 0;
+        for (int ja = 0, jb; ja < nb; ja = jb) {
+            const int mk = mat[p0 + (size_t)ja];
+            for (jb = ja + 1; jb < nb && mat[p0 + (size_t)jb] == mk; jb++)
+                ;
+            const mpm_material *const m = &mats[mk];
+            const bool vm = m->model == MPM_VONMISES;
+            any += vm ? (chk ? pass_elastic(&T, ja, jb, p0, m, &cb, &E, true, true)
+                             : pass_elastic(&T, ja, jb, p0, m, &cb, &E, true, false))
+                      : (chk ? pass_elastic(&T, ja, jb, p0, m, &cb, &E, false, true)
+                             : pass_elastic(&T, ja, jb, p0, m, &cb, &E, false, false));
+        }
         /* (D) */
         if (any)
             for (int j = 0; j < nb; j++)

@@ -3,7 +3,7 @@
  * suspects finished one at a time) against its scalar reference (the same scene with
  * stress_scalar, mpm_internal.h: material_update_zz point by point), bit for bit, point by point.
  * The scenes hold what the lanes must route right: von Mises points that yield next to elastic
- * ones, blocks holding points of two materials (which take the one-at-a-time path), a point
+ * ones, blocks holding points of two materials (runs of each in its lanes), a point
  * count that is odd and not a multiple of the block (the remainders), points crossing a
  * periodic edge (wrapped by the check), both update orders (MUSL checks each point right after
  * its update, USF later), both shape functions, and a run that inverts a point (the same point
