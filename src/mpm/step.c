@@ -1109,8 +1109,10 @@ static int bad_why(const mpm_scene *s, size_t first)
 static inline bool point_suspect(const check_bounds *b, double x, double y, double vx, double vy,
                                  const double sig[3])
 {
-    const double z = 0 * x + 0 * y + 0 * vx + 0 * vy + 0 * sig[0] + 0 * sig[1] + 0 * sig[2];
-    return !(z == 0) | (x < b->lo[0]) | (x >= b->hi[0]) | (y < b->lo[1]) | (y >= b->hi[1]);
+    /* s - s is 0 for a finite sum and NaN for a non-finite value (or a sum that overflows: a
+     * suspect too, which point_bad_at clears) */
+    const double sum = x + y + vx + vy + sig[0] + sig[1] + sig[2];
+    return !(sum - sum == 0) | (x < b->lo[0]) | (x >= b->hi[0]) | (y < b->lo[1]) | (y >= b->hi[1]);
 }
 
 /* The stress update works on blocks of CB points in passes, so that the arithmetic before and
@@ -1185,8 +1187,15 @@ static void point_scalar(mpm_scene *s, const check_bounds *cb, bool chk, const d
         *first = p;
 }
 
+/* material_update_zz's and log_strains's conditions (det f > 0, J > 0, l2 > 0 and ln(b_e,zz) / 2
+ * = lz > -inf), branch-free. */
+static inline bool update_ok(const double f[4], double J, double l2, double lz)
+{
+    return (f[0] * f[3] - f[1] * f[2] > 0) & (J > 0) & (l2 > 0) & (lz > -INFINITY);
+}
+
 /* (A2) of point j (p): F, J, the trial b_e and its eigen-split into the block; returns whether
- * the update can go on (material_update_zz's and log_strains's conditions). A function called
+ * the update can go on (update_ok: 1, else 0). A function called
  * from the simd loop, so that its arrays are scalarised after inlining rather than made the
  * loop's per-lane arrays. */
 static inline __attribute__((always_inline)) double
@@ -1206,8 +1215,7 @@ lane_trial(cblock *T, int j, size_t p, double *F0, double *F1, double *F2, doubl
     double tr[3], l1, l2, dir[3];
     trial_be(f, be, tr);
     eig2(tr[0], tr[1], tr[2], &l1, &l2, dir);
-    const double ok =
-        (f[0] * f[3] - f[1] * f[2] > 0) & (J > 0) & (l2 > 0) & (lzz[p] > -INFINITY) ? 1.0 : 0.0;
+    const double ok = update_ok(f, J, l2, lzz[p]) ? 1.0 : 0.0;
     for (int c = 0; c < 3; c++) {
         T->tr[c][j] = tr[c];
         T->dir[c][j] = dir[c];
@@ -1215,7 +1223,6 @@ lane_trial(cblock *T, int j, size_t p, double *F0, double *F1, double *F2, doubl
     T->lg[0][j] = l1;
     T->lg[1][j] = l2;
     T->J[j] = J;
-    T->flag[j] = ok;
     return ok;
 }
 
@@ -1343,7 +1350,8 @@ static inline __attribute__((always_inline)) size_t constitutive_with(mpm_scene 
             /* (B)-(D) one point at a time */
             for (int j = 0; j < nb; j++) {
                 const size_t p = p0 + (size_t)j;
-                if (!T.flag[j]) {
+                const double f[4] = {T.f[0][j], T.f[1][j], T.f[2][j], T.f[3][j]};
+                if (!update_ok(f, T.J[j], T.lg[1][j], lzz[p])) {
                     if (bad == (size_t)-1)
                         bad = p;
                     continue;
