@@ -873,6 +873,35 @@ STAGE static void contact_update(mpm_scene *s, double dt)
  * code elsewhere): each lane's arithmetic is the IEEE operation of the scalar code. */
 typedef double v2d __attribute__((vector_size(16)));
 
+/* Two consecutive doubles as a vector and back (memcpy: any alignment, no aliasing question;
+ * one unaligned load or store). */
+static inline v2d v2_load(const double *p)
+{
+    v2d v;
+    memcpy(&v, p, sizeof v);
+    return v;
+}
+static inline void v2_store(double *p, v2d v) { memcpy(p, &v, sizeof v); }
+
+/* Point p's sums of G2P: a = sum_i N_i a_i and dv = sum_i N_i (a_i - v_i), x and y in the two
+ * lanes, each lane's sums in the scalar order. */
+static inline __attribute__((always_inline)) void
+g2p_gather(const int *sf, const double *sw, const double *nax, const double *nay, const double *nvx,
+           const double *nvy, size_t p, const int ns, v2d *a, v2d *dv)
+{
+    const int *n = &sf[ns * p];
+    const double *w = &sw[ns * p];
+    v2d sa = {0, 0}, sd = {0, 0};
+    for (int k = 0; k < ns; k++) {
+        const int i = n[k];
+        const v2d wk = {w[k], w[k]}, na = {nax[i], nay[i]}, nv = {nvx[i], nvy[i]};
+        sa += wk * na;
+        sd += wk * (na - nv);
+    }
+    *a = sa;
+    *dv = sd;
+}
+
 /* Step 3: positions (Eq. 10) and velocities (Eq. 11, blended with PIC) of thread t's points; a
  * prescribed grain's points keep its velocity exactly. */
 static inline __attribute__((always_inline)) void to_points_with(mpm_scene *s, double dt, int t,
@@ -884,18 +913,27 @@ static inline __attribute__((always_inline)) void to_points_with(mpm_scene *s, d
     const double *const nax = s->nax, *const nay = s->nay, *const nvx = s->nvx, *const nvy = s->nvy;
     double *const x = s->x, *const y = s->y, *const ux = s->ux, *const uy = s->uy;
     double *const vx = s->vx, *const vy = s->vy;
-    const size_t pb = s->tp[t + 1];
-    for (size_t p = s->tp[t]; p < pb; p++) {
-        const int *n = &sf[ns * p];
-        const double *w = &sw[ns * p];
-        /* x and y in the two lanes of a vector (v2d): each lane's sums in the scalar order */
-        v2d a = {0, 0}, dv = {0, 0};
-        for (int k = 0; k < ns; k++) {
-            const int i = n[k];
-            const v2d wk = {w[k], w[k]}, na = {nax[i], nay[i]}, nv = {nvx[i], nvy[i]};
-            a += wk * na;
-            dv += wk * (na - nv);
-        }
+    const size_t pa = s->tp[t], pb = s->tp[t + 1];
+    size_t p = pa;
+    /* two points at a time: their gathers, then the updates with the points in the lanes (not
+     * with no_lanes, the tests' reference) */
+    for (; p + 1 < pb && !s->no_lanes; p += 2) {
+        v2d a[2], dv[2];
+        g2p_gather(sf, sw, nax, nay, nvx, nvy, p, ns, &a[0], &dv[0]);
+        g2p_gather(sf, sw, nax, nay, nvx, nvy, p + 1, ns, &a[1], &dv[1]);
+        const v2d ax = {a[0][0], a[1][0]}, ay = {a[0][1], a[1][1]};
+        const v2d dvx = {dv[0][0], dv[1][0]}, dvy = {dv[0][1], dv[1][1]};
+        const v2d dx = dt * ax, dy = dt * ay;
+        v2_store(&x[p], v2_load(&x[p]) + dx);
+        v2_store(&y[p], v2_load(&y[p]) + dy);
+        v2_store(&ux[p], v2_load(&ux[p]) + dx);
+        v2_store(&uy[p], v2_load(&uy[p]) + dy);
+        v2_store(&vx[p], flip * (v2_load(&vx[p]) + dvx) + pic * ax);
+        v2_store(&vy[p], flip * (v2_load(&vy[p]) + dvy) + pic * ay);
+    }
+    for (; p < pb; p++) {
+        v2d a, dv;
+        g2p_gather(sf, sw, nax, nay, nvx, nvy, p, ns, &a, &dv);
         const double ax = a[0], ay = a[1], dvx = dv[0], dvy = dv[1];
         x[p] += dt * ax;
         y[p] += dt * ay;
@@ -909,9 +947,9 @@ static inline __attribute__((always_inline)) void to_points_with(mpm_scene *s, d
             const int k = s->gpres[g];
             if (k < 0)
                 continue;
-            for (size_t p = s->gstart[g]; p < s->gstart[g] + s->gcount[g]; p++) {
-                s->vx[p] = s->pv[k][0];
-                s->vy[p] = s->pv[k][1];
+            for (size_t q = s->gstart[g]; q < s->gstart[g] + s->gcount[g]; q++) {
+                s->vx[q] = s->pv[k][0];
+                s->vy[q] = s->pv[k][1];
             }
         }
 }
@@ -1124,7 +1162,7 @@ static inline bool point_suspect(const check_bounds *b, double x, double y, doub
  * material_update_zz's operations in its order through the same helpers, and IEEE arithmetic is
  * the same per lane as scalar, so the bits are the scalar update's. (C) runs over the block's
  * runs of points of one material. A block with an inverted point takes (B)-(D) one point at a
- * time (finish_point), as material_update_zz does. With s->stress_scalar, (A2)-(D) are point_scalar
+ * time (finish_point), as material_update_zz does. With s->no_lanes, (A2)-(D) are point_scalar
  * instead: the reference tests/mpm/test_mpm_lanes.c compares the lanes with. */
 enum { CB = 64 };
 typedef struct {
@@ -1156,7 +1194,7 @@ static inline void finish_point(mpm_scene *s, const check_bounds *cb, bool chk, 
 
 /* Point p from its increment f, scalar: F, material_update_zz, the stores, with chk the
  * end-of-step check; *bad: the first inverted point, *first: the first bad one. The stress
- * update's reference (s->stress_scalar). */
+ * update's reference (s->no_lanes). */
 static void point_scalar(mpm_scene *s, const check_bounds *cb, bool chk, const double f[4],
                          size_t p, size_t *bad, size_t *first)
 {
@@ -1334,7 +1372,7 @@ static inline __attribute__((always_inline)) size_t constitutive_with(mpm_scene 
             T.f[3][j] = 1 + dy[1];
             __asm__(""); /* keeps the loop over the points scalar: SSE2 has no gather */
         }
-        if (s->stress_scalar) {
+        if (s->no_lanes) {
             for (int j = 0; j < nb; j++) {
                 const double f[4] = {T.f[0][j], T.f[1][j], T.f[2][j], T.f[3][j]};
                 point_scalar(s, &cb, chk, f, p0 + (size_t)j, &bad, &first);

@@ -1,13 +1,14 @@
-/* The MPM stress update's lanes (constitutive in src/mpm/step.c: blocks of points, two at a time
- * in SSE2 lanes, the logarithms scalar, the possibly plastic points and the end-of-step check's
- * suspects finished one at a time) against its scalar reference (the same scene with
- * stress_scalar, mpm_internal.h: material_update_zz point by point), bit for bit, point by point.
- * The scenes hold what the lanes must route right: von Mises points that yield next to elastic
- * ones, blocks holding points of two materials (runs of each in its lanes), a point
- * count that is odd and not a multiple of the block (the remainders), points crossing a
- * periodic edge (wrapped by the check), both update orders (MUSL checks each point right after
- * its update, USF later), both shape functions, and a run that inverts a point (the same point
- * reported). */
+/* The MPM step's lanes against their scalar reference (the same scene with no_lanes,
+ * mpm_internal.h), bit for bit, point by point: the stress update (constitutive in
+ * src/mpm/step.c: blocks of points, two at a time in SSE2 lanes, the logarithms scalar, the
+ * possibly plastic points and the end-of-step check's suspects finished one at a time; the
+ * reference is material_update_zz point by point) and G2P (to_points: two points at a time, the
+ * last one of an odd range alone; the reference one at a time). The scenes hold what the lanes
+ * must route right: von Mises points that yield next to elastic ones, blocks holding points of
+ * two materials (runs of each in its lanes), a point count that is odd and not a multiple of
+ * the block (the remainders), points crossing a periodic edge (wrapped by the check), both
+ * update orders (MUSL checks each point right after its update, USF later), both shape
+ * functions, and a run that inverts a point (the same point reported). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -33,7 +34,7 @@ static mpm_scene *scene(mpm_update update, mpm_shape_fn shape, mpm_contact_model
     def.shape = shape;
     mpm_scene *s = NULL;
     assert_int_equal(mpm_create(&def, &s, &err), CORE_OK);
-    s->stress_scalar = scalar;
+    s->no_lanes = scalar;
     mpm_material vm = mpm_default_material(), el = mpm_default_material();
     vm.model = MPM_VONMISES;
     vm.yield = 2e4;
@@ -74,12 +75,12 @@ static void same_points(const mpm_scene *a, const mpm_scene *b)
     mpm_get_points(b, &pb);
     const size_t n = mpm_point_count(a);
     assert_int_equal(mpm_point_count(b), n);
-    const double *fa[] = {pa.x,        pa.y,        pa.vx,   pa.vy,       pa.F[0],
-                          pa.F[1],     pa.F[2],     pa.F[3], pa.sigma[0], pa.sigma[1],
-                          pa.sigma[2], pa.sigma[3], pa.eps_p};
-    const double *fb[] = {pb.x,        pb.y,        pb.vx,   pb.vy,       pb.F[0],
-                          pb.F[1],     pb.F[2],     pb.F[3], pb.sigma[0], pb.sigma[1],
-                          pb.sigma[2], pb.sigma[3], pb.eps_p};
+    const double *fa[] = {pa.x,        pa.y,        pa.vx,       pa.vy,       pa.ux,
+                          pa.uy,       pa.F[0],     pa.F[1],     pa.F[2],     pa.F[3],
+                          pa.sigma[0], pa.sigma[1], pa.sigma[2], pa.sigma[3], pa.eps_p};
+    const double *fb[] = {pb.x,        pb.y,        pb.vx,       pb.vy,       pb.ux,
+                          pb.uy,       pb.F[0],     pb.F[1],     pb.F[2],     pb.F[3],
+                          pb.sigma[0], pb.sigma[1], pb.sigma[2], pb.sigma[3], pb.eps_p};
     for (size_t k = 0; k < sizeof fa / sizeof *fa; k++)
         assert_memory_equal(fa[k], fb[k], n * sizeof(double));
 }
