@@ -917,7 +917,8 @@ static inline __attribute__((always_inline)) void to_points_with(mpm_scene *s, d
     size_t p = pa;
     /* two points at a time: their gathers, then the updates with the points in the lanes (not
      * with no_lanes, the tests' reference) */
-    for (; p + 1 < pb && !s->no_lanes; p += 2) {
+    const size_t pl = s->no_lanes ? pa : pb; /* the pairs' end bound, read once */
+    for (; p + 1 < pl; p += 2) {
         v2d a[2], dv[2];
         g2p_gather(sf, sw, nax, nay, nvx, nvy, p, ns, &a[0], &dv[0]);
         g2p_gather(sf, sw, nax, nay, nvx, nvy, p + 1, ns, &a[1], &dv[1]);
