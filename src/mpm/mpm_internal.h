@@ -107,7 +107,16 @@ struct mpm_scene {
      * only it touches belong to one thread; per-thread scratch: marks (nt x nnodes) */
     int nt, ntcap;
     size_t *tp, *tg, *tq, *tc;
-    int *tmark;
+    int *tmark;             /* nt x (nnodes + 1), the last of each -1 */
+    unsigned char *tnear;   /* nt x nnodes, zero outside grain_normals */
+    /* per-thread scratch of the frictional scatter: one record per (grain, node) pair of the
+     * grain being scattered (its sums, see grain_scatter), reccap records per thread */
+    struct mpm_pair_rec *trec;
+    int *tfin;              /* and reccap ints: a grain's pairs' final stencil entries */
+    size_t reccap;
+    struct mpm_point_fac *tfac; /* and the factors of a grain's points, faccap per thread */
+    size_t faccap;
+    size_t *gps, *gpc, gpcap; /* grain g's pairs: gpc[g] from tq[its thread] + gps[g] */
     /* The noslip transfers' chunks: nc grain-aligned point ranges [cp[c], cp[c+1]); thread t
      * scatters chunks t, t + nt, ... each into its own node arrays (chunk 0: the scene's, chunk c
      * > 0: tbuf's (c - 1)-th 5 x nnodes block), added up in chunk order. nc is the processor

@@ -269,6 +269,12 @@ void mpm_destroy(mpm_scene *s)
     free(s->tq);
     free(s->tc);
     free(s->tmark);
+    free(s->trec);
+    free(s->tfin);
+    free(s->gps);
+    free(s->gpc);
+    free(s->tfac);
+    free(s->tnear);
     free(s->tbuf);
     free(s->cp);
     free(s);

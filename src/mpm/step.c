@@ -24,6 +24,23 @@
 /* The step's stages stay separate functions so that a profiler (callgrind) counts each. */
 #define STAGE __attribute__((noinline))
 
+/* Two doubles in one SSE2 register (GCC/Clang vector extension): each lane does exactly the
+ * scalar arithmetic, so a vector sum gives the bits of the two scalar ones. */
+typedef double v2d __attribute__((vector_size(16)));
+
+/* The sums of one (grain, node) pair while its grain is scattered (grain_scatter), as pairs of
+ * lanes: (mass, momentum x), (momentum y, volume), (force x, force y), (mass gradient x, y); one
+ * cache line per pair. */
+struct mpm_pair_rec {
+    v2d mpx, pyv, f, n;
+};
+
+/* A point's factors of those sums: (m, m v_x), (m v_y, V), m g, (sigma_xx, sigma_xy) V and
+ * (sigma_xy, sigma_yy) V. */
+struct mpm_point_fac {
+    v2d mpx, pyv, fg, sa, sb;
+};
+
 enum { T_STENCIL, T_P2G, T_NORMALS, T_GRID, T_CONTACT, T_G2P, T_REMAP, T_MATERIAL, T_CHECK };
 const char *const mpm_stage_names[MPM_NSTAGES] = {"stencil", "p2g",   "normals",  "grid", "contact",
                                                   "g2p",     "remap", "material", "check"};
@@ -116,15 +133,59 @@ static core_status threads_setup(mpm_scene *s, core_error *err)
             *ranges[r] = a;
         }
         free(s->tmark);
-        s->tmark = malloc((size_t)nt * s->nnodes * sizeof *s->tmark);
+        /* per thread nnodes + 1 marks: the last stays -1 (grain_scatter) */
+        s->tmark = malloc((size_t)nt * (s->nnodes + 1) * sizeof *s->tmark);
         if (!s->tmark)
             return core_fail(err, CORE_ERR_NOMEM, "out of memory for %d threads", nt);
-        for (size_t i = 0; i < (size_t)nt * s->nnodes; i++)
+        for (size_t i = 0; i < (size_t)nt * (s->nnodes + 1); i++)
             s->tmark[i] = -1;
+        free(s->tnear);
+        s->tnear = calloc((size_t)nt * s->nnodes, 1);
+        if (!s->tnear)
+            return core_fail(err, CORE_ERR_NOMEM, "out of memory for %d threads", nt);
         s->ntcap = nt;
+        s->reccap = s->faccap = 0; /* the records below are per thread */
     }
     s->nt = nt;
     grain_ranges(s, nt, s->tp, s->tg);
+    if (s->contact == MPM_CONTACT_FRICTION) {
+        /* a grain has at most ns pairs per point */
+        size_t gmax = 1;
+        for (size_t g = 0; g < s->ngrains; g++)
+            gmax = s->gcount[g] > gmax ? s->gcount[g] : gmax;
+        const size_t need = (size_t)s->ns * gmax;
+        if (need > s->reccap) {
+            free(s->trec);
+            const size_t bytes = (size_t)s->ntcap * (need + 1) * sizeof(struct mpm_pair_rec);
+            s->trec = aligned_alloc(64, (bytes + 63) / 64 * 64);
+            free(s->tfin);
+            s->tfin = malloc((size_t)s->ntcap * need * sizeof *s->tfin);
+            s->reccap = s->trec && s->tfin ? need : 0;
+            if (!s->trec || !s->tfin)
+                return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu contact records",
+                                 need);
+        }
+        if (s->ngrains > s->gpcap) {
+            size_t **per_grain[2] = {&s->gps, &s->gpc};
+            for (int k = 0; k < 2; k++) {
+                size_t *a = realloc(*per_grain[k], s->ngrains * sizeof *a);
+                if (!a)
+                    return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu grains",
+                                     s->ngrains);
+                *per_grain[k] = a;
+            }
+            s->gpcap = s->ngrains;
+        }
+        if (gmax > s->faccap) {
+            free(s->tfac);
+            const size_t bytes = (size_t)s->ntcap * gmax * sizeof(struct mpm_point_fac);
+            s->tfac = aligned_alloc(64, (bytes + 63) / 64 * 64);
+            s->faccap = s->tfac ? gmax : 0;
+            if (!s->tfac)
+                return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu contact records",
+                                 gmax);
+        }
+    }
     return CORE_OK;
 }
 
@@ -166,14 +227,29 @@ core_status mpm_timestep_info(const mpm_scene *s, double cfl, mpm_timestep *out,
     return CORE_OK;
 }
 
-/* Node index of grid node gi on axis a (ghost layers and periodic wrap), or -1 outside. */
-static inline int node_of(const mpm_scene *s, int a, int gi)
+/* One grid axis as axis_node needs it, taken into locals once per pass: the loops store ints
+ * (stencils, marks), which could alias the scene's int fields, so reading those inside them
+ * would reload these at every call. */
+typedef struct {
+    int n, ghost, nodes;
+    bool periodic;
+} grid_axis;
+
+static inline grid_axis axis_of(const mpm_scene *s, int a)
 {
-    const int n = s->def.cells[a];
-    if (s->def.periodic[a])
-        return gi < 0 ? gi + n : (gi >= n ? gi - n : gi);
-    const int I = gi + s->gl[a], nn = a ? s->nny : s->nnx;
-    return I >= 0 && I < nn ? I : -1;
+    return (grid_axis){.n = s->def.cells[a],
+                       .ghost = s->gl[a],
+                       .nodes = a ? s->nny : s->nnx,
+                       .periodic = s->def.periodic[a]};
+}
+
+/* Node index of grid node gi on axis ax (ghost layers and periodic wrap), or -1 outside. */
+static inline int axis_node(grid_axis ax, int gi)
+{
+    if (ax.periodic)
+        return gi < 0 ? gi + ax.n : (gi >= ax.n ? gi - ax.n : gi);
+    const int I = gi + ax.ghost;
+    return I >= 0 && I < ax.nodes ? I : -1;
 }
 
 /* floor(x) as an int for finite x in int range (grid coordinates): a truncation and a
@@ -208,6 +284,7 @@ static inline __attribute__((always_inline)) void stencil_range(mpm_scene *s, si
     const double ox = s->def.origin[0], oy = s->def.origin[1];
     const int nx = s->def.cells[0], ny = s->def.cells[1], nnx = s->nnx;
     const double ihx = s->inv_hx, ihy = s->inv_hy;
+    const grid_axis ax = axis_of(s, 0), ay = axis_of(s, 1);
     for (size_t p = pa; p < pb; p++) {
         const double xi = (s->x[p] - ox) * ihx, eta = (s->y[p] - oy) * ihy;
         int *n = &s->sn[ns * p];
@@ -217,9 +294,9 @@ static inline __attribute__((always_inline)) void stencil_range(mpm_scene *s, si
             const int bi = bspline(xi, wx, dx), bj = bspline(eta, wy, dy);
             int k = 0;
             for (int b = 0; b < 3; b++) {
-                const int J = node_of(s, 1, bj + b);
+                const int J = axis_node(ay, bj + b);
                 for (int a = 0; a < 3; a++, k++) {
-                    n[k] = J * nnx + node_of(s, 0, bi + a);
+                    n[k] = J * nnx + axis_node(ax, bi + a);
                     w[k] = wx[a] * wy[b];
                     gx[k] = dx[a] * wy[b] * ihx;
                     gy[k] = wx[a] * dy[b] * ihy;
@@ -237,8 +314,8 @@ static inline __attribute__((always_inline)) void stencil_range(mpm_scene *s, si
         if (j < 0)
             j = 0;
         const double fx = xi - i, fy = eta - j;
-        const int i0 = node_of(s, 0, i), i1 = node_of(s, 0, i + 1);
-        const int j0 = node_of(s, 1, j), j1 = node_of(s, 1, j + 1);
+        const int i0 = axis_node(ax, i), i1 = axis_node(ax, i + 1);
+        const int j0 = axis_node(ay, j), j1 = axis_node(ay, j + 1);
         n[0] = j0 * nnx + i0;
         n[1] = j0 * nnx + i1;
         n[2] = j1 * nnx + i0;
@@ -473,8 +550,8 @@ STAGE static void apply_walls_pairs(mpm_scene *s, double *vx, double *vy, bool d
  * points; the centre-of-mass entries are their sums (Eqs. 5-7 over all points), so no separate
  * transfer is needed. pnx, pny hold the gradient of the grain's mass field at the node, outward:
  * sum_p m_p grad N_i(x_p) over the grain, with the transfer's shape functions or (normals
- * 'averaged' and 'own' with linear transfers) with quadratic B-splines (Eq. 24) in a second pass
- * that visits only the points within reach of a shared node. tgx, tgy at a shared node: the sum
+ * 'averaged' and 'own' with linear transfers) with quadratic B-splines (Eq. 24), read at shared
+ * nodes only. tgx, tgy at a shared node: the sum
  * of its grains' gradients, so that 2 g - g_all of two grains are exactly opposite. A point moves
  * with its grain's field at nodes shared by two or more grains and with the centre-of-mass node
  * elsewhere, so an isolated grain evolves exactly as with noslip. */
@@ -494,16 +571,21 @@ static void move_pairs(mpm_scene *s, size_t to, size_t from, size_t n)
 }
 
 /* Inside the parallel region; thread t takes its grains. Their pairs are first written from
- * ns * tp[t] (a grain has at most ns pairs per point), then packed in thread order. */
+ * ns * tp[t] (a grain has at most ns pairs per point), then packed in thread order. A grain's
+ * pairs are numbered in the order its points first touch their nodes; while the grain is
+ * scattered, their sums build up in the thread's records (one cache line per pair, two sums per
+ * SSE2 operation, mark[i] the record of node i), and are then copied into the nodal and pair
+ * arrays. */
 static inline __attribute__((always_inline)) void
 grain_scatter_with(mpm_scene *s, int t, const int ns, const bool volumes, const bool spline_normals)
 {
     const size_t nn = s->nnodes;
     const double gx0 = s->def.gravity[0], gy0 = s->def.gravity[1];
-    int *mark = s->tmark + (size_t)t * nn;
+    int *const mark = s->tmark + (size_t)t * (nn + 1);
+    struct mpm_pair_rec *const rec = s->trec + (size_t)t * (s->reccap + 1) + 1;
     const size_t base = (size_t)ns * s->tp[t];
-    /* the grain entries (pair r at nn + r of the nodal arrays) and the point arrays as locals:
-     * the stores below cannot change them, and the compiler need not reload them */
+    /* the arrays as locals: the stores below cannot change them, and the compiler need not
+     * reload them */
     double *const pm = s->nm + nn, *const ppx = s->npx + nn, *const ppy = s->npy + nn;
     double *const pfx = s->nfx + nn, *const pfy = s->nfy + nn;
     double *const pnx = s->pnx, *const pny = s->pny, *const pvol = s->pvol;
@@ -511,46 +593,71 @@ grain_scatter_with(mpm_scene *s, int t, const int ns, const bool volumes, const 
     const double *const xm = s->m, *const vx = s->vx, *const vy = s->vy, *const v0 = s->v0;
     const double *const F0 = s->F[0], *const F1 = s->F[1], *const F2 = s->F[2], *const F3 = s->F[3];
     const double *const s0 = s->sig[0], *const s1 = s->sig[1], *const s2 = s->sig[2];
+    const v2d grav = {gx0, gy0};
+    struct mpm_point_fac *const fac = s->tfac + (size_t)t * s->faccap;
     size_t q = base;
     for (size_t g = s->tg[t]; g < s->tg[t + 1]; g++) {
-        const size_t p0 = s->gstart[g], p1 = p0 + s->gcount[g], q0 = q;
+        const size_t p0 = s->gstart[g], p1 = p0 + s->gcount[g];
+        /* three passes over the grain's points (in cache), each with few live pointers: the
+         * stencils, each point's factors, the sums */
+        stencil_range(s, p0, p1, ns);
         for (size_t p = p0; p < p1; p++) {
-            stencil_range(s, p, p + 1, ns); /* in cache for the scatter below */
             const double m = xm[p], px = m * vx[p], py = m * vy[p];
             const double V = v0[p] * (F0[p] * F3[p] - F1[p] * F2[p]);
             const double sxx = V * s0[p], syy = V * s1[p], sxy = V * s2[p];
-            const double fgx = m * gx0, fgy = m * gy0;
+            /* the lanes: m w, p_x w | p_y w, V w | w m g - sigma V G (Eq. 7) */
+            fac[p - p0] = (struct mpm_point_fac){.mpx = {m, px},
+                                                 .pyv = {py, V},
+                                                 .fg = {m * grav[0], m * grav[1]},
+                                                 .sa = {sxx, sxy},
+                                                 .sb = {sxy, syy}};
+        }
+        int nr = 0; /* the grain's pairs so far: records [0, nr), pairs q .. q + nr - 1 */
+        s->gps[g] = q - base;
+        for (size_t p = p0; p < p1; p++) {
+            const struct mpm_point_fac *const f = &fac[p - p0];
             const int *n = &s->sn[ns * p];
             const double *w = &s->sw[ns * p], *gx = &s->sgx[ns * p], *gy = &s->sgy[ns * p];
             int *sv = &s->sv[ns * p];
             for (int k = 0; k < ns; k++) {
                 const int i = n[k];
+                const v2d wk = {w[k], w[k]}, gxk = {gx[k], gx[k]}, gyk = {gy[k], gy[k]};
                 int r = mark[i];
                 if (r < 0) {
-                    r = (int)q++;
+                    r = nr++;
                     mark[i] = r;
-                    pnode[r] = i;
-                    pgrain[r] = (int)g;
-                    pm[r] = ppx[r] = ppy[r] = pfx[r] = pfy[r] = 0;
-                    pnx[r] = pny[r] = pvol[r] = 0;
+                    pnode[q + (size_t)r] = i;
+                    pgrain[q + (size_t)r] = (int)g;
+                    rec[r] = (struct mpm_pair_rec){{0, 0}, {0, 0}, {0, 0}, {0, 0}};
                 }
-                const double wk = w[k];
-                pm[r] += wk * m;
-                ppx[r] += wk * px;
-                ppy[r] += wk * py;
-                pfx[r] += wk * fgx - (sxx * gx[k] + sxy * gy[k]);
-                pfy[r] += wk * fgy - (sxy * gx[k] + syy * gy[k]);
+                struct mpm_pair_rec *const e = &rec[r];
+                e->mpx += wk * f->mpx;
                 if (volumes)
-                    pvol[r] += wk * V;
+                    e->pyv += wk * f->pyv;
+                else
+                    e->pyv[0] += w[k] * f->pyv[0];
+                e->f += wk * f->fg - (f->sa * gxk + f->sb * gyk);
                 if (!spline_normals) {
-                    pnx[r] += m * gx[k];
-                    pny[r] += m * gy[k];
+                    const v2d mm = {f->mpx[0], f->mpx[0]}, gk = {gx[k], gy[k]};
+                    e->n += mm * gk;
                 }
-                sv[k] = r; /* the pair, renumbered after packing */
+                sv[k] = (int)q + r; /* the pair, renumbered after packing */
             }
         }
-        for (size_t r = q0; r < q; r++)
-            mark[pnode[r]] = -1;
+        for (int r = 0; r < nr; r++) {
+            const size_t e = q + (size_t)r;
+            mark[pnode[e]] = -1;
+            pm[e] = rec[r].mpx[0];
+            ppx[e] = rec[r].mpx[1];
+            ppy[e] = rec[r].pyv[0];
+            pvol[e] = rec[r].pyv[1];
+            pfx[e] = rec[r].f[0];
+            pfy[e] = rec[r].f[1];
+            pnx[e] = rec[r].n[0];
+            pny[e] = rec[r].n[1];
+        }
+        q += (size_t)nr;
+        s->gpc[g] = (size_t)nr;
     }
     s->tc[t] = q - base;
 }
@@ -597,78 +704,140 @@ STAGE static void grain_pack(mpm_scene *s)
     }
 }
 
-/* Thread t's points' stencil entries: the grain's pair at shared nodes, else the node. */
-STAGE static void grain_stencil(mpm_scene *s, int t)
+/* The B-spline base node of grid coordinate xi on axis ax (the first of bspline's three), or -1. */
+static inline int spline_base(grid_axis ax, double xi)
 {
-    const size_t nn = s->nnodes;
-    const int ns = s->ns;
-    const size_t base = (size_t)ns * s->tp[t];
-    {
-        const long shift = (long)base - (long)s->tq[t];
-        for (size_t e = (size_t)ns * s->tp[t]; e < (size_t)ns * s->tp[t + 1]; e++) {
-            const int i = s->sn[e];
-            s->sv[e] = s->ngr[i] < 2 ? i : (int)(nn + (size_t)((long)s->sv[e] - shift));
+    return axis_node(ax, ifloor(xi - 0.5));
+}
+
+/* Sets (v = 1) or clears (v = 0) near[] at the B-spline base nodes of the points whose 3 x 3
+ * nodes include node i: the bases up to two nodes below i on each axis. */
+static inline void mark_bases(const mpm_scene *s, unsigned char *near, int i, unsigned char v)
+{
+    const int nnx = s->nnx, I = i % nnx, J = i / nnx;
+    for (int b = 0; b < 3; b++) {
+        int Jb = J - b;
+        if (Jb < 0) {
+            if (!s->def.periodic[1])
+                break;
+            Jb += s->nny;
+        }
+        for (int a = 0; a < 3; a++) {
+            int Ib = I - a;
+            if (Ib < 0) {
+                if (!s->def.periodic[0])
+                    break;
+                Ib += nnx;
+            }
+            near[Jb * nnx + Ib] = v;
         }
     }
 }
 
-/* Eq. 24 with linear transfers: thread t's grains' B-spline mass gradients at their shared pairs.
- */
-STAGE static void grain_normals(mpm_scene *s, int t)
+/* After the packing, each grain (in any order, by any thread t): its points' stencil entries
+ * (sv: the grain's pair at shared nodes, else the node) and, with spline normals (Eq. 24 with
+ * linear transfers), its B-spline mass gradients at its shared pairs, from the points whose 3 x 3
+ * B-spline nodes include one of them (in point order, into the records, two components per SSE2
+ * operation). near[] flags the B-spline bases of such points, so a point far from every shared
+ * node of its grain costs one lookup. */
+static inline __attribute__((always_inline)) void grain_finish_with(mpm_scene *s, int t,
+                                                                    const bool spline)
 {
+    const int ns = s->ns;
+    const size_t nn = s->nnodes;
     const double ox = s->def.origin[0], oy = s->def.origin[1];
-    int *mark = s->tmark + (size_t)t * s->nnodes;
-    {
-        /* Eq. 24 with linear transfers: each grain's B-spline mass gradient at its shared pairs,
-         * from the points whose 3 x 3 B-spline nodes include one of them. */
-        size_t r0 = s->tq[t];
-        for (size_t g = s->tg[t]; g < s->tg[t + 1]; g++) {
-            const size_t p0 = s->gstart[g], p1 = p0 + s->gcount[g];
-            size_t r1 = r0;
-            bool shared = false;
-            while (r1 < s->tq[t + 1] && s->pgrain[r1] == (int)g) {
-                if (s->ngr[s->pnode[r1]] > 1) {
-                    mark[s->pnode[r1]] = (int)r1;
-                    shared = true;
-                }
-                r1++;
+    const double ihx = s->inv_hx, ihy = s->inv_hy;
+    const v2d ih = {ihx, ihy};
+    const int nnx = s->nnx, skip = (int)nn; /* mark[nn] = -1 always */
+    const grid_axis ax = axis_of(s, 0), ay = axis_of(s, 1);
+    int *const mark = s->tmark + (size_t)t * (nn + 1);
+    unsigned char *const near = s->tnear + (size_t)t * nn;
+    /* rec[-1]: a dummy record for the nodes that are not shared pairs of the grain */
+    struct mpm_pair_rec *const rec = s->trec + (size_t)t * (s->reccap + 1) + 1;
+    int *const fin = s->tfin + (size_t)t * s->reccap;
+    const double *const xs = s->x, *const ys = s->y, *const xm = s->m;
+    /* grains in any order, by any thread: a grain's normals are its own (its pairs, in its
+     * points' order), and the threads' loads differ (the shared nodes are not evenly spread) */
+#pragma omp for schedule(dynamic, 4) nowait
+    for (size_t g = 0; g < s->ngrains; g++) {
+        const size_t p0 = s->gstart[g], p1 = p0 + s->gcount[g];
+        int u = 0; /* the thread that scattered the grain, whose pairs start at tq[u] */
+        while (g >= s->tg[u + 1])
+            u++;
+        const size_t r0 = s->tq[u] + s->gps[g], r1 = r0 + s->gpc[g];
+        /* each pair's final entry, then the points' entries through it (sv holds the pairs
+         * as scattered: the grain's from ns * tp[u] + gps[g]) */
+        bool shared = false;
+        for (size_t r = r0; r < r1; r++) {
+            const int i = s->pnode[r];
+            const bool sh = s->ngr[i] > 1;
+            fin[r - r0] = sh ? (int)(nn + r) : i;
+            if (spline && sh) {
+                mark[i] = (int)(r - r0);
+                rec[r - r0].n = (v2d){0, 0};
+                mark_bases(s, near, i, 1);
+                shared = true;
             }
-            if (shared)
-                for (size_t p = p0; p < p1; p++) {
-                    double wx[3], dx[3], wy[3], dy[3];
-                    const int bi = bspline((s->x[p] - ox) * s->inv_hx, wx, dx);
-                    const int bj = bspline((s->y[p] - oy) * s->inv_hy, wy, dy);
-                    int I[3], J[3];
-                    bool any = false;
-                    for (int a = 0; a < 3; a++) {
-                        I[a] = node_of(s, 0, bi + a);
-                        J[a] = node_of(s, 1, bj + a);
-                    }
-                    for (int b = 0; b < 3 && !any; b++)
-                        for (int a = 0; a < 3 && !any; a++)
-                            any = I[a] >= 0 && J[b] >= 0 && mark[J[b] * s->nnx + I[a]] >= 0;
-                    if (!any)
-                        continue;
-                    const double m = s->m[p];
+        }
+        const size_t sv0 = (size_t)ns * s->tp[u] + s->gps[g];
+        for (size_t e = (size_t)ns * p0; e < (size_t)ns * p1; e++)
+            s->sv[e] = fin[(size_t)s->sv[e] - sv0];
+        if (shared)
+            for (size_t p = p0; p < p1; p++) {
+                const double xi = (xs[p] - ox) * ihx, eta = (ys[p] - oy) * ihy;
+                const int Ib = spline_base(ax, xi), Jb = spline_base(ay, eta);
+                if (Ib >= 0 && Jb >= 0 && !near[Jb * nnx + Ib])
+                    continue;
+                double wx[3], dx[3], wy[3], dy[3];
+                const int bi = bspline(xi, wx, dx), bj = bspline(eta, wy, dy);
+                const double m = xm[p];
+                int I[3];
+                v2d ma[3];
+                for (int a = 0; a < 3; a++) {
+                    I[a] = axis_node(ax, bi + a);
+                    ma[a] = (v2d){m * dx[a], m * wx[a]};
+                }
+                int J[3];
+                for (int b = 0; b < 3; b++)
+                    J[b] = axis_node(ay, bj + b);
+                /* lanes x, y: m dx_a wy_b / h_x and m wx_a dy_b / h_y, in the scalar order */
+                if ((I[0] | I[1] | I[2] | J[0] | J[1] | J[2]) >= 0) {
                     for (int b = 0; b < 3; b++) {
-                        if (J[b] < 0)
-                            continue;
-                        for (int a = 0; a < 3; a++) {
-                            if (I[a] < 0)
-                                continue;
-                            const int r = mark[J[b] * s->nnx + I[a]];
-                            if (r >= 0) {
-                                s->pnx[r] += m * dx[a] * wy[b] * s->inv_hx;
-                                s->pny[r] += m * wx[a] * dy[b] * s->inv_hy;
-                            }
-                        }
+                        const int *const row = mark + (size_t)J[b] * (size_t)nnx;
+                        const v2d wb = {wy[b], dy[b]};
+                        for (int a = 0; a < 3; a++)
+                            rec[row[I[a]]].n += ma[a] * wb * ih;
+                    }
+                    continue;
+                }
+                /* near the edge of the grid: a node outside reads the mark of an untouched one */
+                for (int b = 0; b < 3; b++) {
+                    const v2d wb = {wy[b], dy[b]};
+                    for (int a = 0; a < 3; a++) {
+                        const int r = mark[J[b] < 0 || I[a] < 0 ? skip : J[b] * nnx + I[a]];
+                        rec[r].n += ma[a] * wb * ih;
                     }
                 }
-            for (size_t r = r0; r < r1; r++)
-                mark[s->pnode[r]] = -1;
-            r0 = r1;
+            }
+        for (size_t r = r0; r < r1; r++) {
+            const int i = s->pnode[r];
+            if (s->ngr[i] > 1) {
+                s->pnx[r] = rec[r - r0].n[0];
+                s->pny[r] = rec[r - r0].n[1];
+                mark[i] = -1;
+                mark_bases(s, near, i, 0);
+            }
         }
     }
+}
+
+/* grain_finish_with with the normals' choice a constant. */
+STAGE static void grain_finish(mpm_scene *s, int t)
+{
+    if (s->opt.normals != MPM_NORMALS_LINEAR && s->ns != 9)
+        grain_finish_with(s, t, true);
+    else
+        grain_finish_with(s, t, false);
 }
 
 /* At shared nodes: the sum of the grains' gradients and nodal volumes (one thread). */
@@ -697,7 +866,6 @@ STAGE static void grain_sums(mpm_scene *s)
 static void grain_fields(mpm_scene *s, int t, double *tlp)
 {
     double tl = *tlp;
-    const bool spline_normals = s->opt.normals != MPM_NORMALS_LINEAR && s->ns != 9;
     grain_scatter(s, t);
 #pragma omp barrier
 #pragma omp master
@@ -706,10 +874,8 @@ static void grain_fields(mpm_scene *s, int t, double *tlp)
         grain_pack(s);
     }
 #pragma omp barrier
-    grain_stencil(s, t);
-    STAGE_DONE(T_P2G); /* no barrier: the normals need none, so this is thread 0's own time */
-    if (spline_normals)
-        grain_normals(s, t);
+    STAGE_DONE(T_P2G);
+    grain_finish(s, t);
 #pragma omp barrier
 #pragma omp master
     grain_sums(s);
