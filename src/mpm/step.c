@@ -1573,10 +1573,16 @@ static inline __attribute__((always_inline)) size_t constitutive_with(mpm_scene 
         }
         /* (C), by runs of points of one material */
         double any = 0;
+        int other = 0; /* points of another material than the first: a count that vectorises */
+        for (int j = 1; j < nb; j++)
+            other += mat[p0 + (size_t)j] != mat[p0];
         for (int ja = 0, jb; ja < nb; ja = jb) {
             const int mk = mat[p0 + (size_t)ja];
-            for (jb = ja + 1; jb < nb && mat[p0 + (size_t)jb] == mk; jb++)
-                ;
+            if (!other)
+                jb = nb;
+            else
+                for (jb = ja + 1; jb < nb && mat[p0 + (size_t)jb] == mk; jb++)
+                    ;
             const mpm_material *const m = &mats[mk];
             const bool vm = m->model == MPM_VONMISES;
             any += vm ? (chk ? pass_elastic(&T, ja, jb, p0, m, &cb, &E, true, true)
