@@ -38,78 +38,122 @@ static inline bool log_strains(const double be[3], double lz, double eps[3], dou
     return true;
 }
 
-/* mpm_material_update (mpm.h) with the out-of-plane stretch split off: be holds the in-plane
- * b_e (xx, xy, yy); *lz is ln(b_e,zz) / 2, which only a plastic update changes (the zz stretch
- * of plane strain is elastic-constant otherwise), so the caller caches it instead of taking a
- * logarithm of b_e,zz every step. A plastic update sets *bzz and *lz = ln(*bzz) / 2 (the
- * logarithm of the stored value, so a cache rebuilt from b_e,zz holds the same bits); an elastic
- * one leaves both. Returns -1 (inverted), 0 (elastic) or 1 (plastic). */
-static inline int material_update_zz(const mpm_material *m, const double f[4], double be[3],
-                                     double *bzz, double *lz, double *eps_p, double J,
-                                     double sigma[4])
+/* Trial b_e = f b_e f^T (in plane; plane strain keeps the zz stretch): tr = {xx, xy, yy}. */
+static inline void trial_be(const double f[4], const double be[3], double tr[3])
 {
-    if (!(f[0] * f[3] - f[1] * f[2] > 0) || !(J > 0))
-        return -1;
-    /* Trial b_e = f b_e f^T (in plane; plane strain keeps the zz stretch). */
     const double b00 = be[0], b01 = be[1], b11 = be[2];
     double t00 = f[0] * b00 + f[1] * b01, t01 = f[0] * b01 + f[1] * b11;
     double t10 = f[2] * b00 + f[3] * b01, t11 = f[2] * b01 + f[3] * b11;
-    double tr[3] = {t00 * f[0] + t01 * f[1], t00 * f[2] + t01 * f[3], t10 * f[2] + t11 * f[3]};
-    double eps[3], dir[3];
-    if (!log_strains(tr, *lz, eps, dir))
-        return -1;
-    const double K = m->bulk, G = m->shear;
-    double ev = eps[0] + eps[1] + eps[2], e[3], en2 = 0;
+    tr[0] = t00 * f[0] + t01 * f[1];
+    tr[1] = t00 * f[2] + t01 * f[3];
+    tr[2] = t10 * f[2] + t11 * f[3];
+}
+
+/* The volumetric-deviatoric split of the principal log strains: *ev = tr eps, e = eps - ev / 3;
+ * returns |e|^2. */
+static inline double dev_split(const double eps[3], double *ev, double e[3])
+{
+    const double v = eps[0] + eps[1] + eps[2];
+    double en2 = 0;
     for (int i = 0; i < 3; i++) {
-        e[i] = eps[i] - ev / 3;
+        e[i] = eps[i] - v / 3;
         en2 += e[i] * e[i];
     }
+    *ev = v;
+    return en2;
+}
+
+/* The von Mises yield test's quick side: (2 G |e|)^2 below q^2 by more than any rounding (the
+ * margin 1e-9) is elastic without the square root; the other points take the radial return's
+ * test as written (material_return), so the decision is the same. Branch-free, for the step's
+ * lanes. */
+static inline bool within_yield(const mpm_material *m, double en2, double eps_p)
+{
+    const double k23 = sqrt(2.0 / 3.0), G2 = 2 * m->shear;
+    const double q = k23 * (m->yield + m->hardening * eps_p);
+    return G2 * G2 * en2 < q * q * (1 - 1e-9);
+}
+
+/* Kirchhoff stress tau = K ev + 2 G e in principal axes, back to the tensor along dir
+ * (eig2's), and sigma = tau / J. */
+static inline void stress_of(const mpm_material *m, double ev, const double e[3],
+                             const double dir[3], double J, double sigma[4])
+{
+    const double K = m->bulk, G = m->shear;
+    double tau[3];
+    for (int i = 0; i < 3; i++)
+        tau[i] = K * ev + 2 * G * e[i];
+    const double c2 = dir[0], s2 = dir[1], csn = dir[2];
+    const double inv_j = 1 / J;
+    sigma[0] = (tau[0] * c2 + tau[1] * s2) * inv_j;
+    sigma[1] = (tau[0] * s2 + tau[1] * c2) * inv_j;
+    sigma[2] = (tau[0] - tau[1]) * csn * inv_j;
+    sigma[3] = tau[2] * inv_j;
+}
+
+/* The update from the trial state on: tr (trial_be), its principal log strains eps and
+ * directions dir (log_strains). Radial return for von Mises: f = |s| - sqrt(2/3) (yield + H
+ * eps_p) with s = 2 G e. Writes be (the trial itself when elastic) and sigma; a plastic update
+ * also sets *eps_p, *bzz and *lz = ln(*bzz) / 2 (the logarithm of the stored value, so a cache
+ * rebuilt from b_e,zz holds the same bits). Returns whether the update was plastic. */
+static inline bool material_return(const mpm_material *m, const double tr[3], const double eps[3],
+                                   const double dir[3], double J, double be[3], double *bzz,
+                                   double *lz, double *eps_p, double sigma[4])
+{
+    double ev, e[3];
+    const double en2 = dev_split(eps, &ev, e);
     bool plastic = false;
-    if (m->model == MPM_VONMISES) {
-        /* Radial return: f = |s| - sqrt(2/3) (yield + H eps_p) with s = 2 G e. A point whose
-         * (2 G |e|)^2 is below q^2 by more than any rounding (the margin 1e-9) is elastic without
-         * the square root; the others take the test as written, so the decision is the same. */
-        const double k23 = sqrt(2.0 / 3.0), G2 = 2 * G;
+    if (m->model == MPM_VONMISES && !within_yield(m, en2, *eps_p)) {
+        const double G = m->shear, k23 = sqrt(2.0 / 3.0), G2 = 2 * G;
         const double q = k23 * (m->yield + m->hardening * *eps_p);
-        if (!(G2 * G2 * en2 < q * q * (1 - 1e-9))) {
-            const double en = sqrt(en2);
-            double ftrial = G2 * en - q;
-            if (en > 0 && ftrial > 0) {
-                double dgamma = ftrial / (2 * G + 2.0 / 3.0 * m->hardening);
-                double scale = 1 - dgamma / en;
-                for (int i = 0; i < 3; i++)
-                    e[i] *= scale;
-                *eps_p += k23 * dgamma;
-                plastic = true;
-            }
+        const double en = sqrt(en2);
+        double ftrial = G2 * en - q;
+        if (en > 0 && ftrial > 0) {
+            double dgamma = ftrial / (2 * G + 2.0 / 3.0 * m->hardening);
+            double scale = 1 - dgamma / en;
+            for (int i = 0; i < 3; i++)
+                e[i] *= scale;
+            *eps_p += k23 * dgamma;
+            plastic = true;
         }
     }
-    double tau[3];
-    for (int i = 0; i < 3; i++) {
-        eps[i] = e[i] + ev / 3;
-        tau[i] = K * ev + 2 * G * e[i];
-    }
-    /* Back to tensors: b_e = sum exp(2 eps_i) n_i n_i (the trial itself when elastic), tau
-     * likewise; sigma = tau / J. */
-    const double c2 = dir[0], s2 = dir[1], csn = dir[2];
+    /* Back to tensors: b_e = sum exp(2 eps_i) n_i n_i. */
     if (plastic) {
-        double l1 = exp(2 * eps[0]), l2 = exp(2 * eps[1]);
+        double ep[3];
+        for (int i = 0; i < 3; i++)
+            ep[i] = e[i] + ev / 3;
+        const double c2 = dir[0], s2 = dir[1], csn = dir[2];
+        double l1 = exp(2 * ep[0]), l2 = exp(2 * ep[1]);
         be[0] = l1 * c2 + l2 * s2;
         be[1] = (l1 - l2) * csn;
         be[2] = l1 * s2 + l2 * c2;
-        *bzz = exp(2 * eps[2]);
+        *bzz = exp(2 * ep[2]);
         *lz = 0.5 * log(*bzz);
     } else {
         be[0] = tr[0];
         be[1] = tr[1];
         be[2] = tr[2];
     }
-    double inv_j = 1 / J;
-    sigma[0] = (tau[0] * c2 + tau[1] * s2) * inv_j;
-    sigma[1] = (tau[0] * s2 + tau[1] * c2) * inv_j;
-    sigma[2] = (tau[0] - tau[1]) * csn * inv_j;
-    sigma[3] = tau[2] * inv_j;
+    stress_of(m, ev, e, dir, J, sigma);
     return plastic;
+}
+
+/* mpm_material_update (mpm.h) with the out-of-plane stretch split off: be holds the in-plane
+ * b_e (xx, xy, yy); *lz is ln(b_e,zz) / 2, which only a plastic update changes (the zz stretch
+ * of plane strain is elastic-constant otherwise), so the caller caches it instead of taking a
+ * logarithm of b_e,zz every step; a plastic update sets *bzz and *lz (material_return), an
+ * elastic one leaves both. Returns -1 (inverted), 0 (elastic) or 1 (plastic). */
+static inline int material_update_zz(const mpm_material *m, const double f[4], double be[3],
+                                     double *bzz, double *lz, double *eps_p, double J,
+                                     double sigma[4])
+{
+    if (!(f[0] * f[3] - f[1] * f[2] > 0) || !(J > 0))
+        return -1;
+    double tr[3], eps[3], dir[3];
+    trial_be(f, be, tr);
+    if (!log_strains(tr, *lz, eps, dir))
+        return -1;
+    return material_return(m, tr, eps, dir, J, be, bzz, lz, eps_p, sigma);
 }
 
 /* mpm_material_update (mpm.h). */

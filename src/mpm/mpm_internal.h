@@ -66,6 +66,9 @@ struct mpm_scene {
      * outside the step) */
     double *lzz;
     bool lzz_ok;
+    /* the stress update and G2P one point at a time, for the tests: the reference of their
+     * lanes (constitutive and to_points in step.c); false (calloc) otherwise */
+    bool no_lanes;
     int *grain, *mat;
     /* stencil, MPM_STENCIL per point */
     int *sn;
