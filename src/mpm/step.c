@@ -252,6 +252,22 @@ static inline int axis_node(grid_axis ax, int gi)
     return I >= 0 && I < ax.nodes ? I : -1;
 }
 
+/* axis_node for a cell index within [0, n) (the linear stencil's clamped cell): always a node. */
+static inline int cell_node(grid_axis ax, int i)
+{
+    return ax.periodic ? i : i + ax.ghost;
+}
+
+/* The node after node I on the axis (axis_node(ax, gi + 1) for I = axis_node(ax, gi) >= 0):
+ * wrapped on a periodic axis, -1 past the last node of another. */
+static inline int next_node(grid_axis ax, int I)
+{
+    const int J = I + 1;
+    if (ax.periodic)
+        return J == ax.n ? 0 : J;
+    return I >= 0 && J < ax.nodes ? J : -1;
+}
+
 /* floor(x) as an int for finite x in int range (grid coordinates): a truncation and a
  * correction below zero, cheaper than floor() without SSE4.1 and the same value. */
 static inline int ifloor(double x)
@@ -260,11 +276,10 @@ static inline int ifloor(double x)
     return i - (x < (double)i);
 }
 
-/* Quadratic B-spline weights and derivatives (per grid unit) of the three nodes base, base+1,
- * base+2 around a point at grid coordinate xi. */
-static inline int bspline(double xi, double w[3], double d[3])
+/* Quadratic B-spline weights and derivatives (per grid unit) of the three nodes b, b + 1, b + 2
+ * around a point at grid coordinate xi whose base node is b. */
+static inline void bspline_at(double xi, int b, double w[3], double d[3])
 {
-    const int b = ifloor(xi - 0.5);
     const double t = xi - b; /* in [0.5, 1.5) */
     w[0] = 0.5 * (1.5 - t) * (1.5 - t);
     w[1] = 0.75 - (t - 1) * (t - 1);
@@ -272,6 +287,13 @@ static inline int bspline(double xi, double w[3], double d[3])
     d[0] = t - 1.5;
     d[1] = -2 * (t - 1);
     d[2] = t - 0.5;
+}
+
+/* bspline_at with its base node b = floor(xi - 1/2), returned. */
+static inline int bspline(double xi, double w[3], double d[3])
+{
+    const int b = ifloor(xi - 0.5);
+    bspline_at(xi, b, w, d);
     return b;
 }
 
@@ -314,8 +336,8 @@ static inline __attribute__((always_inline)) void stencil_range(mpm_scene *s, si
         if (j < 0)
             j = 0;
         const double fx = xi - i, fy = eta - j;
-        const int i0 = axis_node(ax, i), i1 = axis_node(ax, i + 1);
-        const int j0 = axis_node(ay, j), j1 = axis_node(ay, j + 1);
+        const int i0 = cell_node(ax, i), i1 = next_node(ax, i0);
+        const int j0 = cell_node(ay, j), j1 = next_node(ay, j0);
         n[0] = j0 * nnx + i0;
         n[1] = j0 * nnx + i1;
         n[2] = j1 * nnx + i0;
@@ -798,12 +820,6 @@ static inline long shared_next(const mpm_scene *s, shared_iter *it)
     return s->slist[s->tq[it->u] + (it->k++ - it->base)];
 }
 
-/* The B-spline base node of grid coordinate xi on axis ax (the first of bspline's three), or -1. */
-static inline int spline_base(grid_axis ax, double xi)
-{
-    return axis_node(ax, ifloor(xi - 0.5));
-}
-
 /* Sets (v = 1) or clears (v = 0) near[] at the B-spline base nodes of the points whose 3 x 3
  * nodes include node i: the bases up to two nodes below i on each axis. */
 static inline void mark_bases(const mpm_scene *s, unsigned char *near, int i, unsigned char v)
@@ -879,21 +895,30 @@ static inline __attribute__((always_inline)) void grain_finish_with(mpm_scene *s
         if (shared)
             for (size_t p = p0; p < p1; p++) {
                 const double xi = (xs[p] - ox) * ihx, eta = (ys[p] - oy) * ihy;
-                const int Ib = spline_base(ax, xi), Jb = spline_base(ay, eta);
-                if (Ib >= 0 && Jb >= 0 && !near[Jb * nnx + Ib])
+                const int bi = ifloor(xi - 0.5), bj = ifloor(eta - 0.5);
+                int I[3], J[3];
+                I[0] = axis_node(ax, bi);
+                J[0] = axis_node(ay, bj);
+                if (I[0] >= 0 && J[0] >= 0 && !near[J[0] * nnx + I[0]])
                     continue;
                 double wx[3], dx[3], wy[3], dy[3];
-                const int bi = bspline(xi, wx, dx), bj = bspline(eta, wy, dy);
+                bspline_at(xi, bi, wx, dx);
+                bspline_at(eta, bj, wy, dy);
                 const double m = xm[p];
-                int I[3];
                 v2d ma[3];
-                for (int a = 0; a < 3; a++) {
-                    I[a] = axis_node(ax, bi + a);
+                for (int a = 0; a < 3; a++)
                     ma[a] = (v2d){m * dx[a], m * wx[a]};
+                if (I[0] >= 0 && J[0] >= 0) {
+                    I[1] = next_node(ax, I[0]);
+                    I[2] = next_node(ax, I[1]);
+                    J[1] = next_node(ay, J[0]);
+                    J[2] = next_node(ay, J[1]);
+                } else {
+                    for (int a = 1; a < 3; a++) {
+                        I[a] = axis_node(ax, bi + a);
+                        J[a] = axis_node(ay, bj + a);
+                    }
                 }
-                int J[3];
-                for (int b = 0; b < 3; b++)
-                    J[b] = axis_node(ay, bj + b);
                 /* lanes x, y: m dx_a wy_b / h_x and m wx_a dy_b / h_y, in the scalar order */
                 if ((I[0] | I[1] | I[2] | J[0] | J[1] | J[2]) >= 0) {
                     for (int b = 0; b < 3; b++) {
