@@ -81,7 +81,6 @@ struct mpm_scene {
     /* frictional contact (Eqs. 12-24): sparse per-grain nodal fields, rebuilt every step */
     double mu;
     size_t paircap;         /* the nodal arrays hold nnodes + paircap entries */
-    size_t npairs;
     int *pnode;             /* node of pair q */
     int *pgrain;            /* grain of pair q */
     unsigned char *pin;     /* pair q in contact this step (Eq. 12 at the momentum update) */
@@ -114,11 +113,13 @@ struct mpm_scene {
 
     /* threads: nt contiguous point ranges [tp[t], tp[t+1]) aligned to grains (tg[t] the first
      * grain of range t), so that a grain's points, its per-grain field entries and the nodes
-     * only it touches belong to one thread; per-thread scratch: marks (nt x nnodes) */
+     * only it touches belong to one thread; thread t's pairs (friction) are [tq[t], tq[t] +
+     * tc[t]) with tq[t] = ns tp[t], in grain order, gaps between the threads' ranges;
+     * per-thread scratch: marks (nt x nnodes) */
     int nt, ntcap;
     size_t *tp, *tg, *tq, *tc, *tsh;
     int *tmark;             /* nt x (nnodes + 1), the last of each -1 */
-    unsigned char *tnear;   /* nt x nnodes, zero outside grain_normals */
+    unsigned char *tnear;   /* nt x nnodes, zero outside grain_finish */
     /* per-thread scratch of the frictional scatter: one record per (grain, node) pair of the
      * grain being scattered (its sums, see grain_scatter), reccap records per thread */
     struct mpm_pair_rec *trec;

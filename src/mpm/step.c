@@ -568,23 +568,9 @@ static inline void pair_walls(mpm_scene *s, double *vx, double *vy, size_t q, bo
  * of its grains' gradients, so that 2 g - g_all of two grains are exactly opposite. A point moves
  * with its grain's field at nodes shared by two or more grains and with the centre-of-mass node
  * elsewhere, so an isolated grain evolves exactly as with noslip. */
-static void move_pairs(mpm_scene *s, size_t to, size_t from, size_t n)
-{
-    if (to == from || n == 0)
-        return;
-    const size_t nn = s->nnodes;
-    double *node[5] = {s->nm, s->npx, s->npy, s->nfx, s->nfy};
-    for (int k = 0; k < 5; k++)
-        memmove(node[k] + nn + to, node[k] + nn + from, n * sizeof(double));
-    double *pair[3] = {s->pnx, s->pny, s->pvol};
-    for (int k = 0; k < 3; k++)
-        memmove(pair[k] + to, pair[k] + from, n * sizeof(double));
-    memmove(s->pnode + to, s->pnode + from, n * sizeof(int));
-    memmove(s->pgrain + to, s->pgrain + from, n * sizeof(int));
-}
 
-/* Inside the parallel region; thread t takes its grains. Their pairs are first written from
- * ns * tp[t] (a grain has at most ns pairs per point), then packed in thread order. A grain's
+/* Inside the parallel region; thread t takes its grains. Their pairs are written from ns *
+ * tp[t] (a grain has at most ns pairs per point) and stay there (grain_pack). A grain's
  * pairs are numbered in the order its points first touch their nodes; while the grain is
  * scattered, their sums build up in the thread's records (one cache line per pair, two sums per
  * SSE2 operation, mark[i] the record of node i), and are then copied into the nodal and pair
@@ -687,20 +673,19 @@ STAGE static void grain_scatter(mpm_scene *s, int t)
         grain_scatter_with(s, t, s->ns, volumes, spline_normals);
 }
 
-/* Packs the threads' pairs in thread order (one thread): thread t's pairs are then
- * [tq[t], tq[t+1]), all pairs in grain order. */
+/* Thread t's pairs stay where its scatter wrote them, [tq[t], tq[t] + tc[t]) with tq[t] =
+ * ns tp[t] (a grain has at most ns pairs per point): no serial packing pass (it moved the second
+ * thread's pairs, 10 arrays, on one thread). Pair indices run in grain order with gaps between
+ * the threads' ranges that no loop visits: the loops over pairs take a thread's range
+ * (pairs_end), the node sums follow the chains of pair indices. */
 STAGE static void grain_pack(mpm_scene *s)
 {
-    const int ns = s->ns;
-    size_t off = 0;
-    for (int u = 0; u < s->nt; u++) {
-        s->tq[u] = off;
-        move_pairs(s, off, (size_t)ns * s->tp[u], s->tc[u]);
-        off += s->tc[u];
-    }
-    s->tq[s->nt] = off;
-    s->npairs = off;
+    for (int u = 0; u <= s->nt; u++)
+        s->tq[u] = (size_t)s->ns * s->tp[u];
 }
+
+/* The end of thread t's pairs. */
+static inline size_t pairs_end(const mpm_scene *s, int t) { return s->tq[t] + s->tc[t]; }
 
 /* The node sums of the frictional contact without a serial pass: each node's pairs are chained
  * in pair order (nhead, pnext), and the threads add them up node by node over even ranges of the
@@ -716,7 +701,7 @@ STAGE static void pair_chains(mpm_scene *s, int t)
     int *const mark = s->tmark + (size_t)t * (s->nnodes + 1);
     const int *const pnode = s->pnode;
     int *const pnext = s->pnext;
-    for (size_t q = s->tq[t + 1]; q-- > s->tq[t];) {
+    for (size_t q = pairs_end(s, t); q-- > s->tq[t];) {
         const int i = pnode[q];
         pnext[q] = mark[i];
         mark[i] = (int)q;
@@ -782,7 +767,7 @@ STAGE static void pair_kinds(mpm_scene *s, int t)
     int *const mark = s->tmark + (size_t)t * (s->nnodes + 1);
     int *const list = s->slist + s->tq[t];
     size_t n = 0;
-    for (size_t q = s->tq[t]; q < s->tq[t + 1]; q++) {
+    for (size_t q = s->tq[t]; q < pairs_end(s, t); q++) {
         const int i = s->pnode[q];
         mark[i] = -1;
         s->pshared[q] = s->ngr[i] > 1;
@@ -1347,7 +1332,7 @@ scatter_sf_with(mpm_scene *s, int t, double *a, double *b, bool force, const int
     }
     /* thread t zeroes the entries its points feed (its pairs at shared nodes, the nodes only its
      * grains touch; the others are not read: nodes no point reaches have no mass) */
-    for (size_t q = s->tq[t]; q < s->tq[t + 1]; q++) {
+    for (size_t q = s->tq[t]; q < pairs_end(s, t); q++) {
         const size_t e = s->pshared[q] ? nn + q : (size_t)s->pnode[q];
         a[e] = b[e] = 0;
     }
@@ -1811,12 +1796,8 @@ static core_status run_steps(mpm_scene *s, const mpm_run_def *run, long *done, c
                          "the scene has no material points: add a grain first");
     core_status st;
     const bool friction = s->contact == MPM_CONTACT_FRICTION;
-    if (friction) {
-        if ((st = mpm_contact_reserve(s, err)))
-            return st;
-    } else {
-        s->npairs = 0;
-    }
+    if (friction && (st = mpm_contact_reserve(s, err)))
+        return st;
     if ((st = threads_setup(s, err)))
         return st;
     if (!s->lzz_ok) {
