@@ -93,6 +93,16 @@ struct mpm_scene {
     mpm_contact_options opt;
     double *pnx, *pny;      /* sum_p m_p G_pi over the grain: its outward normal direction */
     int *ngr;               /* grains touching node i (nnodes) */
+    /* Each node's pairs in pair order, rebuilt every step (step.c, pair_chains): nhead, the
+     * node's first pair or -1 (nnodes); pnext, the next pair at the same node or -1; pshared:
+     * pair q is at a node of two or more grains. The threads add up a node's pairs along its
+     * chain, each over its own range of nodes, so that no pass over all pairs is serial. */
+    int *nhead, *pnext;
+    unsigned char *pshared;
+    /* The pairs at shared nodes in pair order, thread t's (tsh[t] of them) at slist[tq[t]...]:
+     * the contact loops split this list evenly (the shared nodes are not evenly spread over the
+     * threads' grains). */
+    int *slist;
     double *tgx, *tgy;      /* sum_p m_p G_pi over all grains (nnodes) */
     int *sv;                /* ns per point: the friction sf */
 
@@ -106,7 +116,7 @@ struct mpm_scene {
      * grain of range t), so that a grain's points, its per-grain field entries and the nodes
      * only it touches belong to one thread; per-thread scratch: marks (nt x nnodes) */
     int nt, ntcap;
-    size_t *tp, *tg, *tq, *tc;
+    size_t *tp, *tg, *tq, *tc, *tsh;
     int *tmark;             /* nt x (nnodes + 1), the last of each -1 */
     unsigned char *tnear;   /* nt x nnodes, zero outside grain_normals */
     /* per-thread scratch of the frictional scatter: one record per (grain, node) pair of the
