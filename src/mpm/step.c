@@ -1462,7 +1462,7 @@ static inline bool point_suspect(const check_bounds *b, double x, double y, doub
  * runs of points of one material. A block with an inverted point takes (B)-(D) one point at a
  * time (finish_point), as material_update_zz does. With s->no_lanes, (A2)-(D) are point_scalar
  * instead: the reference tests/mpm/test_mpm_lanes.c compares the lanes with. */
-enum { CB = 64 };
+enum { CB = 64 }; /* the block (cblock): 7 kB, in L1; CB = 16 cost 7 instructions per point more */
 typedef struct {
     double f[4][CB], tr[3][CB], dir[3][CB], lg[2][CB], J[CB];
     double flag[CB]; /* 1 or 0: doubles, which SSE2 selects as lanes (64-bit integers not) */
@@ -1531,9 +1531,8 @@ static inline bool update_ok(const double f[4], double J, double l2, double lz)
 }
 
 /* (A2) of point j (p): F, J, the trial b_e and its eigen-split into the block; returns whether
- * the update can go on (update_ok: 1, else 0). A function called
- * from the simd loop, so that its arrays are scalarised after inlining rather than made the
- * loop's per-lane arrays. */
+ * the update can go on (update_ok: 1, else 0). A function called from the simd loop, so that
+ * its arrays are scalarised after inlining rather than made the loop's per-lane arrays. */
 static inline __attribute__((always_inline)) double
 lane_trial(cblock *T, int j, size_t p, double *F0, double *F1, double *F2, double *F3,
            const double *b0, const double *b1, const double *b2, const double *lzz)
