@@ -148,6 +148,8 @@ static core_status threads_setup(mpm_scene *s, core_error *err)
     }
     s->nt = nt;
     grain_ranges(s, nt, s->tp, s->tg);
+    for (int u = 0; u <= nt; u++)
+        s->tq[u] = (size_t)s->ns * s->tp[u]; /* thread u's pairs (friction), grain_scatter */
     if (s->contact == MPM_CONTACT_FRICTION) {
         /* a grain has at most ns pairs per point */
         size_t gmax = 1;
@@ -253,10 +255,7 @@ static inline int axis_node(grid_axis ax, int gi)
 }
 
 /* axis_node for a cell index within [0, n) (the linear stencil's clamped cell): always a node. */
-static inline int cell_node(grid_axis ax, int i)
-{
-    return ax.periodic ? i : i + ax.ghost;
-}
+static inline int cell_node(grid_axis ax, int i) { return ax.periodic ? i : i + ax.ghost; }
 
 /* The node after node I on the axis (axis_node(ax, gi + 1) for I = axis_node(ax, gi) >= 0):
  * wrapped on a periodic axis, -1 past the last node of another. */
@@ -569,8 +568,8 @@ static inline void pair_walls(mpm_scene *s, double *vx, double *vy, size_t q, bo
  * with its grain's field at nodes shared by two or more grains and with the centre-of-mass node
  * elsewhere, so an isolated grain evolves exactly as with noslip. */
 
-/* Inside the parallel region; thread t takes its grains. Their pairs are written from ns *
- * tp[t] (a grain has at most ns pairs per point) and stay there (grain_pack). A grain's
+/* Inside the parallel region; thread t takes its grains. Their pairs are written from tq[t] =
+ * ns tp[t] (a grain has at most ns pairs per point) and stay there. A grain's
  * pairs are numbered in the order its points first touch their nodes; while the grain is
  * scattered, their sums build up in the thread's records (one cache line per pair, two sums per
  * SSE2 operation, mark[i] the record of node i), and are then copied into the nodal and pair
@@ -674,15 +673,10 @@ STAGE static void grain_scatter(mpm_scene *s, int t)
 }
 
 /* Thread t's pairs stay where its scatter wrote them, [tq[t], tq[t] + tc[t]) with tq[t] =
- * ns tp[t] (a grain has at most ns pairs per point): no serial packing pass (it moved the second
- * thread's pairs, 10 arrays, on one thread). Pair indices run in grain order with gaps between
- * the threads' ranges that no loop visits: the loops over pairs take a thread's range
- * (pairs_end), the node sums follow the chains of pair indices. */
-STAGE static void grain_pack(mpm_scene *s)
-{
-    for (int u = 0; u <= s->nt; u++)
-        s->tq[u] = (size_t)s->ns * s->tp[u];
-}
+ * ns tp[t] (a grain has at most ns pairs per point; set with the ranges, threads_setup): no
+ * packing pass (a serial one moved the second thread's pairs, 10 arrays, on one thread). Pair
+ * indices run in grain order with gaps between the threads' ranges that no loop visits: the loops
+ * over pairs take a thread's range (pairs_end), the node sums follow the chains of pair indices. */
 
 /* The end of thread t's pairs. */
 static inline size_t pairs_end(const mpm_scene *s, int t) { return s->tq[t] + s->tc[t]; }
@@ -695,7 +689,7 @@ static inline size_t pairs_end(const mpm_scene *s, int t) { return s->tq[t] + s-
  * cache), not an even split of all pairs (half of which would be the other thread's lines). */
 
 /* Thread t's pairs chained per node within the thread (pnext, -1 after the thread's last pair
- * at a node), its first pair at each node left in its marks (after grain_pack). */
+ * at a node), its first pair at each node left in its marks (right after its scatter). */
 STAGE static void pair_chains(mpm_scene *s, int t)
 {
     int *const mark = s->tmark + (size_t)t * (s->nnodes + 1);
@@ -969,11 +963,7 @@ static void grain_fields(mpm_scene *s, int t, double *tlp)
 {
     double tl = *tlp;
     grain_scatter(s, t);
-#pragma omp barrier
-#pragma omp master
-    grain_pack(s);
-#pragma omp barrier
-    pair_chains(s, t);
+    pair_chains(s, t); /* its own pairs: no barrier before */
 #pragma omp barrier
     node_sums(s); /* its loop's barrier: every node done */
     pair_kinds(s, t);
