@@ -1458,16 +1458,11 @@ typedef struct {
     double flag[CB]; /* 1 or 0: doubles, which SSE2 selects as lanes (64-bit integers not) */
 } cblock;
 
-/* Point j (p) of a block, scalar, from its log strains eps: material_return, the stores, and
- * with chk the end-of-step check (*first: the first bad point). */
-static inline void finish_point(mpm_scene *s, const check_bounds *cb, bool chk, const cblock *T,
-                                int j, size_t p, const double eps[3], size_t *first)
+/* Point p's new in-plane b_e and stress stored, then with chk the end-of-step check (*first: the
+ * first bad point). */
+static inline void store_point(mpm_scene *s, const check_bounds *cb, bool chk, size_t p,
+                               const double be[3], const double sig[4], size_t *first)
 {
-    const double tr[3] = {T->tr[0][j], T->tr[1][j], T->tr[2][j]};
-    const double dir[3] = {T->dir[0][j], T->dir[1][j], T->dir[2][j]};
-    double be[3], sig[4];
-    material_return(&s->mats[s->mat[p]], tr, eps, dir, T->J[j], be, &s->be[3][p], &s->lzz[p],
-                    &s->eps_p[p], sig);
     s->be[0][p] = be[0];
     s->be[1][p] = be[1];
     s->be[2][p] = be[2];
@@ -1478,6 +1473,19 @@ static inline void finish_point(mpm_scene *s, const check_bounds *cb, bool chk, 
     if (chk && point_bad_at(s, cb, &s->x[p], &s->y[p], s->vx[p], s->vy[p], sig) &&
         *first == (size_t)-1)
         *first = p;
+}
+
+/* Point j (p) of a block, scalar, from its log strains eps: material_return, the stores, and
+ * with chk the end-of-step check (*first: the first bad point). */
+static inline void finish_point(mpm_scene *s, const check_bounds *cb, bool chk, const cblock *T,
+                                int j, size_t p, const double eps[3], size_t *first)
+{
+    const double tr[3] = {T->tr[0][j], T->tr[1][j], T->tr[2][j]};
+    const double dir[3] = {T->dir[0][j], T->dir[1][j], T->dir[2][j]};
+    double be[3], sig[4];
+    material_return(&s->mats[s->mat[p]], tr, eps, dir, T->J[j], be, &s->be[3][p], &s->lzz[p],
+                    &s->eps_p[p], sig);
+    store_point(s, cb, chk, p, be, sig, first);
 }
 
 /* Point p from its increment f, scalar: F, material_update_zz, the stores, with chk the
@@ -1501,16 +1509,7 @@ static void point_scalar(mpm_scene *s, const check_bounds *cb, bool chk, const d
             *bad = p;
         return;
     }
-    s->be[0][p] = be[0];
-    s->be[1][p] = be[1];
-    s->be[2][p] = be[2];
-    s->sig[0][p] = sig[0];
-    s->sig[1][p] = sig[1];
-    s->sig[2][p] = sig[2];
-    s->sig[3][p] = sig[3];
-    if (chk && point_bad_at(s, cb, &s->x[p], &s->y[p], s->vx[p], s->vy[p], sig) &&
-        *first == (size_t)-1)
-        *first = p;
+    store_point(s, cb, chk, p, be, sig, first);
 }
 
 /* material_update_zz's and log_strains's conditions (det f > 0, J > 0, l2 > 0 and ln(b_e,zz) / 2
