@@ -24,8 +24,9 @@
 /* The step's stages stay separate functions so that a profiler (callgrind) counts each. */
 #define STAGE __attribute__((noinline))
 
-/* Two doubles in one SSE2 register (GCC/Clang vector extension): each lane does exactly the
- * scalar arithmetic, so a vector sum gives the bits of the two scalar ones. */
+/* Two doubles in the lanes of one SSE2 register (GCC's vector extension; NEON on arm64, scalar
+ * code elsewhere): each lane's arithmetic is the IEEE operation of the scalar code, so a vector
+ * sum gives the bits of the two scalar ones. */
 typedef double v2d __attribute__((vector_size(16)));
 
 /* The sums of one (grain, node) pair while its grain is scattered (grain_scatter), as pairs of
@@ -566,9 +567,9 @@ static inline void pair_walls(mpm_scene *s, double *vx, double *vy, size_t q, bo
  * nodes only. tgx, tgy at a shared node: the sum
  * of its grains' gradients, so that 2 g - g_all of two grains are exactly opposite. A point moves
  * with its grain's field at nodes shared by two or more grains and with the centre-of-mass node
- * elsewhere, so an isolated grain evolves exactly as with noslip. */
-
-/* Inside the parallel region; thread t takes its grains. Their pairs are written from tq[t] =
+ * elsewhere, so an isolated grain evolves exactly as with noslip.
+ *
+ * Inside the parallel region; thread t takes its grains. Their pairs are written from tq[t] =
  * ns tp[t] (a grain has at most ns pairs per point) and stay there. A grain's
  * pairs are numbered in the order its points first touch their nodes; while the grain is
  * scattered, their sums build up in the thread's records (one cache line per pair, two sums per
@@ -672,21 +673,20 @@ STAGE static void grain_scatter(mpm_scene *s, int t)
         grain_scatter_with(s, t, s->ns, volumes, spline_normals);
 }
 
-/* Thread t's pairs stay where its scatter wrote them, [tq[t], tq[t] + tc[t]) with tq[t] =
- * ns tp[t] (a grain has at most ns pairs per point; set with the ranges, threads_setup): no
- * packing pass (a serial one moved the second thread's pairs, 10 arrays, on one thread). Pair
- * indices run in grain order with gaps between the threads' ranges that no loop visits: the loops
- * over pairs take a thread's range (pairs_end), the node sums follow the chains of pair indices. */
-
-/* The end of thread t's pairs. */
-static inline size_t pairs_end(const mpm_scene *s, int t) { return s->tq[t] + s->tc[t]; }
-
-/* The node sums of the frictional contact without a serial pass: each node's pairs are chained
- * in pair order (nhead, pnext), and the threads add them up node by node over even ranges of the
+/* The end of thread t's pairs. They stay where its scatter wrote them, [tq[t], tq[t] + tc[t])
+ * with tq[t] = ns tp[t] (a grain has at most ns pairs per point; set with the ranges,
+ * threads_setup): no packing pass (a serial one moved the second thread's pairs, 10 arrays, on
+ * one thread). Pair indices run in grain order with gaps between the threads' ranges that no
+ * loop visits: the loops over pairs take a thread's range, the node sums follow the chains of
+ * pair indices.
+ *
+ * The node sums of the frictional contact have no serial pass: each node's pairs are chained in
+ * pair order (nhead, pnext), and the threads add them up node by node over even ranges of the
  * nodes (the static split of the node loops), in pair order along the chain: the same sums as
  * one thread adding all pairs in order, so the same bits on any thread count. The loops over
- * pairs take a thread's own pairs [tq[t], tq[t+1]), which its grain scatter wrote (in its
- * cache), not an even split of all pairs (half of which would be the other thread's lines). */
+ * pairs take a thread's own pairs, which its grain scatter wrote (in its cache), not an even
+ * split of all pairs (half of which would be the other thread's lines). */
+static inline size_t pairs_end(const mpm_scene *s, int t) { return s->tq[t] + s->tc[t]; }
 
 /* Thread t's pairs chained per node within the thread (pnext, -1 after the thread's last pair
  * at a node), its first pair at each node left in its marks (right after its scatter). */
@@ -823,7 +823,7 @@ static inline void mark_bases(const mpm_scene *s, unsigned char *near, int i, un
     }
 }
 
-/* After the packing, each grain (in any order, by any thread t): its points' stencil entries
+/* After the node sums, each grain (in any order, by any thread t): its points' stencil entries
  * (sv: the grain's pair at shared nodes, else the node) and, with spline normals (Eq. 24 with
  * linear transfers), its B-spline mass gradients at its shared pairs, from the points whose 3 x 3
  * B-spline nodes include one of them (in point order, into the records, two components per SSE2
@@ -859,7 +859,7 @@ static inline __attribute__((always_inline)) void grain_finish_with(mpm_scene *s
         bool shared = false;
         for (size_t r = r0; r < r1; r++) {
             const int i = s->pnode[r];
-            const bool sh = s->ngr[i] > 1;
+            const bool sh = s->ngr[i] > 1; /* not pshared: another thread's, no barrier */
             fin[r - r0] = sh ? (int)(nn + r) : i;
             if (spline && sh) {
                 mark[i] = (int)(r - r0);
@@ -919,7 +919,7 @@ static inline __attribute__((always_inline)) void grain_finish_with(mpm_scene *s
             }
         for (size_t r = r0; r < r1; r++) {
             const int i = s->pnode[r];
-            if (s->ngr[i] > 1) {
+            if (spline && s->ngr[i] > 1) {
                 s->pnx[r] = rec[r - r0].n[0];
                 s->pny[r] = rec[r - r0].n[1];
                 mark[i] = -1;
@@ -1135,10 +1135,6 @@ STAGE static void contact_update(mpm_scene *s, double dt, int t)
 #pragma omp barrier
     contact_correct(s, t, s->nax, s->nay, true, dt);
 }
-
-/* Two doubles in the lanes of one SSE2 register (GCC's vector extension; NEON on arm64, scalar
- * code elsewhere): each lane's arithmetic is the IEEE operation of the scalar code. */
-typedef double v2d __attribute__((vector_size(16)));
 
 /* Two consecutive doubles as a vector and back (memcpy: any alignment, no aliasing question;
  * one unaligned load or store). */
