@@ -102,6 +102,46 @@ static int clamp_count(const mpm_scene *s, int n)
     return n < 1 ? 1 : n;
 }
 
+/* The frictional scatter's per-thread scratch (records and factors of the largest grain) and
+ * the per-grain pair ranges, sized for the current grains and s->ntcap threads. */
+static core_status contact_scratch(mpm_scene *s, core_error *err)
+{
+    /* a grain has at most ns pairs per point */
+    size_t gmax = 1;
+    for (size_t g = 0; g < s->ngrains; g++)
+        gmax = s->gcount[g] > gmax ? s->gcount[g] : gmax;
+    const size_t need = (size_t)s->ns * gmax;
+    if (need > s->reccap) {
+        free(s->trec);
+        const size_t bytes = (size_t)s->ntcap * (need + 1) * sizeof(struct mpm_pair_rec);
+        s->trec = aligned_alloc(64, (bytes + 63) / 64 * 64);
+        free(s->tfin);
+        s->tfin = malloc((size_t)s->ntcap * need * sizeof *s->tfin);
+        s->reccap = s->trec && s->tfin ? need : 0;
+        if (!s->trec || !s->tfin)
+            return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu contact records", need);
+    }
+    if (s->ngrains > s->gpcap) {
+        size_t **per_grain[2] = {&s->gps, &s->gpc};
+        for (int k = 0; k < 2; k++) {
+            size_t *a = realloc(*per_grain[k], s->ngrains * sizeof *a);
+            if (!a)
+                return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu grains", s->ngrains);
+            *per_grain[k] = a;
+        }
+        s->gpcap = s->ngrains;
+    }
+    if (gmax > s->faccap) {
+        free(s->tfac);
+        const size_t bytes = (size_t)s->ntcap * gmax * sizeof(struct mpm_point_fac);
+        s->tfac = aligned_alloc(64, (bytes + 63) / 64 * 64);
+        s->faccap = s->tfac ? gmax : 0;
+        if (!s->tfac)
+            return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu contact records", gmax);
+    }
+    return CORE_OK;
+}
+
 /* Threads: every parallel region runs s->nt threads, thread t on points [tp[t], tp[t+1]); the
  * noslip transfers scatter by chunks (mpm_internal.h). The ranges and all reductions are fixed
  * for a thread count (friction: for any thread count; noslip: for a chunk count), so results are
@@ -151,44 +191,8 @@ static core_status threads_setup(mpm_scene *s, core_error *err)
     grain_ranges(s, nt, s->tp, s->tg);
     for (int u = 0; u <= nt; u++)
         s->tq[u] = (size_t)s->ns * s->tp[u]; /* thread u's pairs (friction), grain_scatter */
-    if (s->contact == MPM_CONTACT_FRICTION) {
-        /* a grain has at most ns pairs per point */
-        size_t gmax = 1;
-        for (size_t g = 0; g < s->ngrains; g++)
-            gmax = s->gcount[g] > gmax ? s->gcount[g] : gmax;
-        const size_t need = (size_t)s->ns * gmax;
-        if (need > s->reccap) {
-            free(s->trec);
-            const size_t bytes = (size_t)s->ntcap * (need + 1) * sizeof(struct mpm_pair_rec);
-            s->trec = aligned_alloc(64, (bytes + 63) / 64 * 64);
-            free(s->tfin);
-            s->tfin = malloc((size_t)s->ntcap * need * sizeof *s->tfin);
-            s->reccap = s->trec && s->tfin ? need : 0;
-            if (!s->trec || !s->tfin)
-                return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu contact records",
-                                 need);
-        }
-        if (s->ngrains > s->gpcap) {
-            size_t **per_grain[2] = {&s->gps, &s->gpc};
-            for (int k = 0; k < 2; k++) {
-                size_t *a = realloc(*per_grain[k], s->ngrains * sizeof *a);
-                if (!a)
-                    return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu grains",
-                                     s->ngrains);
-                *per_grain[k] = a;
-            }
-            s->gpcap = s->ngrains;
-        }
-        if (gmax > s->faccap) {
-            free(s->tfac);
-            const size_t bytes = (size_t)s->ntcap * gmax * sizeof(struct mpm_point_fac);
-            s->tfac = aligned_alloc(64, (bytes + 63) / 64 * 64);
-            s->faccap = s->tfac ? gmax : 0;
-            if (!s->tfac)
-                return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu contact records",
-                                 gmax);
-        }
-    }
+    if (s->contact == MPM_CONTACT_FRICTION)
+        return contact_scratch(s, err);
     return CORE_OK;
 }
 
