@@ -524,16 +524,24 @@ static inline bool near_plane(const mpm_scene *s, int k, size_t i)
     return d <= s->dref[k][i] + s->def.wall_gap * h;
 }
 
-/* Wall and plane conditions on centre-of-mass node i, then the velocity of a prescribed grain
- * whose points touch it. */
-static inline void node_walls(mpm_scene *s, double *vx, double *vy, size_t i, bool decide)
+/* The wall rules of the planes at node i on one velocity (*vx, *vy) with contact flags *win (a
+ * node's or a pair's). */
+static inline void planes_at(const mpm_scene *s, double *vx, double *vy, size_t i,
+                             unsigned char *win, bool decide)
 {
     const unsigned char w = s->nwall[i];
     if (w)
         for (int k = 0; k < s->nplanes; k++)
             if (w & (1u << k))
-                wall_rule(&s->planes[k], &vx[i], &vy[i], &s->nwin[i], (unsigned char)(1u << k),
-                          decide, !decide || near_plane(s, k, i));
+                wall_rule(&s->planes[k], vx, vy, win, (unsigned char)(1u << k), decide,
+                          !decide || near_plane(s, k, i));
+}
+
+/* Wall and plane conditions on centre-of-mass node i, then the velocity of a prescribed grain
+ * whose points touch it. */
+static inline void node_walls(mpm_scene *s, double *vx, double *vy, size_t i, bool decide)
+{
+    planes_at(s, &vx[i], &vy[i], i, &s->nwin[i], decide);
     if (s->npres && s->nforce[i]) {
         vx[i] = s->pv[s->nforce[i] - 1][0];
         vy[i] = s->pv[s->nforce[i] - 1][1];
@@ -544,14 +552,8 @@ static inline void node_walls(mpm_scene *s, double *vx, double *vy, size_t i, bo
  * grain's own field takes its velocity everywhere. */
 static inline void pair_walls(mpm_scene *s, double *vx, double *vy, size_t q, bool decide)
 {
-    const int i = s->pnode[q];
     const size_t e = s->nnodes + q;
-    const unsigned char w = s->nwall[i];
-    if (w)
-        for (int k = 0; k < s->nplanes; k++)
-            if (w & (1u << k))
-                wall_rule(&s->planes[k], &vx[e], &vy[e], &s->pwin[q], (unsigned char)(1u << k),
-                          decide, !decide || near_plane(s, k, i));
+    planes_at(s, &vx[e], &vy[e], (size_t)s->pnode[q], &s->pwin[q], decide);
     const int k = s->npres ? s->gpres[s->pgrain[q]] : -1;
     if (k >= 0) {
         vx[e] = s->pv[k][0];
