@@ -1171,10 +1171,47 @@ g2p_gather(const int *sf, const double *sw, const double *nax, const double *nay
     *dv = sd;
 }
 
-/* Step 3: positions (Eq. 10) and velocities (Eq. 11, blended with PIC) of thread t's points; a
- * prescribed grain's points keep its velocity exactly. */
+/* Thread t's zeroes in the entries its points feed with friction (its pairs at shared nodes,
+ * the nodes only its grains touch; the others are not read: nodes no point reaches have no
+ * mass) of the arrays a, b, before it scatters into them. */
+static void zero_own(mpm_scene *s, int t, double *a, double *b)
+{
+    const size_t nn = s->nnodes;
+    const int *const pnode = s->pnode;
+    const unsigned char *const pshared = s->pshared;
+    for (size_t q = s->tq[t]; q < pairs_end(s, t); q++) {
+        const size_t e = pshared[q] ? nn + q : (size_t)pnode[q];
+        a[e] = b[e] = 0;
+    }
+}
+
+/* The momenta m_p v_p of points [pa, pb) into the entries they feed, in point order and each
+ * point's in stencil order: the MUSL remap's Eq. 5, as scatter_sf_range adds them. */
+static inline __attribute__((always_inline)) void
+momenta_into(const int *restrict sf, const double *restrict sw, const double *restrict xm,
+             const double *restrict vx, const double *restrict vy, size_t pa, size_t pb,
+             const int ns, double *restrict npx, double *restrict npy)
+{
+    for (size_t p = pa; p < pb; p++) {
+        const int *const n = &sf[ns * p];
+        const double *const w = &sw[ns * p];
+        const double A = xm[p] * vx[p], B = xm[p] * vy[p];
+        for (int k = 0; k < ns; k++) {
+            npx[n[k]] += w[k] * A;
+            npy[n[k]] += w[k] * B;
+        }
+    }
+}
+
+/* Step 3: positions (Eq. 10) and velocities (Eq. 11, blended with PIC) of thread t's points,
+ * grain by grain; a prescribed grain's points keep its velocity exactly. With remap (friction
+ * and MUSL) each grain's points then scatter their new momenta into npx, npy (the remap's
+ * scatter, fused: the grain's stencils are still in the cache, and the points' order is the
+ * remap's), after the thread has zeroed the entries its points feed: nothing reads npx, npy
+ * between the contact stage's barrier and the remap's node loop, and every entry a thread's
+ * points feed is its own. */
 static inline __attribute__((always_inline)) void to_points_with(mpm_scene *s, double dt, int t,
-                                                                 const int ns)
+                                                                 const int ns, const bool remap)
 {
     const double pic = s->def.pic, flip = 1 - pic;
     const int *const sf = s->sf;
@@ -1182,55 +1219,58 @@ static inline __attribute__((always_inline)) void to_points_with(mpm_scene *s, d
     const double *const nax = s->nax, *const nay = s->nay, *const nvx = s->nvx, *const nvy = s->nvy;
     double *const x = s->x, *const y = s->y, *const ux = s->ux, *const uy = s->uy;
     double *const vx = s->vx, *const vy = s->vy;
-    const size_t pa = s->tp[t], pb = s->tp[t + 1];
-    size_t p = pa;
-    /* two points at a time: their gathers, then the updates with the points in the lanes (not
-     * with no_lanes, the tests' reference) */
-    const size_t pl = s->no_lanes ? pa : pb; /* the pairs' end bound, read once */
-    for (; p + 1 < pl; p += 2) {
-        v2d a[2], dv[2];
-        g2p_gather(sf, sw, nax, nay, nvx, nvy, p, ns, &a[0], &dv[0]);
-        g2p_gather(sf, sw, nax, nay, nvx, nvy, p + 1, ns, &a[1], &dv[1]);
-        const v2d ax = {a[0][0], a[1][0]}, ay = {a[0][1], a[1][1]};
-        const v2d dvx = {dv[0][0], dv[1][0]}, dvy = {dv[0][1], dv[1][1]};
-        const v2d dx = dt * ax, dy = dt * ay;
-        v2_store(&x[p], v2_load(&x[p]) + dx);
-        v2_store(&y[p], v2_load(&y[p]) + dy);
-        v2_store(&ux[p], v2_load(&ux[p]) + dx);
-        v2_store(&uy[p], v2_load(&uy[p]) + dy);
-        v2_store(&vx[p], flip * (v2_load(&vx[p]) + dvx) + pic * ax);
-        v2_store(&vy[p], flip * (v2_load(&vy[p]) + dvy) + pic * ay);
-    }
-    for (; p < pb; p++) {
-        v2d a, dv;
-        g2p_gather(sf, sw, nax, nay, nvx, nvy, p, ns, &a, &dv);
-        const double ax = a[0], ay = a[1], dvx = dv[0], dvy = dv[1];
-        x[p] += dt * ax;
-        y[p] += dt * ay;
-        ux[p] += dt * ax;
-        uy[p] += dt * ay;
-        vx[p] = flip * (vx[p] + dvx) + pic * ax;
-        vy[p] = flip * (vy[p] + dvy) + pic * ay;
-    }
-    if (s->npres)
-        for (size_t g = s->tg[t]; g < s->tg[t + 1]; g++) {
-            const int k = s->gpres[g];
-            if (k < 0)
-                continue;
-            for (size_t q = s->gstart[g]; q < s->gstart[g] + s->gcount[g]; q++) {
-                s->vx[q] = s->pv[k][0];
-                s->vy[q] = s->pv[k][1];
-            }
+    const bool lanes = !s->no_lanes; /* the lanes below, or one point at a time (the tests') */
+    if (remap)
+        zero_own(s, t, s->npx, s->npy);
+    for (size_t g = s->tg[t]; g < s->tg[t + 1]; g++) {
+        const size_t p0 = s->gstart[g], p1 = p0 + s->gcount[g];
+        size_t p = p0;
+        /* two points at a time: their gathers, then the updates with the points in the lanes */
+        for (; lanes && p + 1 < p1; p += 2) {
+            v2d a[2], dv[2];
+            g2p_gather(sf, sw, nax, nay, nvx, nvy, p, ns, &a[0], &dv[0]);
+            g2p_gather(sf, sw, nax, nay, nvx, nvy, p + 1, ns, &a[1], &dv[1]);
+            const v2d ax = {a[0][0], a[1][0]}, ay = {a[0][1], a[1][1]};
+            const v2d dvx = {dv[0][0], dv[1][0]}, dvy = {dv[0][1], dv[1][1]};
+            const v2d dx = dt * ax, dy = dt * ay;
+            v2_store(&x[p], v2_load(&x[p]) + dx);
+            v2_store(&y[p], v2_load(&y[p]) + dy);
+            v2_store(&ux[p], v2_load(&ux[p]) + dx);
+            v2_store(&uy[p], v2_load(&uy[p]) + dy);
+            v2_store(&vx[p], flip * (v2_load(&vx[p]) + dvx) + pic * ax);
+            v2_store(&vy[p], flip * (v2_load(&vy[p]) + dvy) + pic * ay);
         }
+        for (; p < p1; p++) {
+            v2d a, dv;
+            g2p_gather(sf, sw, nax, nay, nvx, nvy, p, ns, &a, &dv);
+            const double ax = a[0], ay = a[1], dvx = dv[0], dvy = dv[1];
+            x[p] += dt * ax;
+            y[p] += dt * ay;
+            ux[p] += dt * ax;
+            uy[p] += dt * ay;
+            vx[p] = flip * (vx[p] + dvx) + pic * ax;
+            vy[p] = flip * (vy[p] + dvy) + pic * ay;
+        }
+        const int k = s->npres ? s->gpres[g] : -1;
+        if (k >= 0)
+            for (p = p0; p < p1; p++) {
+                vx[p] = s->pv[k][0];
+                vy[p] = s->pv[k][1];
+            }
+        if (remap)
+            momenta_into(sf, sw, s->m, vx, vy, p0, p1, ns, s->npx, s->npy);
+    }
 }
 
 /* to_points_with with ns = 4 (linear shapes) a constant: the stencil loops unroll. */
-STAGE static void to_points(mpm_scene *s, double dt, int t)
+STAGE static void to_points(mpm_scene *s, double dt, int t, bool remap)
 {
-    if (s->ns == 4)
-        to_points_with(s, dt, t, 4);
+    if (s->ns == 4 && remap)
+        to_points_with(s, dt, t, 4, true);
+    else if (s->ns == 4)
+        to_points_with(s, dt, t, 4, false);
     else
-        to_points_with(s, dt, t, s->ns);
+        to_points_with(s, dt, t, s->ns, remap);
 }
 
 /* v = p / m on the centre-of-mass nodes and the grain entries, then the walls and the contact
@@ -1267,6 +1307,26 @@ STAGE static void nodal_velocity(mpm_scene *s, double dt, int t, bool decide)
     }
     if (friction)
         contact_correct(s, t, s->nax, s->nay, decide, dt);
+}
+
+/* At shared nodes the centre of mass takes the sum of the grains' entries of a, b, in pair order
+ * (every thread's scatter done). No barrier after: the next reader of a shared node is the same
+ * thread, in a node loop with the same static split (nodal_velocity, grid_update). */
+static void shared_sums(mpm_scene *s, double *a, double *b)
+{
+    const size_t nn = s->nnodes;
+#pragma omp for schedule(static) nowait
+    for (size_t i = 0; i < nn; i++) {
+        if (s->ngr[i] < 2)
+            continue;
+        double sa = 0, sb = 0;
+        for (int r = s->nhead[i]; r >= 0; r = s->pnext[r]) {
+            sa += a[nn + (size_t)r];
+            sb += b[nn + (size_t)r];
+        }
+        a[i] = sa;
+        b[i] = sb;
+    }
 }
 
 /* scatter_sf_with's points [pa, pb) into the arrays f[0], f[1]. */
@@ -1322,28 +1382,10 @@ scatter_sf_with(mpm_scene *s, int t, double *a, double *b, bool force, const int
         reduce_buffers(s, main, 2);
         return;
     }
-    /* thread t zeroes the entries its points feed (its pairs at shared nodes, the nodes only its
-     * grains touch; the others are not read: nodes no point reaches have no mass) */
-    for (size_t q = s->tq[t]; q < pairs_end(s, t); q++) {
-        const size_t e = s->pshared[q] ? nn + q : (size_t)s->pnode[q];
-        a[e] = b[e] = 0;
-    }
+    zero_own(s, t, a, b);
     scatter_sf_range(s, s->tp[t], s->tp[t + 1], main, force, ns);
 #pragma omp barrier
-    /* no barrier after: the next reader of a shared node is the same thread, in the node loop
-     * with the same static split (nodal_velocity, grid_update) */
-#pragma omp for schedule(static) nowait
-    for (size_t i = 0; i < nn; i++) {
-        if (s->ngr[i] < 2)
-            continue;
-        double sa = 0, sb = 0;
-        for (int r = s->nhead[i]; r >= 0; r = s->pnext[r]) {
-            sa += a[nn + (size_t)r];
-            sb += b[nn + (size_t)r];
-        }
-        a[i] = sa;
-        b[i] = sb;
-    }
+    shared_sums(s, a, b);
 }
 
 /* scatter_sf_with with ns = 4 (linear shapes) a constant: the stencil loops unroll. */
@@ -1356,10 +1398,16 @@ STAGE static void scatter_sf(mpm_scene *s, int t, double *a, double *b, bool for
 }
 
 /* MUSL: the updated point momenta mapped back (Eq. 5 with v_p^{n+1}) give the nodal velocities
- * the strain increment is taken from; with friction each grain's own field at shared nodes. */
+ * the strain increment is taken from; with friction each grain's own field at shared nodes,
+ * scattered by to_points. */
 STAGE static void remap(mpm_scene *s, double dt, int t)
 {
-    scatter_sf(s, t, s->npx, s->npy, false);
+    if (s->contact == MPM_CONTACT_FRICTION) {
+#pragma omp barrier
+        shared_sums(s, s->npx, s->npy);
+    } else {
+        scatter_sf(s, t, s->npx, s->npy, false);
+    }
     nodal_velocity(s, dt, t, false);
 }
 
@@ -1857,7 +1905,7 @@ static core_status run_steps(mpm_scene *s, const mpm_run_def *run, long *done, c
             /* With friction a thread's points read only its own pairs and the nodes that only
              * its grains reach, which no thread writes again before the next barrier (the
              * remap zeroes and scatters into the same entries), so no barrier follows. */
-            to_points(s, dt, t);
+            to_points(s, dt, t, friction && musl);
             if (!friction) {
 #pragma omp barrier
             }
