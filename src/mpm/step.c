@@ -777,34 +777,6 @@ STAGE static void pair_kinds(mpm_scene *s, int t)
     s->tsh[t] = n;
 }
 
-/* Thread t's share of the pairs at shared nodes (every thread's pair_kinds done): entries
- * [lo, hi) of their list, an even split. Measured on the shear (10 cycles, callgrind per
- * thread): the grains of the second half hold 2.4 times the shared pairs of the first, so the
- * threads' own pairs would leave one thread twice the contact work. */
-typedef struct {
-    size_t k, hi, base;
-    int u;
-} shared_iter;
-
-static inline shared_iter shared_share(const mpm_scene *s, int t)
-{
-    size_t n = 0;
-    for (int u = 0; u < s->nt; u++)
-        n += s->tsh[u];
-    const size_t lo = n * (size_t)t / (size_t)s->nt, hi = n * (size_t)(t + 1) / (size_t)s->nt;
-    return (shared_iter){.k = lo, .hi = hi, .base = 0, .u = 0};
-}
-
-/* The next pair of the share, or -1 at its end. */
-static inline long shared_next(const mpm_scene *s, shared_iter *it)
-{
-    if (it->k >= it->hi)
-        return -1;
-    while (it->k >= it->base + s->tsh[it->u])
-        it->base += s->tsh[it->u++];
-    return s->slist[s->tq[it->u] + (it->k++ - it->base)];
-}
-
 /* Sets (v = 1) or clears (v = 0) near[] at the B-spline base nodes of the points whose 3 x 3
  * nodes include node i: the bases up to two nodes below i on each axis. */
 static inline void mark_bases(const mpm_scene *s, unsigned char *near, int i, unsigned char v)
@@ -999,130 +971,187 @@ static inline void grid_entry(mpm_scene *s, size_t i, double dt)
     }
 }
 
-/* Every node with its walls; no barrier at the end (the callers' next step decides). */
+/* Every node with its walls; with friction the nodes of one grain (ngr = 1; shared nodes are
+ * contact_update's, and the nodes no point reaches are never read). No barrier at the end (the
+ * callers' next step decides). */
 STAGE static void grid_update(mpm_scene *s, double dt)
 {
+    const int *const ngr = s->contact == MPM_CONTACT_FRICTION ? s->ngr : NULL;
 #pragma omp for schedule(static) nowait
     for (size_t i = 0; i < s->nnodes; i++) {
+        if (ngr && ngr[i] != 1)
+            continue;
         grid_entry(s, i, dt);
         node_walls(s, s->nax, s->nay, i, true);
     }
 }
 
-/* contact_correct's last part (option conserve): the momentum the corrections changed at each
- * node taken back evenly from its corrected grains. */
-static void conserve(mpm_scene *s, int th, double *vx, double *vy)
+/* The contact rule's constants for a step. */
+typedef struct {
+    double mu, sep, cap;
+    bool own, conserve;
+} contact_rule;
+
+/* The sums over a shared node's pairs that the rule reads: the grains' mass gradients (tg) and
+ * nodal volumes (vol), added along the node's chain in pair order. */
+typedef struct {
+    v2d tg;
+    double vol;
+} pair_sums;
+
+static inline contact_rule rule_of(const mpm_scene *s, double dt)
 {
-    const size_t nn = s->nnodes;
-    double *dp = s->ndp; /* per node: momentum change x, y, and the corrected grains' mass */
-#pragma omp barrier
-#pragma omp for schedule(static)
-    for (size_t i = 0; i < nn; i++) {
-        if (s->ngr[i] < 2)
-            continue;
-        /* the node's sums over its corrected pairs, in pair order */
-        double px = 0, py = 0, m = 0;
-        bool any = false;
-        for (int r = s->nhead[i]; r >= 0; r = s->pnext[r])
-            if (s->pin[r]) {
-                const double mr = s->nm[nn + (size_t)r];
-                px += mr * s->pcx[r];
-                py += mr * s->pcy[r];
-                m += mr;
-                any = true;
-            }
-        if (any) {
-            dp[i] = px;
-            dp[nn + i] = py;
-            dp[2 * nn + i] = m;
-        }
-    }
-    shared_iter it = shared_share(s, th);
-    for (long qq; (qq = shared_next(s, &it)) >= 0;) {
-        const size_t q = (size_t)qq;
-        const int i = s->pnode[q];
-        if (!s->pin[q] || s->nwall[i] || (s->npres && s->nforce[i]))
-            continue;
-        const double M = dp[2 * nn + i];
-        vx[nn + q] -= dp[i] / M;
-        vy[nn + q] -= dp[nn + i] / M;
-    }
+    return (contact_rule){.mu = s->mu,
+                          .sep = s->opt.separation * s->hx * s->hy,
+                          .cap = s->opt.strain_cap * (s->hx < s->hy ? s->hx : s->hy) / dt,
+                          .own = s->opt.normals == MPM_NORMALS_OWN,
+                          .conserve = s->opt.conserve};
 }
 
-/* The contact rule at nodes shared by two or more grains: each grain's velocity (vx, vy at entry
- * nnodes + q) against the centre-of-mass velocity at its node. With decide, Eq. 12 (the grain
- * overtakes the centre-of-mass field along its normal) and the separation check mark the pair in
- * contact for this step; without, the marks of the momentum update are reused (see remap).
- * Marked pairs get the normal correction (Eq. 14) and Coulomb friction (Eqs. 18-23), capped by
- * the strain cap; then the momentum the corrections changed at a node (non-zero with three or
- * more grains, or with the cap) is taken back evenly from the corrected grains there, a common
- * velocity shift that leaves their relative motion as the rule made it. */
-STAGE static void contact_correct(mpm_scene *s, int th, double *vx, double *vy, bool decide,
-                                  double dt)
+/* The contact rule for pair q at shared node i: the grain's velocity (vx, vy at entry nnodes + q)
+ * against the centre-of-mass velocity at its node. With decide, Eq. 12 (the grain overtakes the
+ * centre-of-mass field along its normal) and the separation check mark the pair in contact for
+ * this step; without, the marks of the momentum update are reused (see nodal_velocity). A marked
+ * pair gets the normal correction (Eq. 14) and Coulomb friction (Eqs. 18-23), capped by the
+ * strain cap; *cx, *cy: the correction (0 without). */
+static inline void pair_rule(mpm_scene *s, size_t i, size_t q, double *vx, double *vy, bool decide,
+                             const contact_rule *c, const pair_sums *ps, double *cx, double *cy)
+{
+    const size_t e = s->nnodes + q;
+    *cx = *cy = 0;
+    if (decide)
+        s->pin[q] = 0;
+    if (!(s->nm[e] > 0))
+        return;
+    double gx = s->pnx[q], gy = s->pny[q];
+    if (!c->own) {
+        /* The grain's mass gradient against that of everything else at the node,
+         * g - (g_all - g) = 2 g - g_all: at a node of two grains their normals are then
+         * exactly opposite and the corrections conserve momentum. */
+        gx = 2 * gx - ps->tg[0];
+        gy = 2 * gy - ps->tg[1];
+    }
+    const double len = sqrt(gx * gx + gy * gy);
+    if (!(len > 0))
+        return;
+    const double nx = gx / len, ny = gy / len;
+    const double dvx = vx[e] - vx[i], dvy = vy[e] - vy[i];
+    const double dn = dvx * nx + dvy * ny;
+    if (decide)
+        s->pin[q] = dn > 0 && !(c->sep > 0 && ps->vol < c->sep); /* Eq. 12, separation */
+    if (!s->pin[q])
+        return;
+    const double tx = dvx - dn * nx, ty = dvy - dn * ny, t = sqrt(tx * tx + ty * ty);
+    /* Eq. 14: the normal velocity becomes the centre-of-mass one (the force of Eq. 15);
+     * Eqs. 18-23: sticking would remove the whole relative tangential velocity t (Eq. 18);
+     * Coulomb caps the removal at mu times the normal correction |dn|, i.e.
+     * mu' = min(mu, t / dn) (Eq. 21) along -t / |t| (Eqs. 20, 22), which is Eq. 23. */
+    double ux = -dn * nx, uy = -dn * ny;
+    if (t > 0) {
+        const double k = fmin(c->mu * fabs(dn), t) / t;
+        ux -= k * tx;
+        uy -= k * ty;
+    }
+    if (c->cap > 0) {
+        const double k = sqrt(ux * ux + uy * uy);
+        if (k > c->cap) {
+            ux *= c->cap / k;
+            uy *= c->cap / k;
+        }
+    }
+    vx[e] += ux;
+    vy[e] += uy;
+    *cx = ux;
+    *cy = uy;
+}
+
+/* The contact rule at shared node i (its velocity and its pairs' are final): each pair in pair
+ * order (the node's chain, pair_rule); then (option conserve) the momentum the corrections
+ * changed at the node (non-zero with three or more grains, or with the cap) is taken back evenly
+ * from the corrected grains there, a common velocity shift that leaves their relative motion as
+ * the rule made it. Node by node, by the thread whose static share of the nodes holds i: the
+ * rule reads only the node's own entries, so no barrier separates it from the node's velocity,
+ * and the momentum sums need no pass of their own. */
+static inline void contact_node(mpm_scene *s, size_t i, double *vx, double *vy, bool decide,
+                                const contact_rule *c, const pair_sums *ps)
 {
     const size_t nn = s->nnodes;
-    const double mu = s->mu;
-    const mpm_normals normals = s->opt.normals;
-    const double sep = s->opt.separation * s->hx * s->hy;
-    const double cap = s->opt.strain_cap * (s->hx < s->hy ? s->hx : s->hy) / dt;
-    /* every pair at a shared node on its own (the thread's share; the nodes' velocities are
-     * done, after a barrier); the corrections are kept in pcx, pcy. Pairs at other nodes are
-     * never in contact, and nothing reads their pin, pcx, pcy. */
-    shared_iter it = shared_share(s, th);
-    for (long qq; (qq = shared_next(s, &it)) >= 0;) {
-        const size_t q = (size_t)qq;
-        const int i = s->pnode[q];
-        const size_t e = nn + q;
-        s->pcx[q] = s->pcy[q] = 0;
-        if (decide)
-            s->pin[q] = 0;
-        if (!(s->nm[e] > 0))
-            continue;
-        double gx = s->pnx[q], gy = s->pny[q];
-        if (normals != MPM_NORMALS_OWN) {
-            /* The grain's mass gradient against that of everything else at the node,
-             * g - (g_all - g) = 2 g - g_all: at a node of two grains their normals are then
-             * exactly opposite and the corrections conserve momentum. */
-            gx = 2 * gx - s->tgx[i];
-            gy = 2 * gy - s->tgy[i];
+    double px = 0, py = 0, m = 0; /* the corrected pairs' momentum change and mass */
+    bool any = false;
+    for (int r = s->nhead[i]; r >= 0; r = s->pnext[r]) {
+        const size_t q = (size_t)r;
+        if (!decide && !s->pin[q])
+            continue; /* the momentum update left it out of contact */
+        double cx, cy;
+        pair_rule(s, i, q, vx, vy, decide, c, ps, &cx, &cy);
+        if (c->conserve && s->pin[q]) {
+            const double mr = s->nm[nn + q];
+            px += mr * cx;
+            py += mr * cy;
+            m += mr;
+            any = true;
         }
-        const double len = sqrt(gx * gx + gy * gy);
-        if (!(len > 0))
-            continue;
-        const double nx = gx / len, ny = gy / len;
-        const double dvx = vx[e] - vx[i], dvy = vy[e] - vy[i];
-        const double dn = dvx * nx + dvy * ny;
-        if (decide)
-            s->pin[q] = dn > 0 && !(sep > 0 && s->tvol[i] < sep); /* Eq. 12, separation */
-        if (!s->pin[q])
-            continue;
-        const double tx = dvx - dn * nx, ty = dvy - dn * ny, t = sqrt(tx * tx + ty * ty);
-        /* Eq. 14: the normal velocity becomes the centre-of-mass one (the force of Eq. 15);
-         * Eqs. 18-23: sticking would remove the whole relative tangential velocity t (Eq. 18);
-         * Coulomb caps the removal at mu times the normal correction |dn|, i.e.
-         * mu' = min(mu, t / dn) (Eq. 21) along -t / |t| (Eqs. 20, 22), which is Eq. 23. */
-        double cx = -dn * nx, cy = -dn * ny;
-        if (t > 0) {
-            const double c = fmin(mu * fabs(dn), t) / t;
-            cx -= c * tx;
-            cy -= c * ty;
-        }
-        if (cap > 0) {
-            const double c = sqrt(cx * cx + cy * cy);
-            if (c > cap) {
-                cx *= cap / c;
-                cy *= cap / c;
-            }
-        }
-        vx[e] += cx;
-        vy[e] += cy;
-        s->pcx[q] = cx;
-        s->pcy[q] = cy;
     }
-    /* then a barrier: the threads' shares are not the pairs their own points read next */
-    if (s->opt.conserve)
-        conserve(s, th, vx, vy);
-#pragma omp barrier
+    if (!any || s->nwall[i] || (s->npres && s->nforce[i]))
+        return;
+    const double ex = px / m, ey = py / m;
+    for (int r = s->nhead[i]; r >= 0; r = s->pnext[r])
+        if (s->pin[r]) {
+            vx[nn + (size_t)r] -= ex;
+            vy[nn + (size_t)r] -= ey;
+        }
+}
+
+/* v = p / m at entry i (the remap and USF: nodal_velocity). */
+static inline void velocity_entry(mpm_scene *s, size_t i)
+{
+    const double m = s->nm[i];
+    s->nax[i] = m > 0 ? s->npx[i] / m : 0;
+    s->nay[i] = m > 0 ? s->npy[i] / m : 0;
+}
+
+/* The nodes of the contact loops per dynamic chunk: a node's work is its own (the same bits
+ * whichever thread takes it), and the shared nodes are not evenly spread over the grid (on the
+ * shear the second half of the nodes held 1.3 times the first's contact work). */
+enum { NODE_CHUNK = 256 };
+
+/* Shared node i (every thread's scatter done): with a, b (not NULL), the node's entry of those
+ * arrays first, the sum of its grains' (in pair order: the remap's momenta, USF's forces); the
+ * velocities of its pairs and of the node, from the momentum update (grid, Eq. 9) or p / m (the
+ * remap and USF, velocity_entry), their walls, the sums the rule reads, then the contact rule. */
+static inline void shared_node(mpm_scene *s, size_t i, double dt, bool grid, bool decide, double *a,
+                               double *b, const contact_rule *c)
+{
+    const size_t nn = s->nnodes;
+    const bool sums = a != NULL;
+    double sa = 0, sb = 0;
+    pair_sums ps = {{0, 0}, 0};
+    for (int r = s->nhead[i]; r >= 0; r = s->pnext[r]) {
+        const size_t e = nn + (size_t)r;
+        if (sums) {
+            sa += a[e];
+            sb += b[e];
+        }
+        if (grid)
+            grid_entry(s, e, dt);
+        else
+            velocity_entry(s, e);
+        pair_walls(s, s->nax, s->nay, (size_t)r, decide);
+        if (!c->own)
+            ps.tg += (v2d){s->pnx[r], s->pny[r]};
+        if (c->sep > 0)
+            ps.vol += s->pvol[r];
+    }
+    if (sums) {
+        a[i] = sa;
+        b[i] = sb;
+    }
+    if (grid)
+        grid_entry(s, i, dt);
+    else
+        velocity_entry(s, i);
+    node_walls(s, s->nax, s->nay, i, decide);
+    contact_node(s, i, s->nax, s->nay, decide, c, &ps);
 }
 
 /* Step 2 for the grain fields at shared nodes: v_i^g and the updated v_i^g (Eqs. 5 and 9 over the
@@ -1130,16 +1159,20 @@ STAGE static void contact_correct(mpm_scene *s, int th, double *vx, double *vy, 
  * rule. Applied after the momentum update (the paper's order) and not to the P2G velocities
  * (measured on the 0.5 m/s head-on collision: correcting v_i^g after P2G as well changed the
  * rebound speed by 1.5% and did not remove the energy error that the consistent marks below
- * fix), so a point's FLIP increment carries the whole correction. */
-STAGE static void contact_update(mpm_scene *s, double dt, int t)
+ * fix), so a point's FLIP increment carries the whole correction. Node by node (shared_node:
+ * the shared nodes' own momentum update too, which grid_update leaves out), then the barrier:
+ * the points read their pairs next, whichever thread corrected them. */
+STAGE static void contact_update(mpm_scene *s, double dt)
 {
-    shared_iter it = shared_share(s, t);
-    for (long q; (q = shared_next(s, &it)) >= 0;) {
-        grid_entry(s, s->nnodes + (size_t)q, dt);
-        pair_walls(s, s->nax, s->nay, (size_t)q, true);
-    }
+    const contact_rule c = rule_of(s, dt);
+    /* USF: the forces were scattered from the new stress (scatter_sf), their sums are due */
+    double *const a = s->def.update == MPM_USF ? s->nfx : NULL;
+    double *const b = s->def.update == MPM_USF ? s->nfy : NULL;
+#pragma omp for schedule(dynamic, NODE_CHUNK) nowait
+    for (size_t i = 0; i < s->nnodes; i++)
+        if (s->ngr[i] > 1)
+            shared_node(s, i, dt, true, true, a, b, &c);
 #pragma omp barrier
-    contact_correct(s, t, s->nax, s->nay, true, dt);
 }
 
 /* Two consecutive doubles as a vector and back (memcpy: any alignment, no aliasing question;
@@ -1283,50 +1316,31 @@ STAGE static void to_points(mpm_scene *s, double dt, int t, bool remap)
  * elastic) / initial kinetic = 1.01: no remap correction: 1.64; remap correction re-deciding
  * Eq. 12 on the remapped field (contact switching on and off every other step): 1.58; the marks
  * of the momentum update: 1.03. */
-static inline void velocity_entry(mpm_scene *s, size_t i)
-{
-    const double m = s->nm[i];
-    s->nax[i] = m > 0 ? s->npx[i] / m : 0;
-    s->nay[i] = m > 0 ? s->npy[i] / m : 0;
-}
-
-STAGE static void nodal_velocity(mpm_scene *s, double dt, int t, bool decide)
-{
-    const bool friction = s->contact == MPM_CONTACT_FRICTION;
-    if (friction) { /* thread t's share of the pairs at shared nodes */
-        shared_iter it = shared_share(s, t);
-        for (long q; (q = shared_next(s, &it)) >= 0;) {
-            velocity_entry(s, s->nnodes + (size_t)q);
-            pair_walls(s, s->nax, s->nay, (size_t)q, decide);
-        }
-    }
-#pragma omp for schedule(static)
-    for (size_t i = 0; i < s->nnodes; i++) {
-        velocity_entry(s, i);
-        node_walls(s, s->nax, s->nay, i, decide);
-    }
-    if (friction)
-        contact_correct(s, t, s->nax, s->nay, decide, dt);
-}
-
-/* At shared nodes the centre of mass takes the sum of the grains' entries of a, b, in pair order
- * (every thread's scatter done). No barrier after: the next reader of a shared node is the same
- * thread, in a node loop with the same static split (nodal_velocity, grid_update). */
-static void shared_sums(mpm_scene *s, double *a, double *b)
+STAGE static void nodal_velocity(mpm_scene *s, double dt, bool decide, bool sums)
 {
     const size_t nn = s->nnodes;
-#pragma omp for schedule(static) nowait
-    for (size_t i = 0; i < nn; i++) {
-        if (s->ngr[i] < 2)
-            continue;
-        double sa = 0, sb = 0;
-        for (int r = s->nhead[i]; r >= 0; r = s->pnext[r]) {
-            sa += a[nn + (size_t)r];
-            sb += b[nn + (size_t)r];
+    if (s->contact != MPM_CONTACT_FRICTION) {
+#pragma omp for schedule(static)
+        for (size_t i = 0; i < nn; i++) {
+            velocity_entry(s, i);
+            node_walls(s, s->nax, s->nay, i, decide);
         }
-        a[i] = sa;
-        b[i] = sb;
+        return;
     }
+    /* Node by node (the nodes no point reaches are never read; shared_node), then the barrier:
+     * the points read their entries next */
+    const contact_rule c = rule_of(s, dt);
+#pragma omp for schedule(dynamic, NODE_CHUNK) nowait
+    for (size_t i = 0; i < nn; i++) {
+        const int n = s->ngr[i];
+        if (n > 1) {
+            shared_node(s, i, dt, false, decide, sums ? s->npx : NULL, sums ? s->npy : NULL, &c);
+        } else if (n) {
+            velocity_entry(s, i);
+            node_walls(s, s->nax, s->nay, i, decide);
+        }
+    }
+#pragma omp barrier
 }
 
 /* scatter_sf_with's points [pa, pb) into the arrays f[0], f[1]. */
@@ -1361,11 +1375,12 @@ scatter_sf_range(const mpm_scene *s, size_t pa, size_t pb, double *const f[2], b
 }
 
 /* Scatters a per-point vector into the entries each point feeds (sf: its grain's entry at shared
- * nodes, the centre of mass elsewhere) of the arrays a, b: momentum m_p v_p (force = false) or
- * the internal force and gravity (Eq. 7) from the current stress (force = true); at shared nodes
- * the centre of mass then takes the sum of the grains' entries. Inside the parallel region. With
- * friction every entry a point feeds belongs to its thread (its grain's, or a node only its grain
- * touches); noslip scatters by chunks (to_grid). */
+ * nodes, the centre of mass elsewhere) of the arrays a, b: momentum m_p v_p (force = false; the
+ * noslip remap) or the internal force and gravity (Eq. 7) from the current stress (force = true;
+ * USF). Inside the parallel region. With friction every entry a point feeds belongs to its
+ * thread (its grain's, or a node only its grain touches), and a shared node's centre of mass
+ * takes the sum of the grains' entries in contact_update (shared_node); noslip scatters by
+ * chunks (to_grid). */
 static inline __attribute__((always_inline)) void
 scatter_sf_with(mpm_scene *s, int t, double *a, double *b, bool force, const int ns)
 {
@@ -1385,7 +1400,6 @@ scatter_sf_with(mpm_scene *s, int t, double *a, double *b, bool force, const int
     zero_own(s, t, a, b);
     scatter_sf_range(s, s->tp[t], s->tp[t + 1], main, force, ns);
 #pragma omp barrier
-    shared_sums(s, a, b);
 }
 
 /* scatter_sf_with with ns = 4 (linear shapes) a constant: the stencil loops unroll. */
@@ -1404,11 +1418,10 @@ STAGE static void remap(mpm_scene *s, double dt, int t)
 {
     if (s->contact == MPM_CONTACT_FRICTION) {
 #pragma omp barrier
-        shared_sums(s, s->npx, s->npy);
     } else {
         scatter_sf(s, t, s->npx, s->npy, false);
     }
-    nodal_velocity(s, dt, t, false);
+    nodal_velocity(s, dt, false, true);
 }
 
 /* The end-of-step check's bounds per axis: [lo, hi) of a periodic axis, [lo, hi] (the slack
@@ -1887,7 +1900,7 @@ static core_status run_steps(mpm_scene *s, const mpm_run_def *run, long *done, c
             STAGE_DONE(friction ? T_NORMALS : T_P2G);
             tbad[t] = (size_t)-1;
             if (usf) {
-                nodal_velocity(s, dt, t, true); /* v_i^n, for the stress update */
+                nodal_velocity(s, dt, true, false); /* v_i^n, for the stress update */
                 tbad[t] = constitutive(s, dt, t, s->nax, s->nay, NULL);
 #pragma omp barrier
                 STAGE_DONE(T_MATERIAL);
@@ -1897,14 +1910,15 @@ static core_status run_steps(mpm_scene *s, const mpm_run_def *run, long *done, c
             grid_update(s, dt);
             STAGE_DONE(T_GRID); /* thread 0's own time (no barrier) */
             if (friction) {
-                contact_update(s, dt, t);
+                contact_update(s, dt);
                 STAGE_DONE(T_CONTACT);
             } else {
 #pragma omp barrier
             }
             /* With friction a thread's points read only its own pairs and the nodes that only
              * its grains reach, which no thread writes again before the next barrier (the
-             * remap zeroes and scatters into the same entries), so no barrier follows. */
+             * remap's scatter, in to_points, zeroes and adds into the same entries, npx and
+             * npy only), so no barrier follows. */
             to_points(s, dt, t, friction && musl);
             if (!friction) {
 #pragma omp barrier
