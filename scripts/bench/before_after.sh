@@ -1,7 +1,8 @@
 #!/bin/sh
 # Before and after, side by side (issue 16): the three engines' benchmarks run by two grainlab
-# checkouts on the same machine, alternating (old new old new ...), each checkout with its own
-# bench scripts (the scenes are the same; a newer script may call what an older binary lacks).
+# checkouts on the same machine, alternating in ABBA blocks (old new new old), each checkout
+# with its own bench scripts (the scenes are the same; a newer script may call what an older
+# binary lacks).
 #   scripts/bench/before_after.sh OLD_CHECKOUT NEW_CHECKOUT [reps=2] [engines=mpm,dem,dsmc]
 # Each checkout must be built in its build/. Benches (their defaults but shorter runs), each on 1
 # and then 2 threads in one process:
@@ -10,7 +11,7 @@
 #          exported once, pile=; the old one prepares the same state, bit for bit)
 #   dsmc : bench/dsmc_cooling.lua steps=30 (10^6 disks)
 # Prints one line per run (engine, threads, side, rate, load) and a Markdown table of medians
-# (particle- or point-steps per second).
+# (particle- or point-steps per second) and of the ABBA blocks' ratios (below).
 set -eu
 OLD=$1 NEW=$2
 shift 2
@@ -47,23 +48,34 @@ run() {
       t = $1; sub(/^particle_steps_per_s_/, "", t); sub(/_threads$/, "", t); print e, t, s, $2, l }' |
     tee -a "$LOG"
 }
+# Each repetition runs old new new old (ABBA): a machine whose speed drifts during the block
+# (this host's runs move by 20 % and more) weighs on both sides alike, so the block's ratio
+# (the sum of its two new rates over its two old ones) is steadier than either side's rates.
 for e in $ENGINES; do
   r=1
   while [ "$r" -le "$REPS" ]; do
     run "$OLD" old $e
     run "$NEW" new $e
+    run "$NEW" new $e
+    run "$OLD" old $e
     r=$((r + 1))
   done
 done
 echo
-echo "| engine | threads | before | after | after / before |"
-echo "|---|---:|---:|---:|---:|"
+echo "| engine | threads | before | after | after / before | blocks' ratios: median (range) |"
+echo "|---|---:|---:|---:|---:|---:|"
 med() { sort -g | awk '{ a[NR] = $1 } END { print a[int((NR + 1) / 2)] }'; }
 for e in $ENGINES; do
   for t in 1 2; do
     o=$(awk -v e=$e -v t=$t '$1 == e && $2 == t && $3 == "old" { print $4 }' "$LOG" | med)
     n=$(awk -v e=$e -v t=$t '$1 == e && $2 == t && $3 == "new" { print $4 }' "$LOG" | med)
-    echo "| $e | $t | $o | $n | $(awk -v o="$o" -v n="$n" 'BEGIN { printf "%.2f", n / o }') |"
+    # the lines of (e, t) in log order: 4 per block, old new new old
+    blocks=$(awk -v e=$e -v t=$t '$1 == e && $2 == t { v[k++] = $4 }
+      END { for (b = 0; b + 3 < k; b += 4) printf "%.4f\n", (v[b + 1] + v[b + 2]) / (v[b] + v[b + 3]) }' "$LOG")
+    bm=$(echo "$blocks" | med)
+    lo=$(echo "$blocks" | sort -g | head -n 1)
+    hi=$(echo "$blocks" | sort -g | tail -n 1)
+    echo "| $e | $t | $o | $n | $(awk -v o="$o" -v n="$n" 'BEGIN { printf "%.2f", n / o }') | $(printf '%.2f (%.2f-%.2f)' "$bm" "$lo" "$hi") |"
   done
 done
 rm -f "$LOG"

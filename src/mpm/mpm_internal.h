@@ -136,6 +136,7 @@ struct mpm_scene {
     int nc, nccap;
     size_t *cp;
     double *tbuf;
+    struct mpm_node_rec *nrec; /* nc x nnodes: the chunks' node sums of to_grid */
 
     mpm_contact_model contact;
     double time;

@@ -281,6 +281,7 @@ void mpm_destroy(mpm_scene *s)
     free(s->tfac);
     free(s->tnear);
     free(s->tbuf);
+    free(s->nrec);
     free(s->cp);
     free(s);
 }

@@ -42,6 +42,12 @@ struct mpm_point_fac {
     v2d mpx, pyv, fg, sa, sb;
 };
 
+/* A node's sums during the noslip transfer (to_grid), in SSE2 lanes as the frictional scatter's
+ * records: (mass, momentum x), (momentum y, unused), (force x, force y). */
+struct mpm_node_rec {
+    v2d mpx, py, f;
+};
+
 enum { T_STENCIL, T_P2G, T_NORMALS, T_GRID, T_CONTACT, T_G2P, T_REMAP, T_MATERIAL, T_CHECK };
 const char *const mpm_stage_names[MPM_NSTAGES] = {"stencil", "p2g",   "normals",  "grid", "contact",
                                                   "g2p",     "remap", "material", "check"};
@@ -149,9 +155,7 @@ static core_status contact_scratch(mpm_scene *s, core_error *err)
 static core_status threads_setup(mpm_scene *s, core_error *err)
 {
     const int nt = clamp_count(s, threads_get());
-    const int nc = s->contact == MPM_CONTACT_FRICTION
-                       ? 1
-                       : clamp_count(s, threads_max());
+    const int nc = s->contact == MPM_CONTACT_FRICTION ? 1 : clamp_count(s, threads_max());
     if (nc > s->nccap || !s->cp) {
         size_t *a = realloc(s->cp, (size_t)(nc + 1) * sizeof *a);
         if (!a)
@@ -159,7 +163,10 @@ static core_status threads_setup(mpm_scene *s, core_error *err)
         s->cp = a;
         free(s->tbuf);
         s->tbuf = nc > 1 ? malloc((size_t)(nc - 1) * 5 * s->nnodes * sizeof *s->tbuf) : NULL;
-        if (nc > 1 && !s->tbuf)
+        free(s->nrec);
+        const size_t bytes = (size_t)nc * s->nnodes * sizeof *s->nrec;
+        s->nrec = aligned_alloc(64, (bytes + 63) / 64 * 64);
+        if ((nc > 1 && !s->tbuf) || !s->nrec)
             return core_fail(err, CORE_ERR_NOMEM, "out of memory for %d chunks", nc);
         s->nccap = nc;
     }
@@ -410,28 +417,53 @@ static void moments(mpm_scene *s)
         }
 }
 
-/* Step 1: lumped mass (Eq. 6), momentum (Eq. 5), internal force (Eq. 7, m_p / rho_p = V_p) and
- * gravity m_i g, for points [pa, pb) into the five nodal arrays f[0..4] (mass, momentum x, y,
- * force x, y). */
-static void to_grid_range(const mpm_scene *s, size_t pa, size_t pb, double *const f[5])
+/* The factors of the transfer's sums for points [p0, p1) into fac[0 .. p1 - p0): m, m v, m g and
+ * sigma V (Eq. 7, m_p / rho_p = V_p), paired for the lanes. A pass of its own: with the
+ * scatter in the same loop, its dozen arrays and the scatter's spill the registers. */
+static inline __attribute__((always_inline)) void
+point_factors(const mpm_scene *s, size_t p0, size_t p1, struct mpm_point_fac *fac)
 {
-    double *nm = f[0], *npx = f[1], *npy = f[2], *nfx = f[3], *nfy = f[4];
-    const double gx0 = s->def.gravity[0], gy0 = s->def.gravity[1];
-    const int ns = s->ns;
-    for (size_t p = pa; p < pb; p++) {
-        const double m = s->m[p], px = m * s->vx[p], py = m * s->vy[p];
-        const double V = s->v0[p] * (s->F[0][p] * s->F[3][p] - s->F[1][p] * s->F[2][p]);
-        const double sxx = V * s->sig[0][p], syy = V * s->sig[1][p], sxy = V * s->sig[2][p];
-        const double fgx = m * gx0, fgy = m * gy0;
-        const int *n = &s->sn[ns * p];
-        const double *w = &s->sw[ns * p], *gx = &s->sgx[ns * p], *gy = &s->sgy[ns * p];
-        for (int k = 0; k < ns; k++) {
-            const int i = n[k];
-            nm[i] += w[k] * m;
-            npx[i] += w[k] * px;
-            npy[i] += w[k] * py;
-            nfx[i] += w[k] * fgx - (sxx * gx[k] + sxy * gy[k]);
-            nfy[i] += w[k] * fgy - (sxy * gx[k] + syy * gy[k]);
+    const v2d grav = {s->def.gravity[0], s->def.gravity[1]};
+    const double *const xm = s->m, *const vx = s->vx, *const vy = s->vy, *const v0 = s->v0;
+    const double *const F0 = s->F[0], *const F1 = s->F[1], *const F2 = s->F[2], *const F3 = s->F[3];
+    const double *const s0 = s->sig[0], *const s1 = s->sig[1], *const s2 = s->sig[2];
+    for (size_t p = p0; p < p1; p++) {
+        const double m = xm[p], px = m * vx[p], py = m * vy[p];
+        const double V = v0[p] * (F0[p] * F3[p] - F1[p] * F2[p]);
+        const double sxx = V * s0[p], syy = V * s1[p], sxy = V * s2[p];
+        /* the lanes: m w, p_x w | p_y w, V w | w m g - sigma V G (Eq. 7) */
+        fac[p - p0] = (struct mpm_point_fac){.mpx = {m, px},
+                                             .pyv = {py, V},
+                                             .fg = {m * grav[0], m * grav[1]},
+                                             .sa = {sxx, sxy},
+                                             .sb = {sxy, syy}};
+    }
+}
+
+/* Step 1: lumped mass (Eq. 6), momentum (Eq. 5), internal force (Eq. 7) and gravity m_i g, for
+ * points [pa, pb) into the node records r, in blocks whose factors are computed first; each
+ * lane's sums are the scalar ones in point order. */
+enum { TG_BLOCK = 128 }; /* 10 kB of factors */
+static inline __attribute__((always_inline)) void
+to_grid_range(const mpm_scene *s, size_t pa, size_t pb, struct mpm_node_rec *r, const int ns)
+{
+    struct mpm_point_fac fac[TG_BLOCK];
+    const int *const sn = s->sn;
+    const double *const sw = s->sw, *const sgx = s->sgx, *const sgy = s->sgy;
+    for (size_t b0 = pa; b0 < pb; b0 += TG_BLOCK) {
+        const size_t b1 = pb - b0 < TG_BLOCK ? pb : b0 + TG_BLOCK;
+        point_factors(s, b0, b1, fac);
+        for (size_t p = b0; p < b1; p++) {
+            const struct mpm_point_fac *const f = &fac[p - b0];
+            const int *n = &sn[ns * p];
+            const double *w = &sw[ns * p], *gx = &sgx[ns * p], *gy = &sgy[ns * p];
+            for (int k = 0; k < ns; k++) {
+                const v2d wk = {w[k], w[k]}, gxk = {gx[k], gx[k]}, gyk = {gy[k], gy[k]};
+                struct mpm_node_rec *const e = &r[n[k]];
+                e->mpx += wk * f->mpx;
+                e->py[0] += w[k] * f->pyv[0];
+                e->f += wk * f->fg - (f->sa * gxk + f->sb * gyk);
+            }
         }
     }
 }
@@ -459,18 +491,38 @@ static void reduce_buffers(mpm_scene *s, double *const main[], int n)
 }
 
 /* The centre-of-mass transfer (noslip), inside the parallel region: thread t scatters its chunks'
- * points into their arrays, then they are added up. */
+ * points into their node records, then the records are added up in chunk order into the nodal
+ * arrays (the same sums as chunk 0 into the arrays and the others added to them). */
 static void to_grid(mpm_scene *s, int t)
 {
-    double *const main[5] = {s->nm, s->npx, s->npy, s->nfx, s->nfy};
+    const size_t nn = s->nnodes;
     for (int c = t; c < s->nc; c += s->nt) {
-        double *f[5];
-        chunk_arrays(s, c, main, 5, f);
-        for (int k = 0; k < 5; k++)
-            memset(f[k], 0, s->nnodes * sizeof(double));
-        to_grid_range(s, s->cp[c], s->cp[c + 1], f);
+        struct mpm_node_rec *const r = s->nrec + (size_t)c * nn;
+        memset(r, 0, nn * sizeof *r);
+        if (s->ns == 4)
+            to_grid_range(s, s->cp[c], s->cp[c + 1], r, 4);
+        else
+            to_grid_range(s, s->cp[c], s->cp[c + 1], r, s->ns);
     }
-    reduce_buffers(s, main, 5);
+    const struct mpm_node_rec *const rec = s->nrec;
+    const int nc = s->nc;
+    double *const nm = s->nm, *const npx = s->npx, *const npy = s->npy, *const nfx = s->nfx,
+                  *const nfy = s->nfy;
+#pragma omp barrier
+#pragma omp for schedule(static)
+    for (size_t i = 0; i < nn; i++) {
+        v2d mpx = rec[i].mpx, py = rec[i].py, f = rec[i].f;
+        for (int c = 1; c < nc; c++) {
+            mpx += rec[(size_t)c * nn + i].mpx;
+            py += rec[(size_t)c * nn + i].py;
+            f += rec[(size_t)c * nn + i].f;
+        }
+        nm[i] = mpx[0];
+        npx[i] = mpx[1];
+        npy[i] = py[0];
+        nfx[i] = f[0];
+        nfy[i] = f[1];
+    }
 }
 
 /* The wall rule of plane pl on one nodal velocity, relative to the wall's velocity. For a
@@ -585,7 +637,6 @@ static inline __attribute__((always_inline)) void
 grain_scatter_with(mpm_scene *s, int t, const int ns, const bool volumes, const bool spline_normals)
 {
     const size_t nn = s->nnodes;
-    const double gx0 = s->def.gravity[0], gy0 = s->def.gravity[1];
     int *const mark = s->tmark + (size_t)t * (nn + 1);
     struct mpm_pair_rec *const rec = s->trec + (size_t)t * (s->reccap + 1) + 1;
     const size_t base = (size_t)ns * s->tp[t];
@@ -595,10 +646,6 @@ grain_scatter_with(mpm_scene *s, int t, const int ns, const bool volumes, const 
     double *const pfx = s->nfx + nn, *const pfy = s->nfy + nn;
     double *const pnx = s->pnx, *const pny = s->pny, *const pvol = s->pvol;
     int *const pnode = s->pnode, *const pgrain = s->pgrain;
-    const double *const xm = s->m, *const vx = s->vx, *const vy = s->vy, *const v0 = s->v0;
-    const double *const F0 = s->F[0], *const F1 = s->F[1], *const F2 = s->F[2], *const F3 = s->F[3];
-    const double *const s0 = s->sig[0], *const s1 = s->sig[1], *const s2 = s->sig[2];
-    const v2d grav = {gx0, gy0};
     struct mpm_point_fac *const fac = s->tfac + (size_t)t * s->faccap;
     size_t q = base;
     for (size_t g = s->tg[t]; g < s->tg[t + 1]; g++) {
@@ -606,17 +653,7 @@ grain_scatter_with(mpm_scene *s, int t, const int ns, const bool volumes, const 
         /* three passes over the grain's points (in cache), each with few live pointers: the
          * stencils, each point's factors, the sums */
         stencil_range(s, p0, p1, ns);
-        for (size_t p = p0; p < p1; p++) {
-            const double m = xm[p], px = m * vx[p], py = m * vy[p];
-            const double V = v0[p] * (F0[p] * F3[p] - F1[p] * F2[p]);
-            const double sxx = V * s0[p], syy = V * s1[p], sxy = V * s2[p];
-            /* the lanes: m w, p_x w | p_y w, V w | w m g - sigma V G (Eq. 7) */
-            fac[p - p0] = (struct mpm_point_fac){.mpx = {m, px},
-                                                 .pyv = {py, V},
-                                                 .fg = {m * grav[0], m * grav[1]},
-                                                 .sa = {sxx, sxy},
-                                                 .sb = {sxy, syy}};
-        }
+        point_factors(s, p0, p1, fac);
         int nr = 0; /* the grain's pairs so far: records [0, nr), pairs q .. q + nr - 1 */
         s->gps[g] = q - base;
         for (size_t p = p0; p < p1; p++) {
@@ -1344,9 +1381,9 @@ STAGE static void nodal_velocity(mpm_scene *s, double dt, bool decide, bool sums
 }
 
 /* scatter_sf_with's points [pa, pb) into the arrays f[0], f[1]. */
-static inline __attribute__((always_inline)) void
-scatter_sf_range(const mpm_scene *s, size_t pa, size_t pb, double *const f[2], bool force,
-                 const int ns)
+static inline __attribute__((always_inline)) void scatter_sf_range(const mpm_scene *s, size_t pa,
+                                                                   size_t pb, double *const f[2],
+                                                                   bool force, const int ns)
 {
     const double gx0 = s->def.gravity[0], gy0 = s->def.gravity[1];
     for (size_t p = pa; p < pb; p++) {
