@@ -1106,9 +1106,9 @@ static inline void pair_rule(mpm_scene *s, size_t i, size_t q, double *vx, doubl
  * order (the node's chain, pair_rule); then (option conserve) the momentum the corrections
  * changed at the node (non-zero with three or more grains, or with the cap) is taken back evenly
  * from the corrected grains there, a common velocity shift that leaves their relative motion as
- * the rule made it. Node by node, by the thread whose static share of the nodes holds i: the
- * rule reads only the node's own entries, so no barrier separates it from the node's velocity,
- * and the momentum sums need no pass of their own. */
+ * the rule made it. Node by node, by whichever thread takes the node (shared_node): the rule
+ * reads only the node's entry and its pairs', which that thread has just set, so no barrier
+ * separates it from the velocities, and the momentum sums need no pass of their own. */
 static inline void contact_node(mpm_scene *s, size_t i, double *vx, double *vy, bool decide,
                                 const contact_rule *c, const pair_sums *ps)
 {
@@ -1149,7 +1149,8 @@ static inline void velocity_entry(mpm_scene *s, size_t i)
 
 /* The nodes of the contact loops per dynamic chunk: a node's work is its own (the same bits
  * whichever thread takes it), and the shared nodes are not evenly spread over the grid (on the
- * shear the second half of the nodes held 1.3 times the first's contact work). */
+ * shear a static split left the second half of the nodes 1.25 times the first's contact work, in
+ * instructions). */
 enum { NODE_CHUNK = 256 };
 
 /* Shared node i (every thread's scatter done): with a, b (not NULL), the node's entry of those
