@@ -1050,16 +1050,17 @@ static inline contact_rule rule_of(const mpm_scene *s, double dt)
  * centre-of-mass field along its normal) and the separation check mark the pair in contact for
  * this step; without, the marks of the momentum update are reused (see nodal_velocity). A marked
  * pair gets the normal correction (Eq. 14) and Coulomb friction (Eqs. 18-23), capped by the
- * strain cap; *cx, *cy: the correction (0 without). */
-static inline void pair_rule(mpm_scene *s, size_t i, size_t q, double *vx, double *vy, bool decide,
+ * strain cap; *cx, *cy: the correction (0 without). Returns the pair's mark, which the caller
+ * stores (one byte store per pair: after a store through a char pointer the compiler reloads
+ * every field of the scene). */
+static inline bool pair_rule(mpm_scene *s, size_t i, size_t q, double *vx, double *vy, bool decide,
                              const contact_rule *c, const pair_sums *ps, double *cx, double *cy)
 {
     const size_t e = s->nnodes + q;
     *cx = *cy = 0;
-    if (decide)
-        s->pin[q] = 0;
+    bool in = !decide; /* without decide, only marked pairs come here */
     if (!(s->nm[e] > 0))
-        return;
+        return in;
     double gx = s->pnx[q], gy = s->pny[q];
     if (!c->own) {
         /* The grain's mass gradient against that of everything else at the node,
@@ -1070,14 +1071,14 @@ static inline void pair_rule(mpm_scene *s, size_t i, size_t q, double *vx, doubl
     }
     const double len = sqrt(gx * gx + gy * gy);
     if (!(len > 0))
-        return;
+        return in;
     const double nx = gx / len, ny = gy / len;
     const double dvx = vx[e] - vx[i], dvy = vy[e] - vy[i];
     const double dn = dvx * nx + dvy * ny;
     if (decide)
-        s->pin[q] = dn > 0 && !(c->sep > 0 && ps->vol < c->sep); /* Eq. 12, separation */
-    if (!s->pin[q])
-        return;
+        in = dn > 0 && !(c->sep > 0 && ps->vol < c->sep); /* Eq. 12, separation */
+    if (!in)
+        return false;
     const double tx = dvx - dn * nx, ty = dvy - dn * ny, t = sqrt(tx * tx + ty * ty);
     /* Eq. 14: the normal velocity becomes the centre-of-mass one (the force of Eq. 15);
      * Eqs. 18-23: sticking would remove the whole relative tangential velocity t (Eq. 18);
@@ -1100,6 +1101,7 @@ static inline void pair_rule(mpm_scene *s, size_t i, size_t q, double *vx, doubl
     vy[e] += uy;
     *cx = ux;
     *cy = uy;
+    return true;
 }
 
 /* The contact rule at shared node i (its velocity and its pairs' are final): each pair in pair
@@ -1120,8 +1122,10 @@ static inline void contact_node(mpm_scene *s, size_t i, double *vx, double *vy, 
         if (!decide && !s->pin[q])
             continue; /* the momentum update left it out of contact */
         double cx, cy;
-        pair_rule(s, i, q, vx, vy, decide, c, ps, &cx, &cy);
-        if (c->conserve && s->pin[q]) {
+        const bool in = pair_rule(s, i, q, vx, vy, decide, c, ps, &cx, &cy);
+        if (decide)
+            s->pin[q] = in;
+        if (c->conserve && in) {
             const double mr = s->nm[nn + q];
             px += mr * cx;
             py += mr * cy;
@@ -1206,9 +1210,10 @@ STAGE static void contact_update(mpm_scene *s, double dt)
     /* USF: the forces were scattered from the new stress (scatter_sf), their sums are due */
     double *const a = s->def.update == MPM_USF ? s->nfx : NULL;
     double *const b = s->def.update == MPM_USF ? s->nfy : NULL;
+    const int *const ngr = s->ngr; /* a local: the stores below could alias the scene */
 #pragma omp for schedule(dynamic, NODE_CHUNK) nowait
     for (size_t i = 0; i < s->nnodes; i++)
-        if (s->ngr[i] > 1)
+        if (ngr[i] > 1)
             shared_node(s, i, dt, true, true, a, b, &c);
 #pragma omp barrier
 }
@@ -1368,9 +1373,10 @@ STAGE static void nodal_velocity(mpm_scene *s, double dt, bool decide, bool sums
     /* Node by node (the nodes no point reaches are never read; shared_node), then the barrier:
      * the points read their entries next */
     const contact_rule c = rule_of(s, dt);
+    const int *const ngr = s->ngr; /* a local: the stores below could alias the scene */
 #pragma omp for schedule(dynamic, NODE_CHUNK) nowait
     for (size_t i = 0; i < nn; i++) {
-        const int n = s->ngr[i];
+        const int n = ngr[i];
         if (n > 1) {
             shared_node(s, i, dt, false, decide, sums ? s->npx : NULL, sums ? s->npy : NULL, &c);
         } else if (n) {
