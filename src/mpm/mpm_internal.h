@@ -86,9 +86,6 @@ struct mpm_scene {
     unsigned char *pin;     /* pair q in contact this step (Eq. 12 at the momentum update) */
     unsigned char *pwin;    /* pair q: bit k, friction plane k in contact (as nwin) */
     double *pvol;           /* sum_p N_ip V_p over the grain (the separation check) */
-    double *pcx, *pcy;      /* scratch: the contact correction of pair q this call */
-    double *tvol;           /* the same over all grains (nnodes) */
-    double *ndp;            /* scratch (3 nnodes): momentum change of the corrections at a node */
     mpm_contact_options opt;
     double *pnx, *pny;      /* sum_p m_p G_pi over the grain: its outward normal direction */
     int *ngr;               /* grains touching node i (nnodes) */
@@ -98,11 +95,6 @@ struct mpm_scene {
      * chain, each over its own range of nodes, so that no pass over all pairs is serial. */
     int *nhead, *pnext;
     unsigned char *pshared;
-    /* The pairs at shared nodes in pair order, thread t's (tsh[t] of them) at slist[tq[t]...]:
-     * the contact loops split this list evenly (the shared nodes are not evenly spread over the
-     * threads' grains). */
-    int *slist;
-    double *tgx, *tgy;      /* sum_p m_p G_pi over all grains (nnodes) */
     int *sv;                /* ns per point: the friction sf */
 
     mpm_material *mats;
@@ -117,7 +109,7 @@ struct mpm_scene {
      * tc[t]) with tq[t] = ns tp[t], in grain order, gaps between the threads' ranges;
      * per-thread scratch: marks (nt x nnodes) */
     int nt, ntcap;
-    size_t *tp, *tg, *tq, *tc, *tsh;
+    size_t *tp, *tg, *tq, *tc;
     int *tmark;             /* nt x (nnodes + 1), the last of each -1 */
     unsigned char *tnear;   /* nt x nnodes, zero outside grain_finish */
     /* per-thread scratch of the frictional scatter: one record per (grain, node) pair of the

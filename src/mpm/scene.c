@@ -244,22 +244,15 @@ void mpm_destroy(mpm_scene *s)
     free(s->nforce);
     free(s->pwin);
     free(s->pvol);
-    free(s->pcx);
-    free(s->pcy);
-    free(s->tvol);
-    free(s->ndp);
     free(s->pnode);
     free(s->pgrain);
     free(s->pin);
-    free(s->tgx);
-    free(s->tgy);
     free(s->pnx);
     free(s->pny);
     free(s->ngr);
     free(s->nhead);
     free(s->pnext);
     free(s->pshared);
-    free(s->slist);
     free(s->sv);
     core_free_staggered(s->grain, STAGGER_INT);
     core_free_staggered(s->mat, STAGGER_INT + 1);
@@ -272,7 +265,6 @@ void mpm_destroy(mpm_scene *s)
     free(s->tg);
     free(s->tq);
     free(s->tc);
-    free(s->tsh);
     free(s->tmark);
     free(s->trec);
     free(s->tfin);
@@ -629,14 +621,9 @@ core_status mpm_contact_reserve(mpm_scene *s, core_error *err)
     if (need + nn > (size_t)INT_MAX)
         return core_fail(err, CORE_ERR_NOMEM, "%zu points are too many for the contact fields",
                          s->np);
-    if (!s->ndp) {
+    if (!s->nhead) {
         GROW(s->ngr, nn);
         GROW(s->nhead, nn);
-        GROW(s->tgx, nn);
-        GROW(s->tgy, nn);
-        GROW(s->tvol, nn);
-        const size_t nn3 = 3 * nn;
-        GROW(s->ndp, nn3);
     }
     if (need <= s->paircap && s->sv)
         return CORE_OK;
@@ -654,13 +641,10 @@ core_status mpm_contact_reserve(mpm_scene *s, core_error *err)
     GROW(s->pin, need);
     GROW(s->pwin, need);
     GROW(s->pvol, need);
-    GROW(s->pcx, need);
-    GROW(s->pcy, need);
     GROW(s->pnx, need);
     GROW(s->pny, need);
     GROW(s->pnext, need);
     GROW(s->pshared, need);
-    GROW(s->slist, need);
     GROW(s->sv, need);
     s->paircap = need;
     return CORE_OK;

@@ -173,8 +173,8 @@ static core_status threads_setup(mpm_scene *s, core_error *err)
     s->nc = nc;
     grain_ranges(s, nc, s->cp, NULL);
     if (nt > s->ntcap || !s->tp) {
-        size_t **ranges[5] = {&s->tp, &s->tg, &s->tq, &s->tc, &s->tsh};
-        for (int r = 0; r < 5; r++) {
+        size_t **ranges[4] = {&s->tp, &s->tg, &s->tq, &s->tc};
+        for (int r = 0; r < 4; r++) {
             size_t *a = realloc(*ranges[r], (size_t)(nt + 1) * sizeof *a);
             if (!a)
                 return core_fail(err, CORE_ERR_NOMEM, "out of memory for %d threads", nt);
@@ -622,10 +622,10 @@ static inline void pair_walls(mpm_scene *s, double *vx, double *vy, size_t q, bo
  * transfer is needed. pnx, pny hold the gradient of the grain's mass field at the node, outward:
  * sum_p m_p grad N_i(x_p) over the grain, with the transfer's shape functions or (normals
  * 'averaged' and 'own' with linear transfers) with quadratic B-splines (Eq. 24), read at shared
- * nodes only. tgx, tgy at a shared node: the sum
- * of its grains' gradients, so that 2 g - g_all of two grains are exactly opposite. A point moves
- * with its grain's field at nodes shared by two or more grains and with the centre-of-mass node
- * elsewhere, so an isolated grain evolves exactly as with noslip.
+ * nodes only (the contact rule sums a shared
+ * node's gradients along its chain, so that 2 g - g_all of two grains are exactly opposite). A
+ * point moves with its grain's field at nodes shared by two or more grains and with the
+ * centre-of-mass node elsewhere, so an isolated grain evolves exactly as with noslip.
  *
  * Inside the parallel region; thread t takes its grains. Their pairs are written from tq[t] =
  * ns tp[t] (a grain has at most ns pairs per point) and stay there. A grain's
@@ -797,21 +797,15 @@ STAGE static void node_sums(mpm_scene *s)
     }
 }
 
-/* Thread t's marks back to -1 (after node_sums), pshared of its pairs and its part of the list
- * of shared pairs. */
+/* Thread t's marks back to -1 (after node_sums) and pshared of its pairs. */
 STAGE static void pair_kinds(mpm_scene *s, int t)
 {
     int *const mark = s->tmark + (size_t)t * (s->nnodes + 1);
-    int *const list = s->slist + s->tq[t];
-    size_t n = 0;
     for (size_t q = s->tq[t]; q < pairs_end(s, t); q++) {
         const int i = s->pnode[q];
         mark[i] = -1;
         s->pshared[q] = s->ngr[i] > 1;
-        if (s->ngr[i] > 1)
-            list[n++] = (int)q;
     }
-    s->tsh[t] = n;
 }
 
 /* Sets (v = 1) or clears (v = 0) near[] at the B-spline base nodes of the points whose 3 x 3
@@ -953,25 +947,6 @@ STAGE static void grain_finish(mpm_scene *s, int t)
         grain_finish_with(s, t, false);
 }
 
-/* At shared nodes: the sum of the grains' gradients and nodal volumes, in pair order. */
-STAGE static void grain_sums(mpm_scene *s)
-{
-#pragma omp for schedule(static) nowait
-    for (size_t i = 0; i < s->nnodes; i++) {
-        if (s->ngr[i] < 2)
-            continue;
-        double gx = 0, gy = 0, v = 0;
-        for (int r = s->nhead[i]; r >= 0; r = s->pnext[r]) {
-            gx += s->pnx[r];
-            gy += s->pny[r];
-            v += s->pvol[r];
-        }
-        s->tgx[i] = gx;
-        s->tgy[i] = gy;
-        s->tvol[i] = v;
-    }
-}
-
 /* Inside the parallel region: the stages above with the barriers between them; *tlp is thread
  * 0's last clock reading (STAGE_DONE). */
 static void grain_fields(mpm_scene *s, int t, double *tlp)
@@ -985,7 +960,6 @@ static void grain_fields(mpm_scene *s, int t, double *tlp)
     STAGE_DONE(T_P2G);
     grain_finish(s, t);
 #pragma omp barrier
-    grain_sums(s); /* no barrier: the contact rule is the first reader, after barriers */
     *tlp = tl;
 }
 
