@@ -121,14 +121,15 @@ struct mpm_scene {
     size_t faccap;
     size_t *gps, *gpc, gpcap; /* grain g's pairs: gpc[g] from tq[its thread] + gps[g] */
     /* The noslip transfers' chunks: nc grain-aligned point ranges [cp[c], cp[c+1]); thread t
-     * scatters chunks t, t + nt, ... each into its own node arrays (chunk 0: the scene's, chunk c
-     * > 0: tbuf's (c - 1)-th 5 x nnodes block), added up in chunk order. nc is the processor
-     * count in auto mode whatever the thread count of the moment (so the tuner may run a noslip
-     * step on one thread: the same bits), else the thread count. */
+     * scatters chunks t, t + nt, ... each into its own node records (to_grid: nrec, nnodes per
+     * chunk; the remap and USF: tbuf, x and y per node, 2 nnodes doubles per chunk), added up in
+     * chunk order into the nodal arrays. nc is the processor count in auto mode whatever the
+     * thread count of the moment (so the tuner may run a noslip step on one thread: the same
+     * bits), else the thread count. */
     int nc, nccap;
     size_t *cp;
     double *tbuf;
-    struct mpm_node_rec *nrec; /* nc x nnodes: the chunks' node sums of to_grid */
+    struct mpm_node_rec *nrec;
 
     mpm_contact_model contact;
     double time;

@@ -162,11 +162,11 @@ static core_status threads_setup(mpm_scene *s, core_error *err)
             return core_fail(err, CORE_ERR_NOMEM, "out of memory for %d chunks", nc);
         s->cp = a;
         free(s->tbuf);
-        s->tbuf = nc > 1 ? malloc((size_t)(nc - 1) * 5 * s->nnodes * sizeof *s->tbuf) : NULL;
+        s->tbuf = malloc((size_t)nc * 2 * s->nnodes * sizeof *s->tbuf);
         free(s->nrec);
         const size_t bytes = (size_t)nc * s->nnodes * sizeof *s->nrec;
         s->nrec = aligned_alloc(64, (bytes + 63) / 64 * 64);
-        if ((nc > 1 && !s->tbuf) || !s->nrec)
+        if (!s->tbuf || !s->nrec)
             return core_fail(err, CORE_ERR_NOMEM, "out of memory for %d chunks", nc);
         s->nccap = nc;
     }
@@ -466,28 +466,6 @@ to_grid_range(const mpm_scene *s, size_t pa, size_t pb, struct mpm_node_rec *r, 
             }
         }
     }
-}
-
-/* The nodal arrays of noslip chunk c: the scene's for c = 0, else its buffer (n arrays of nn). */
-static void chunk_arrays(mpm_scene *s, int c, double *const main[], int n, double *out[])
-{
-    for (int k = 0; k < n; k++)
-        out[k] = c == 0 ? main[k] : s->tbuf + ((size_t)(c - 1) * 5 + (size_t)k) * s->nnodes;
-}
-
-/* Adds the chunks' buffers to the nodal arrays, in chunk order (inside the parallel region,
- * after every chunk has been scattered): node by node the same sums on any thread count. */
-static void reduce_buffers(mpm_scene *s, double *const main[], int n)
-{
-    if (s->nc == 1)
-        return;
-    const size_t nn = s->nnodes;
-#pragma omp barrier
-#pragma omp for schedule(static)
-    for (size_t i = 0; i < nn; i++)
-        for (int u = 1; u < s->nc; u++)
-            for (int k = 0; k < n; k++)
-                main[k][i] += s->tbuf[((size_t)(u - 1) * 5 + (size_t)k) * nn + i];
 }
 
 /* The centre-of-mass transfer (noslip), inside the parallel region: thread t scatters its chunks'
@@ -1392,6 +1370,40 @@ static inline __attribute__((always_inline)) void scatter_sf_range(const mpm_sce
     }
 }
 
+/* scatter_sf_range for noslip chunks: points [pa, pb) into the node records r (x and y in the
+ * lanes of r[2 i], r[2 i + 1]), each lane's operations those of scatter_sf_range in its order. */
+static inline __attribute__((always_inline)) void
+scatter_lanes_range(const mpm_scene *s, size_t pa, size_t pb, double *r, bool force, const int ns)
+{
+    const double gx0 = s->def.gravity[0], gy0 = s->def.gravity[1];
+    const int *const sf = s->sf;
+    const double *const sw = s->sw, *const sgx = s->sgx, *const sgy = s->sgy;
+    const double *const xm = s->m, *const vx = s->vx, *const vy = s->vy;
+    for (size_t p = pa; p < pb; p++) {
+        const double m = xm[p];
+        v2d AB = {m * vx[p], m * vy[p]}, sa = {0, 0}, sb = {0, 0};
+        if (force) {
+            const double V = s->v0[p] * (s->F[0][p] * s->F[3][p] - s->F[1][p] * s->F[2][p]);
+            const double sxx = V * s->sig[0][p], syy = V * s->sig[1][p], sxy = V * s->sig[2][p];
+            AB = (v2d){m * gx0, m * gy0};
+            sa = (v2d){sxx, sxy};
+            sb = (v2d){sxy, syy};
+        }
+        const int *n = &sf[ns * p];
+        const double *w = &sw[ns * p], *gx = &sgx[ns * p], *gy = &sgy[ns * p];
+        for (int k = 0; k < ns; k++) {
+            double *const e = &r[2 * (size_t)n[k]];
+            v2_store(e, v2_load(e) + (v2d){w[k], w[k]} * AB);
+        }
+        if (force)
+            for (int k = 0; k < ns; k++) {
+                double *const e = &r[2 * (size_t)n[k]];
+                const v2d gxk = {gx[k], gx[k]}, gyk = {gy[k], gy[k]};
+                v2_store(e, v2_load(e) - (sa * gxk + sb * gyk));
+            }
+    }
+}
+
 /* Scatters a per-point vector into the entries each point feeds (sf: its grain's entry at shared
  * nodes, the centre of mass elsewhere) of the arrays a, b: momentum m_p v_p (force = false; the
  * noslip remap) or the internal force and gravity (Eq. 7) from the current stress (force = true;
@@ -1405,14 +1417,24 @@ scatter_sf_with(mpm_scene *s, int t, double *a, double *b, bool force, const int
     const size_t nn = s->nnodes;
     double *const main[2] = {a, b};
     if (s->contact != MPM_CONTACT_FRICTION) {
+        /* by chunks, each into its x, y lanes per node (tbuf), added up in chunk order as
+         * to_grid does */
         for (int c = t; c < s->nc; c += s->nt) {
-            double *f[2];
-            chunk_arrays(s, c, main, 2, f);
-            memset(f[0], 0, nn * sizeof(double));
-            memset(f[1], 0, nn * sizeof(double));
-            scatter_sf_range(s, s->cp[c], s->cp[c + 1], f, force, ns);
+            double *const r = s->tbuf + (size_t)c * 2 * nn;
+            memset(r, 0, 2 * nn * sizeof *r);
+            scatter_lanes_range(s, s->cp[c], s->cp[c + 1], r, force, ns);
         }
-        reduce_buffers(s, main, 2);
+        const double *const r = s->tbuf;
+        const int nc = s->nc;
+#pragma omp barrier
+#pragma omp for schedule(static)
+        for (size_t i = 0; i < nn; i++) {
+            v2d v = v2_load(&r[2 * i]);
+            for (int c = 1; c < nc; c++)
+                v += v2_load(&r[2 * ((size_t)c * nn + i)]);
+            a[i] = v[0];
+            b[i] = v[1];
+        }
         return;
     }
     zero_own(s, t, a, b);
