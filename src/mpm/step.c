@@ -1214,7 +1214,7 @@ static void zero_own(mpm_scene *s, int t, double *a, double *b)
 }
 
 /* The momenta m_p v_p of points [pa, pb) into the entries they feed, in point order and each
- * point's in stencil order: the MUSL remap's Eq. 5, as scatter_sf_range adds them. */
+ * point's in stencil order: the MUSL remap's Eq. 5. */
 static inline __attribute__((always_inline)) void
 momenta_into(const int *restrict sf, const double *restrict sw, const double *restrict xm,
              const double *restrict vx, const double *restrict vy, size_t pa, size_t pb,
@@ -1339,39 +1339,34 @@ STAGE static void nodal_velocity(mpm_scene *s, double dt, bool decide, bool sums
 #pragma omp barrier
 }
 
-/* scatter_sf_with's points [pa, pb) into the arrays f[0], f[1]. */
-static inline __attribute__((always_inline)) void scatter_sf_range(const mpm_scene *s, size_t pa,
-                                                                   size_t pb, double *const f[2],
-                                                                   bool force, const int ns)
+/* The internal force and gravity (Eq. 7) of points [pa, pb) from their current stress into the
+ * entries they feed (sf) of fx, fy, in point order: each point's m g w first, then its stress
+ * terms (USF with friction; the noslip chunks' lanes do the same per lane). */
+static inline __attribute__((always_inline)) void
+forces_into(const mpm_scene *s, size_t pa, size_t pb, double *fx, double *fy, const int ns)
 {
     const double gx0 = s->def.gravity[0], gy0 = s->def.gravity[1];
     for (size_t p = pa; p < pb; p++) {
         const double m = s->m[p];
-        double A = m * s->vx[p], B = m * s->vy[p], sxx = 0, syy = 0, sxy = 0;
-        if (force) {
-            const double V = s->v0[p] * (s->F[0][p] * s->F[3][p] - s->F[1][p] * s->F[2][p]);
-            A = m * gx0;
-            B = m * gy0;
-            sxx = V * s->sig[0][p];
-            syy = V * s->sig[1][p];
-            sxy = V * s->sig[2][p];
-        }
+        const double V = s->v0[p] * (s->F[0][p] * s->F[3][p] - s->F[1][p] * s->F[2][p]);
+        const double A = m * gx0, B = m * gy0;
+        const double sxx = V * s->sig[0][p], syy = V * s->sig[1][p], sxy = V * s->sig[2][p];
         const int *n = &s->sf[ns * p];
         const double *w = &s->sw[ns * p], *gx = &s->sgx[ns * p], *gy = &s->sgy[ns * p];
         for (int k = 0; k < ns; k++) {
-            f[0][n[k]] += w[k] * A;
-            f[1][n[k]] += w[k] * B;
+            fx[n[k]] += w[k] * A;
+            fy[n[k]] += w[k] * B;
         }
-        if (force)
-            for (int k = 0; k < ns; k++) {
-                f[0][n[k]] -= sxx * gx[k] + sxy * gy[k];
-                f[1][n[k]] -= sxy * gx[k] + syy * gy[k];
-            }
+        for (int k = 0; k < ns; k++) {
+            fx[n[k]] -= sxx * gx[k] + sxy * gy[k];
+            fy[n[k]] -= sxy * gx[k] + syy * gy[k];
+        }
     }
 }
 
-/* scatter_sf_range for noslip chunks: points [pa, pb) into the node records r (x and y in the
- * lanes of r[2 i], r[2 i + 1]), each lane's operations those of scatter_sf_range in its order. */
+/* Points [pa, pb) of a noslip chunk into its node records r (x and y in the lanes of r[2 i],
+ * r[2 i + 1]): momenta (as momenta_into) or forces (as forces_into), each lane's operations
+ * theirs in their order. */
 static inline __attribute__((always_inline)) void
 scatter_lanes_range(const mpm_scene *s, size_t pa, size_t pb, double *r, bool force, const int ns)
 {
@@ -1415,7 +1410,6 @@ static inline __attribute__((always_inline)) void
 scatter_sf_with(mpm_scene *s, int t, double *a, double *b, bool force, const int ns)
 {
     const size_t nn = s->nnodes;
-    double *const main[2] = {a, b};
     if (s->contact != MPM_CONTACT_FRICTION) {
         /* by chunks, each into its x, y lanes per node (tbuf), added up in chunk order as
          * to_grid does */
@@ -1438,7 +1432,10 @@ scatter_sf_with(mpm_scene *s, int t, double *a, double *b, bool force, const int
         return;
     }
     zero_own(s, t, a, b);
-    scatter_sf_range(s, s->tp[t], s->tp[t + 1], main, force, ns);
+    if (force)
+        forces_into(s, s->tp[t], s->tp[t + 1], a, b, ns);
+    else
+        momenta_into(s->sf, s->sw, s->m, s->vx, s->vy, s->tp[t], s->tp[t + 1], ns, a, b);
 #pragma omp barrier
 }
 
