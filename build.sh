@@ -2,7 +2,9 @@
 # One entry point for a fresh Debian 12 machine: install what grainlab needs, build, then
 #   ./build.sh demo       run the main job (scripts/demo.lua)
 #   ./build.sh test       run the whole test suite (ctest)
-#   ./build.sh sanitize   build with AddressSanitizer + UBSan into build-asan/ and run the suite
+#   ./build.sh sanitize   build with AddressSanitizer + UBSan into build-asan/ and run the suite;
+#                         that build runs the hot kernels' baseline code only (GRAINLAB_CLONES=OFF)
+#                         and checks its bits against build/'s AVX2 clones (isa_same_bits)
 #   ./build.sh build      only install and build
 set -euo pipefail
 cd "$(dirname "$0")"
@@ -55,7 +57,9 @@ case "$cmd" in
     build)    build build ;;
     demo)     build build && ./build/grainlab scripts/demo.lua "$@" ;;
     test)     build build && ctest --test-dir build --output-on-failure -j "$jobs" "$@" ;;
-    sanitize) build build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DGRAINLAB_SANITIZE=ON &&
+    sanitize) build build &&
+              build build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DGRAINLAB_SANITIZE=ON \
+                  -DGRAINLAB_CLONES=OFF -DGRAINLAB_BITS_REFERENCE="$PWD/build/grainlab" &&
               ctest --test-dir build-asan --output-on-failure -j "$jobs" "$@" ;;
     *) echo "usage: ./build.sh [build|demo|test|sanitize]" >&2; exit 2 ;;
 esac

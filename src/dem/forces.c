@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/clones.h"
 #include "dem/dem_internal.h"
 
 /* Normal force magnitude, positive when repulsive. gamma is the pair's viscous coefficient, or

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/clones.h"
 #include "core/comm.h"
 #include "core/interrupt.h"
 #include "core/threads.h"
@@ -352,7 +353,7 @@ static size_t check_finite(const dem_scene *s)
  * Component-wise loops over contiguous arrays (they vectorise); the drift also returns the largest
  * displacement since the last list build, and the final kick raises s->suspect when a velocity is
  * not finite, so the per-particle checks run only when something is wrong. */
-static void kick_rotation(dem_scene *s, double h)
+GRAINLAB_CLONES static void kick_rotation(dem_scene *s, double h)
 {
     const long n = (long)s->n;
     const double *restrict ii = s->inv_inertia;
@@ -366,7 +367,7 @@ static void kick_rotation(dem_scene *s, double h)
 }
 
 /* 2D orientation: theta += dt omega (omega at the half step in velocity Verlet). */
-static void advance_angles(dem_scene *s, double dt)
+GRAINLAB_CLONES static void advance_angles(dem_scene *s, double dt)
 {
     if (!s->angle)
         return;
@@ -410,7 +411,7 @@ static void advance_angles(dem_scene *s, double dt)
     } while (0)
 /* clang-format on */
 
-static double kick_drift_2d(dem_scene *s, double h, double dt, int rot)
+GRAINLAB_CLONES static double kick_drift_2d(dem_scene *s, double h, double dt, int rot)
 {
     const long n = (long)s->n;
     const double *restrict im = s->inv_m;
@@ -442,7 +443,7 @@ static double kick_drift_2d(dem_scene *s, double h, double dt, int rot)
 }
 #undef KICK_DRIFT_2D_LOOP
 
-static double kick_drift(dem_scene *s, double h, double dt)
+GRAINLAB_CLONES static double kick_drift(dem_scene *s, double h, double dt)
 {
     const long n = (long)s->n;
     const double *restrict im = s->inv_m;
@@ -495,7 +496,7 @@ static double kick_drift(dem_scene *s, double h, double dt)
     } while (0)
 /* clang-format on */
 
-static int kick_check_2d(dem_scene *s, double h)
+GRAINLAB_CLONES static int kick_check_2d(dem_scene *s, double h)
 {
     const long n = (long)s->n;
     const int rot = s->rot;
@@ -513,7 +514,7 @@ static int kick_check_2d(dem_scene *s, double h)
 }
 #undef KICK_CHECK_2D_LOOP
 
-static void kick_check(dem_scene *s, double h)
+GRAINLAB_CLONES static void kick_check(dem_scene *s, double h)
 {
     const long n = (long)s->n;
     const double *restrict im = s->inv_m;

@@ -9,6 +9,7 @@
 #include <stdlib.h>
 
 #include "core/clock.h"
+#include "core/clones.h"
 #include "core/interrupt.h"
 #include "core/threads.h"
 #include "mpm/material_inline.h"
@@ -21,8 +22,9 @@
 #define THREAD_ID() 0
 #endif
 
-/* The step's stages stay separate functions so that a profiler (callgrind) counts each. */
-#define STAGE __attribute__((noinline))
+/* The step's stages stay separate functions so that a profiler (callgrind) counts each; each
+ * is compiled for the baseline and for AVX2 (GRAINLAB_CLONES: the same bits). */
+#define STAGE __attribute__((noinline)) GRAINLAB_CLONES
 
 /* Two doubles in the lanes of one SSE2 register (GCC's vector extension; NEON on arm64, scalar
  * code elsewhere): each lane's arithmetic is the IEEE operation of the scalar code, so a vector
@@ -471,7 +473,7 @@ to_grid_range(const mpm_scene *s, size_t pa, size_t pb, struct mpm_node_rec *r, 
 /* The centre-of-mass transfer (noslip), inside the parallel region: thread t scatters its chunks'
  * points into their node records, then the records are added up in chunk order into the nodal
  * arrays (the same sums as chunk 0 into the arrays and the others added to them). */
-static void to_grid(mpm_scene *s, int t)
+STAGE static void to_grid(mpm_scene *s, int t)
 {
     const size_t nn = s->nnodes;
     for (int c = t; c < s->nc; c += s->nt) {

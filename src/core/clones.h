@@ -1,0 +1,24 @@
+/* GRAINLAB_CLONES: a hot kernel compiled twice, for the portable baseline (x86-64: SSE2) and for
+ * AVX2, the loader picking the clone this CPU runs (GCC's target_clones: an ifunc, resolved once
+ * when the program starts). A portable build then runs four double lanes per vector instruction
+ * on the machines that have them, with the same bits as the baseline: the build has no fused
+ * multiply-adds (-ffp-contract=off, and GCC's avx2 target does not imply FMA), each lane does the
+ * scalar IEEE operation, and the only vector reductions (omp simd) are sums of 0s and 1s, exact
+ * in any order. A floating-point omp simd reduction would break that (its order follows the
+ * vector width): tests/isa_same_bits.lua compares the two clones' runs of every engine.
+ *
+ * Empty (one compilation) elsewhere: another compiler or architecture, a build whose -march
+ * already has AVX2 (GRAINLAB_MARCH), or GRAINLAB_NO_CLONES (CMake GRAINLAB_CLONES=OFF, which the
+ * sanitizer build uses so that the suite runs the baseline code there). A function with the
+ * attribute is never inlined; its omp parallel regions are cloned with it. */
+#ifndef GRAINLAB_CORE_CLONES_H
+#define GRAINLAB_CORE_CLONES_H
+
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__AVX2__) &&      \
+    !defined(GRAINLAB_NO_CLONES)
+#define GRAINLAB_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define GRAINLAB_CLONES
+#endif
+
+#endif
