@@ -2,8 +2,8 @@
 # The opt-in instruction set (CMake GRAINLAB_MARCH, issue 16) against the portable build: the same
 # bits for the three engines, and the speed of each.
 #   scripts/bench/march_bits.sh [march=x86-64-v3] [out=out/march_bits]
-# Builds this checkout twice under OUT (portable, and -march=MARCH), then with each build and on 1
-# and 2 threads: 3000 steps of the DEM benchmark pile (scripts/bench/dem_dense.lua's export, made
+# Builds this checkout twice under OUT (portable without the AVX2 clones of src/core/clones.h, and
+# -march=MARCH), then with each build and on 1 and 2 threads: 3000 steps of the DEM benchmark pile (scripts/bench/dem_dense.lua's export, made
 # once), 20 cycles of the MPM shear benchmark from its prepared scene (mpm_shear.lua save=), 10
 # steps of a 10^5-disk DSMC gas; each run ends in a checkpoint. The checkpoints' physics must be
 # identical: DEM and DSMC are compared by their particle states written as hex floats (their
@@ -21,7 +21,7 @@ done
 SRC=$(pwd)
 mkdir -p "$OUT"
 for b in portable "$MARCH"; do
-  flag=""
+  flag="-DGRAINLAB_CLONES=OFF" # the baseline code only (no AVX2 clones picked at run time)
   [ "$b" = portable ] || flag="-DGRAINLAB_MARCH=$b"
   cmake -S "$SRC" -B "$OUT/build-$b" -DCMAKE_BUILD_TYPE=Release -DGRAINLAB_TESTS=OFF $flag >/dev/null
   cmake --build "$OUT/build-$b" -j2 --target grainlab >/dev/null

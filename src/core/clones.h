@@ -3,9 +3,12 @@
  * when the program starts). A portable build then runs four double lanes per vector instruction
  * on the machines that have them, with the same bits as the baseline: the build has no fused
  * multiply-adds (-ffp-contract=off, and GCC's avx2 target does not imply FMA), each lane does the
- * scalar IEEE operation, and the only vector reductions (omp simd) are sums of 0s and 1s, exact
- * in any order. A floating-point omp simd reduction would break that (its order follows the
- * vector width): tests/isa_same_bits.lua compares the two clones' runs of every engine.
+ * scalar IEEE operation, and the only vector reductions (omp simd) are exact in any order: sums
+ * of 0s and 1s (or of zeros), minima, maxima. A floating-point sum as an omp simd reduction would
+ * break that (its order follows the vector width): tests/cli/isa_same_bits.sh compares the two
+ * clones' runs of every engine. Where the hot kernels are: the MPM step's stages (STAGE in
+ * src/mpm/step.c) and DEM's pair kernel, force gather, walls and integration passes. DSMC has
+ * none: its clones ran no faster (a step of scattered memory accesses; measured at issue 16).
  *
  * Empty (one compilation) elsewhere: another compiler or architecture, a build whose -march
  * already has AVX2 (GRAINLAB_MARCH), or GRAINLAB_NO_CLONES (CMake GRAINLAB_CLONES=OFF, which the
