@@ -15,6 +15,7 @@
 #include <lauxlib.h>
 
 #include "cli/cli.h"
+#include "core/clones.h"
 #include "core/comm.h"
 #include "core/fileio.h"
 #include "core/interrupt.h"
@@ -42,7 +43,7 @@ static const char *USAGE =
     "  --quiet, -q      no progress output\n"
     "  --report FILE    also write the run's grainlab.report as JSON to FILE\n"
     "                   (environment: GRAINLAB_REPORT)\n"
-    "  --version, -v    print version and libraries, then exit\n"
+    "  --version, -v    print version, libraries and the kernels' instruction set, then exit\n"
     "  --help, -h       print this help, then exit\n"
     "  --               end of options\n"
     "\n"
@@ -456,8 +457,8 @@ static int cli_main(int argc, char **argv)
     if (status == 0 && a.help)
         fputs(USAGE, stdout);
     else if (status == 0 && a.version)
-        printf("grainlab %s (%s; %d threads available)\n", GRAINLAB_VERSION, GRAINLAB_DEPS,
-               threads_available());
+        printf("grainlab %s (%s; %d threads available; kernels: %s)\n", GRAINLAB_VERSION,
+               GRAINLAB_DEPS, threads_available(), clones_kernels());
     if (status != 0 || a.help || a.version) {
         free(a.chunks);
         free(a.params);

@@ -17,11 +17,26 @@
 #ifndef GRAINLAB_CORE_CLONES_H
 #define GRAINLAB_CORE_CLONES_H
 
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__AVX2__) &&      \
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__AVX2__) &&       \
     !defined(GRAINLAB_NO_CLONES)
 #define GRAINLAB_CLONES __attribute__((target_clones("avx2", "default")))
+#define GRAINLAB_CLONED 1
 #else
 #define GRAINLAB_CLONES
+#define GRAINLAB_CLONED 0
 #endif
+
+/* The code the hot kernels run in this process, for `grainlab --version`: the clone the loader
+ * picks (the same test as the ifunc's), or the one compilation of a build without clones. */
+static inline const char *clones_kernels(void)
+{
+#if GRAINLAB_CLONED
+    return __builtin_cpu_supports("avx2") ? "AVX2, picked at run time" : "SSE2, picked at run time";
+#elif defined(__AVX2__)
+    return "AVX2, built for it";
+#else
+    return "one compilation, no clones";
+#endif
+}
 
 #endif

@@ -14,10 +14,18 @@ ref=$(realpath "$1") this=$(realpath "$2")
 scenes=$(cd "$(dirname "$0")/../lua" && pwd)/isa_bits_scenes.lua
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-grep -q avx2 /proc/cpuinfo 2>/dev/null && echo "this CPU has AVX2" || echo "this CPU has no AVX2: both binaries run the baseline"
 for exe in "$ref" "$this"; do
   [ -x "$exe" ] || { echo "isa_same_bits.sh: no executable $exe" >&2; exit 1; }
 done
+# what each binary's kernels run (grainlab --version): the comparison means something only
+# between a build with clones and one without
+kref=$("$ref" --version | sed -n 's/.*kernels: \(.*\))$/\1/p')
+kthis=$("$this" --version | sed -n 's/.*kernels: \(.*\))$/\1/p')
+echo "reference: $kref; this build: $kthis"
+case "$kref" in *"picked at run time"*) ;; *)
+  echo "isa_same_bits.sh: the reference $ref has no clones (kernels: '$kref')" >&2; exit 1 ;; esac
+case "$kthis" in *"no clones"*) ;; *)
+  echo "isa_same_bits.sh: this build $this has clones (kernels: '$kthis'): configure it with -DGRAINLAB_CLONES=OFF" >&2; exit 1 ;; esac
 status=0
 for t in 1 2; do
   for side in ref this; do

@@ -18,6 +18,7 @@ lines() { [ "$(printf '%s\n' "$1" | grep -c .)" -eq "$2" ] && ok || bad "$3: exp
 
 # --- flags ---
 run "$G" --version </dev/null;  expect_rc 0 version; has "$out" "grainlab 0.1.0 (Lua 5.4" version
+has "$out" "; kernels: " version
 run "$G" --help </dev/null;     expect_rc 0 help; has "$out" "usage: grainlab" help
 run "$G" --bogus </dev/null;    expect_rc 2 unknown-flag; has "$err" "unknown option '--bogus'" unknown-flag
 lines "$err" 1 unknown-flag
