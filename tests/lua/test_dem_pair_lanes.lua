@@ -12,31 +12,10 @@ grainlab.threads(1)
 local mat = grainlab.material{ density = 2650, young = 1e8, poisson = 0.3, friction = 0.1,
                                restitution = 0.6 }
 
--- side^dim disks (spheres) on a jittered lattice around the centre of a 0.4 m box, moving inwards.
+local new_cluster = dofile("dem_cluster.lua")
 local function cluster(dim, periodic, contact)
-  local lo, hi, per, g = {}, {}, {}, {}
-  for d = 1, dim do lo[d], hi[d], per[d], g[d] = 0, 0.4, d == 1 and periodic, 0 end
-  local s = dem.scene{ dim = dim, box = { lo, hi }, gravity = g, periodic = per }
-  s:contact(contact)
-  local rng = grainlab.rng{ seed = 7 }
-  local side, a = dim == 2 and 16 or 7, 2.1e-3
-  local idx = {}
-  for d = 1, dim do idx[d] = 0 end
-  for _ = 1, side ^ dim do
-    local pos, vel = {}, {}
-    for d = 1, dim do
-      pos[d] = 0.2 + (idx[d] - side / 2) * a + rng:uniform(-1e-4, 1e-4)
-      vel[d] = -(pos[d] - 0.2) * 300 + rng:normal(0, 0.1)
-    end
-    local add = dim == 2 and s.add_disk or s.add_sphere
-    add(s, { pos = pos, radius = rng:uniform(0.8e-3, 1e-3), material = mat, vel = vel })
-    for d = 1, dim do -- odometer
-      idx[d] = idx[d] + 1
-      if idx[d] < side then break end
-      idx[d] = 0
-    end
-  end
-  return s
+  return new_cluster{ dim = dim, side = dim == 2 and 16 or 7, spacing = 2.1e-3, inward = 300,
+                      periodic = periodic, contact = contact, material = mat }
 end
 
 local laws = {}
