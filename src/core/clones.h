@@ -13,7 +13,9 @@
  * Empty (one compilation) elsewhere: another compiler or architecture, a build whose -march
  * already has AVX2 (GRAINLAB_MARCH), or GRAINLAB_NO_CLONES (CMake GRAINLAB_CLONES=OFF, which the
  * sanitizer build uses so that the suite runs the baseline code there). A function with the
- * attribute is never inlined; its omp parallel regions are cloned with it. */
+ * attribute is never inlined; the omp parallel regions written in its body are cloned with it,
+ * but not those of an always_inline function it calls (they are outlined before the cloning:
+ * put the attribute on that function, or check `nm grainlab | grep avx2`). */
 #ifndef GRAINLAB_CORE_CLONES_H
 #define GRAINLAB_CORE_CLONES_H
 
