@@ -20,18 +20,13 @@ local function dump(name, cols)
 end
 
 -- MPM (the scene of test_mpm_contact_paths.lua)
-local mpm_scene = dofile("mpm_contact_scene.lua")
-local cases = {
-  { name = "mpm musl bspline cap separation conserve", update = "musl", shape = "bspline",
-    contact = { strain_cap = 0.05, separation = 0.2, conserve = true } },
-  { name = "mpm usf plane own normals", update = "usf", plane = true, wall_gap = 0.5,
-    contact = { normals = "own", conserve = true } },
-  { name = "mpm usl linear normals pic", update = "usl", pic = 0.3, contact = { normals = "linear" } },
-  { name = "mpm musl noslip", update = "musl", contact = { model = "noslip" } },
-}
+local contact_scene = dofile("mpm_contact_scene.lua")
+local cases = {}
+for _, case in ipairs(contact_scene.cases) do cases[#cases + 1] = case end
+cases[#cases + 1] = { name = "musl, noslip", update = "musl", contact = { model = "noslip" } }
 for _, case in ipairs(cases) do
-  local p = mpm_scene(case):points()
-  dump(case.name, { p.x, p.y, p.vx, p.vy, p.sxx })
+  local p = contact_scene.run(case):points()
+  dump("mpm " .. case.name, { p.x, p.y, p.vx, p.vy, p.sxx })
 end
 
 -- DEM: imploding clusters (dem_cluster.lua), touching from the start

@@ -9,18 +9,11 @@
 -- normals (USF: the force sums); linear normals with a PIC blend (USL, no remap).
 local same_points = dofile("mpm_same_points.lua")
 local check = grainlab.check
-local cases = {
-  { name = "musl, bspline, cap, separation, conserve", update = "musl", shape = "bspline",
-    contact = { strain_cap = 0.05, separation = 0.2, conserve = true } },
-  { name = "usf, friction plane with gap test, own normals", update = "usf", plane = true, wall_gap = 0.5,
-    contact = { normals = "own", conserve = true } },
-  { name = "usl, linear normals, pic", update = "usl", pic = 0.3, contact = { normals = "linear" } },
-}
-
-local scene = dofile("mpm_contact_scene.lua")
+local contact_scene = dofile("mpm_contact_scene.lua")
+local cases = contact_scene.cases
 local function run(case, threads)
   grainlab.threads(threads)
-  return scene(case):points()
+  return contact_scene.run(case):points()
 end
 
 for _, case in ipairs(cases) do
