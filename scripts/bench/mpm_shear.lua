@@ -35,6 +35,12 @@ if params.load then
   -- dominates a callgrind run.
   m = mpm.load(params.load)
   ngrains, area_fraction = m:info().grains, nil
+  -- the loaded scene's contact model, whatever model= says (the report names what ran)
+  if params.model and params.model ~= m:info().contact then
+    error(string.format("mpm_shear: model=%s, but %s was saved with contact %q",
+                        params.model, params.load, m:info().contact), 0)
+  end
+  model = m:info().contact
 else
   local pk = grainlab.pack.slab{ size = L, n = 369, diameter = { 31e-6, 57e-6, 250e-6 }, seed = 5 }
   local hmx = mpm.material{ model = "vonmises", density = 1900, shear = 7.5e9, bulk = 11.4e9, yield = 0.3e9,
@@ -98,8 +104,10 @@ local last = list[#list]
 metrics.particle_steps_per_s = metrics["particle_steps_per_s_" .. last .. "_threads"]
 metrics.projected_full_run_s = metrics["projected_full_run_s_" .. last .. "_threads"]
 metrics.wall_s = total
--- The 5-minute target is reported beside the projection, not checked: timing depends on the load.
-metrics.projected_full_run_target_s = 300
+-- Issue 16's target (issue 5's was 300 s), reported beside the projection, not checked: timing
+-- depends on the load. A projection from the prepared scene understates the full run (its shear
+-- band's contacts grow: 144-194 s projected, 209-221 s run to the end, docs/mpm.md).
+metrics.projected_full_run_target_s = 60
 local names = { "stencil", "p2g", "normals", "grid", "contact", "g2p", "remap", "material", "check" }
 print(string.format("stages (%d thread(s), %d cycles): wall ns per point-step, share", last, cycles))
 for _, k in ipairs(names) do
