@@ -41,6 +41,7 @@ fi
 logs=$repo/out/fresh_machine
 mkdir -p "$logs"
 [ -n "$dir" ] || dir=$(mktemp -d /var/tmp/grainlab-fresh.XXXXXX)
+mkdir -p "$dir"
 root=$dir/root
 [ ! -e "$root" ] || { echo "fresh_machine.sh: $root exists; give another --dir" >&2; exit 2; }
 
