@@ -9,14 +9,18 @@
 --   args.check("grainlab.pack.deposit", 2, opts, SPEC)   -- unknown keys refused too
 --   args.fields(SPEC)                                     -- sorted names, for grainlab.doc
 -- Kinds: number (finite), positive, nonneg, range (lo, hi, open_lo, open_hi), integer (min,
--- max), boolean, string, option (values), function, table, and custom: { check = function(v)
--- return ok, expected end }. Numbers above 1e100 in magnitude are refused, as in the C bindings.
+-- max), boolean, string, path (a file name: non-empty, no NUL byte), option (values), function,
+-- table, and custom: { check = function(v) return ok, expected end }. Numbers above 1e100 in
+-- magnitude are refused, as in the C bindings. An unknown key names the closest valid one.
 local args = {}
 
 local MAX = 1e100
 
 local function describe(v)
-  if type(v) == "string" then return "'" .. (#v > 40 and v:sub(1, 37) .. "..." or v) .. "'" end
+  if type(v) == "string" then
+    v = v:gsub("\0", "\\0") -- a NUL byte shown, as the C bindings show it
+    return "'" .. (#v > 40 and v:sub(1, 37) .. "..." or v) .. "'"
+  end
   if type(v) == "number" or type(v) == "boolean" or v == nil then return tostring(v) end
   return type(v)
 end
@@ -46,6 +50,58 @@ function args.arg_fail(call, argn, expected, got)
   raise(string.format("bad argument #%d to '%s' (%s expected, got %s)", argn, call, expected,
                       describe(got)))
 end
+
+-- Optimal string alignment distance (edits and adjacent swaps), as src/lua/args.c computes it.
+local function distance(a, b)
+  local d = {}
+  for i = 0, #a do d[i] = { [0] = i } end
+  for j = 0, #b do d[0][j] = j end
+  for i = 1, #a do
+    for j = 1, #b do
+      local best = math.min(d[i - 1][j - 1] + (a:byte(i) == b:byte(j) and 0 or 1),
+                            d[i - 1][j] + 1, d[i][j - 1] + 1)
+      if i > 1 and j > 1 and a:byte(i) == b:byte(j - 1) and a:byte(i - 1) == b:byte(j) then
+        best = math.min(best, d[i - 2][j - 2] + 1)
+      end
+      d[i][j] = best
+    end
+  end
+  return d[#a][#b]
+end
+
+-- The name of `names` closest to s, or nil: a unique prefix of at least two letters ("temp"),
+-- else one that differs only in case, else the nearest of three letters or more within a third
+-- of its length, at least one edit (bind_closest_name's rule).
+function args.closest(s, names)
+  if type(s) ~= "string" or #s > 32 then return nil end
+  local prefix, nprefix = nil, 0
+  for _, name in ipairs(names) do
+    if #s >= 2 and name:sub(1, #s) == s then prefix, nprefix = name, nprefix + 1 end
+  end
+  if nprefix == 1 then return prefix end
+  for _, name in ipairs(names) do
+    if name:lower() == s:lower() then return name end
+  end
+  local best, best_d
+  for _, name in ipairs(names) do
+    local d = #name >= 3 and distance(s, name)
+    if d and d <= math.max(1, #name // 3) and (not best_d or d < best_d) then best, best_d = name, d end
+  end
+  return best
+end
+
+-- "(unknown field 'raduis'; did you mean 'radius'? Valid fields: a, b)" for key k of a table
+-- whose keys are `names` (sorted).
+function args.unknown(k, names)
+  local near = args.closest(k, names)
+  return string.format("(unknown field %s; %s: %s)", describe(k),
+                       near and ("did you mean '" .. near .. "'? Valid fields") or "valid fields",
+                       table.concat(names, ", "))
+end
+
+-- A file name that crosses into C intact: a non-empty string without NUL bytes (the C side
+-- would end the name at the first NUL: "a\0b.txt" written as "a").
+function args.is_path(v) return type(v) == "string" and v ~= "" and not v:find("\0", 1, true) end
 
 local function finite(v) return type(v) == "number" and v == v and v >= -MAX and v <= MAX end
 
@@ -78,6 +134,9 @@ local function validate(f, v)
   end
   if kind == "boolean" then return type(v) == "boolean", "boolean" end
   if kind == "string" then return type(v) == "string", "string" end
+  if kind == "path" then
+    return args.is_path(v), type(v) == "string" and "non-empty file path without NUL bytes" or "file path (string)"
+  end
   if kind == "function" then return type(v) == "function", "function" end
   if kind == "table" then return type(v) == "table", "table" end
   if kind == "option" then
@@ -105,8 +164,7 @@ function args.check(call, argn, opts, spec, optional)
   if type(opts) ~= "table" then args.arg_fail(call, argn, "table", opts) end
   for k in pairs(opts) do
     if type(k) ~= "string" or not spec[k] then
-      raise(string.format("bad argument #%d to '%s' (unknown field %s; valid fields: %s)", argn,
-                          call, describe(k), table.concat(args.fields(spec), ", ")))
+      raise(string.format("bad argument #%d to '%s' %s", argn, call, args.unknown(k, args.fields(spec))))
     end
   end
   for _, name in ipairs(args.fields(spec)) do

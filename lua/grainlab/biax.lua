@@ -40,7 +40,7 @@ local CONFIG = {
   ramp_steps = STEPS, hold_steps = STEPS, friction_steps = STEPS, rest_steps = STEPS,
   ramp_stages = { "integer", min = 1, max = 1e6 }, prep_drag = { "nonneg" },
   settle_tol = { "positive" }, settle_rounds = { "integer", min = 1, max = 1e6 },
-  cache = { check = function(v) return v == false or type(v) == "string", "false or a file name" end },
+  cache = { check = function(v) return v == false or args.is_path(v), "false or a file name (no NUL byte)" end },
 }
 biax.fields = args.fields(CONFIG)
 

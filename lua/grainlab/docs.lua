@@ -50,10 +50,12 @@ local function wrap(text, width)
   return table.concat(lines, "\n")
 end
 
+-- records: name = { usage, text[, fields] } (fields: the keys of its options table, as checked).
 local function document(module, prefix, records)
   for name, r in pairs(records) do
     assert(type(module[name]) == "function", prefix .. name .. " is not a function")
-    grainlab.doc(module[name], { name = prefix .. name, usage = prefix .. r[1], doc = wrap(r[2], 92) })
+    grainlab.doc(module[name], { name = prefix .. name, usage = prefix .. r[1], doc = wrap(r[2], 92),
+                                 fields = r[3] })
   end
 end
 
@@ -114,5 +116,6 @@ document(recorder.methods, "rec:", {
   column = { "column(name)", "A copy of the column's values, in sampling order." },
   write = { "write([path])", "Writes the whole CSV to path (default: the recorder's file), temporary file + rename. Returns the path." },
   plot = { "plot{ file =, x = first column, y = other columns | name | { names }, labels =, title =, xlabel =, ylabel =, xlog =, ylog =, width =, height =, style = 'line' }",
-    "Draws y against x with render.plot. Axis labels default to the column names with their units; on a log axis values <= 0 are gaps. Returns the file." },
+    "Draws y against x with render.plot. Axis labels default to the column names with their units; on a log axis values <= 0 are gaps. Returns the file.",
+    recorder.plot_fields },
 })

@@ -5,7 +5,7 @@
 local figures = {}
 
 local function describe(v)
-  if type(v) == "string" then return "'" .. v .. "'" end
+  if type(v) == "string" then return "'" .. v:gsub("\0", "\\0") .. "'" end
   if type(v) == "number" or type(v) == "boolean" then return tostring(v) end
   return type(v)
 end
@@ -44,6 +44,10 @@ local function resolve(opts, argn, fname)
     error(string.format("bad field 'out' in argument #%d to '%s' (directory name expected, got %s)",
                         argn, fname, describe(opts.out)), 3)
   end
+  if opts.out and opts.out:find("\0", 1, true) then -- the shell would end the name there
+    error(string.format("bad field 'out' in argument #%d to '%s' (directory name without NUL bytes expected, got %s)",
+                        argn, fname, describe(opts.out)), 3)
+  end
   for k in pairs(opts) do
     if k ~= "published" and k ~= "out" then
       error(string.format("bad argument #%d to '%s' (unknown field '%s'; valid fields: out, published)",
@@ -67,6 +71,9 @@ function figures.path(name, opts)
   if type(name) ~= "string" or name == "" or name:find("/", 1, true) then
     error("bad argument #1 to 'path' (file name without a directory expected, got " ..
           describe(name) .. ")", 2)
+  end
+  if name:find("\0", 1, true) then
+    error("bad argument #1 to 'path' (file name without NUL bytes expected, got " .. describe(name) .. ")", 2)
   end
   return resolve(opts, 2, "path") .. "/" .. name
 end

@@ -45,8 +45,8 @@ local function material(t)
   end
   for k in pairs(t) do
     if not FIELDS[k] then
-      error(string.format("bad argument #1 to 'material' (unknown field %s; valid fields: density, friction, name, poisson, restitution, rolling_friction, young)",
-                          describe(k)), 2)
+      error("bad argument #1 to 'material' " .. require("grainlab.args").unknown(k,
+        { "density", "friction", "name", "poisson", "restitution", "rolling_friction", "young" }), 2)
     end
   end
   local m = {}

@@ -128,8 +128,7 @@ local function pretty(v, opts)
     end
     for k, x in pairs(opts) do
       if DEFAULTS[k] == nil then
-        error(string.format("bad argument #2 to 'pretty' (unknown field %s; valid fields: %s)",
-          type(k) == "string" and "'" .. k .. "'" or tostring(k), table.concat(OPTS, ", ")), 2)
+        error("bad argument #2 to 'pretty' " .. require("grainlab.args").unknown(k, OPTS), 2)
       end
       if math.type(x) ~= "integer" or x < 0 then
         error(string.format("bad field '%s' in argument #2 to 'pretty' (non-negative integer expected, got %s)",
@@ -154,7 +153,9 @@ end
 
 M.pretty, M.show = pretty, show
 
-grainlab.doc(pretty, { name = "grainlab.pretty",
+local fields = table.move(OPTS, 1, #OPTS, 1, {})
+table.sort(fields)
+grainlab.doc(pretty, { name = "grainlab.pretty", fields = fields,
   usage = "grainlab.pretty(v, { depth = 3, items = 10, fields = 40, width = 100, string = 80 })",
   doc = [[A readable string of v, as the REPL prints results: arrays in order, then string keys
 sorted (then other keys); tables nested deeper than `depth` as {…}; arrays past `items`

@@ -10,12 +10,13 @@
 -- outright (SIGKILL, a node's time limit) loses at most the last `flush` seconds of samples; the
 -- file on disk is always a complete CSV of the rows sampled before its last write.
 local grainlab = grainlab
+local args = require("grainlab.args")
 
 local M = {} -- the methods; the instance metatable is below
 local MT = { __index = M, __name = "grainlab.recorder" }
 
 local function describe(v)
-  if type(v) == "string" then return "'" .. v .. "'" end
+  if type(v) == "string" then return "'" .. v:gsub("\0", "\\0") .. "'" end
   if type(v) == "number" or type(v) == "boolean" then return tostring(v) end
   return type(v)
 end
@@ -42,7 +43,12 @@ local function mkdir_for(path)
 end
 
 local FIELDS = { file = true, columns = true, order = true, units = true, flush = true }
-local FIELD_LIST = "columns, file, flush, order, units"
+local FIELD_NAMES = { "columns", "file", "flush", "order", "units" }
+
+-- A file name: non-empty, and without a NUL byte (the C side would end the name there).
+local function file_expected(v)
+  return type(v) == "string" and v ~= "" and "file name without NUL bytes" or "file name"
+end
 
 -- Reads `columns` (+ `order`) into an array of { name =, fn = } in CSV order.
 local function read_columns(t)
@@ -118,12 +124,11 @@ local function new(t)
   end
   for k in pairs(t) do
     if not FIELDS[k] then
-      error(string.format("bad argument #1 to 'recorder' (unknown field %s; valid fields: %s)",
-                          describe(k), FIELD_LIST), 2)
+      error("bad argument #1 to 'recorder' " .. args.unknown(k, FIELD_NAMES), 2)
     end
   end
-  if t.file ~= nil and (type(t.file) ~= "string" or t.file == "") then
-    bad_field("recorder", "file", "file name", t.file, 2)
+  if t.file ~= nil and not args.is_path(t.file) then
+    bad_field("recorder", "file", file_expected(t.file), t.file, 2)
   end
   local flush = t.flush
   if flush == nil then flush = 10 end
@@ -230,7 +235,9 @@ function M.add(rec, values)
   end
   for k in pairs(values) do
     if not rec._index[k] then
-      error(string.format("bad argument #1 to 'add' (unknown column %s; columns: %s)", describe(k),
+      local near = args.closest(k, M.names(rec))
+      error(string.format("bad argument #1 to 'add' (unknown column %s; %scolumns: %s)", describe(k),
+                          near and ("did you mean '" .. near .. "'? ") or "",
                           table.concat(M.names(rec), ", ")), 2)
     end
   end
@@ -271,8 +278,8 @@ end
 function M.write(rec, path)
   check_self(rec, "write")
   path = path or rec._file
-  if type(path) ~= "string" or path == "" then
-    error("bad argument #1 to 'write' (file name expected, got " .. describe(path) ..
+  if not args.is_path(path) then
+    error("bad argument #1 to 'write' (" .. file_expected(path) .. " expected, got " .. describe(path) ..
           (rec._file and ")" or "; the recorder has no file)"), 2)
   end
   mkdir_for(path)
@@ -281,9 +288,16 @@ function M.write(rec, path)
   return path
 end
 
-local PLOT_FIELDS = { file = true, x = true, y = true, labels = true, title = true, xlabel = true,
-                      ylabel = true, xlog = true, ylog = true, width = true, height = true, style = true }
-local PLOT_LIST = "file, height, labels, style, title, width, x, xlabel, xlog, y, ylabel, ylog"
+-- rec:plot's options, checked at its entry (render.plot would name its own fields: series[1]).
+local SIZE = { "integer", min = 16, max = 8192 } -- render's image sizes
+local PLOT = {
+  file = { required = true, check = function(v) return args.is_path(v), file_expected(v) end },
+  x = { "string" },
+  y = { check = function(v) return type(v) == "string" or type(v) == "table", "column name or array of names" end },
+  labels = { "table" }, title = { "string" }, xlabel = { "string" }, ylabel = { "string" },
+  xlog = { "boolean" }, ylog = { "boolean" }, width = SIZE, height = SIZE,
+  style = { "option", values = { "line", "points", "both", "none" } },
+}
 
 -- On a log axis a value <= 0 has no place: it becomes a gap (NaN), as a zero kinetic energy at rest.
 local function plotted(data, n, log)
@@ -298,16 +312,7 @@ end
 -- ylabel =, xlog =, ylog =, width =, height =, style = 'line' }
 function M.plot(rec, o)
   check_self(rec, "plot")
-  if type(o) ~= "table" then
-    error("bad argument #1 to 'plot' (table expected, got " .. describe(o) .. ")", 2)
-  end
-  for k in pairs(o) do
-    if not PLOT_FIELDS[k] then
-      error(string.format("bad argument #1 to 'plot' (unknown field %s; valid fields: %s)", describe(k),
-                          PLOT_LIST), 2)
-    end
-  end
-  if type(o.file) ~= "string" or o.file == "" then bad_field("plot", "file", "file name", o.file, 2) end
+  args.check("plot", 1, o, PLOT)
   if rec._n == 0 then error("bad self to 'plot' (the recorder holds no samples yet)", 2) end
   local xc = rec._cols[1]
   if o.x ~= nil then
@@ -322,8 +327,18 @@ function M.plot(rec, o)
     ys = { ys }
   end
   if type(ys) ~= "table" or #ys == 0 then bad_field("plot", "y", "column name or array of names", o.y, 2) end
+  for i in pairs(ys) do
+    if math.type(i) ~= "integer" or i < 1 or i > #ys then
+      bad_field("plot", "y", "column name or array of names", o.y, 2)
+    end
+  end
   if o.labels ~= nil and (type(o.labels) ~= "table" or #o.labels ~= #ys) then
     bad_field("plot", "labels", "array of " .. #ys .. " labels (one per y column)", o.labels, 2)
+  end
+  for i, label in pairs(o.labels or {}) do
+    if math.type(i) ~= "integer" or i < 1 or i > #ys or type(label) ~= "string" then
+      bad_field("plot", "labels", "array of " .. #ys .. " labels (one per y column)", o.labels, 2)
+    end
   end
   local x = plotted(xc.data, rec._n, o.xlog)
   local series, unit = {}, nil
@@ -365,9 +380,10 @@ MT.__gc = finish
 -- tests/lua/test_help_all.lua find its methods the way they find dem.scene's.
 debug.getregistry()["grainlab.recorder"] = MT
 
--- The fields of grainlab.recorder{...} (for help and the generated test, test_fuzz_core.lua).
+-- The fields of grainlab.recorder{...} and rec:plot{...} (for help and the generated test,
+-- test_fuzz_core.lua).
 local fields = {}
 for k in pairs(FIELDS) do fields[#fields + 1] = k end
 table.sort(fields)
 
-return { new = new, methods = M, type = MT, fields = fields }
+return { new = new, methods = M, type = MT, fields = fields, plot_fields = args.fields(PLOT) }

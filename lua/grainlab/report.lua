@@ -3,6 +3,7 @@
 --   {"scenario", "params", "metrics", "checks": [{"name","value","limit","op","pass"}], "wall_s"}
 -- whole (temporary file, then rename). Failed checks make the process exit non-zero.
 local json = require "grainlab.json"
+local args = require "grainlab.args"
 
 local M = { failed = 0, written = nil }
 
@@ -33,8 +34,7 @@ local function only(t, where, allowed)
       local names = {}
       for name in pairs(allowed) do names[#names + 1] = name end
       table.sort(names)
-      local unknown = string.format("(unknown field %s; valid fields: %s)", describe(k),
-                                    table.concat(names, ", "))
+      local unknown = args.unknown(k, names)
       if where then
         error(string.format("bad field '%s' in argument #1 to 'report' %s", where, unknown), 0)
       end
@@ -44,6 +44,13 @@ local function only(t, where, allowed)
 end
 
 local function is_name(s) return type(s) == "string" and s:match("^[a-z][a-z0-9_]*$") ~= nil end
+
+-- A scenario names the run in the JSON and in the file names tools derive from it: letters,
+-- digits, '_', '.' and '-', starting with a letter or digit, at most 64 characters.
+local SCENARIO = "scenario name of letters, digits, '_', '.' and '-' (starting with a letter or digit, at most 64)"
+local function is_scenario(s)
+  return type(s) == "string" and #s <= 64 and s:match("^[A-Za-z0-9][A-Za-z0-9_.-]*$") ~= nil
+end
 
 -- A figure is a finite number, a string, a boolean, or a table of figures that JSON can hold
 -- (an array 1..n, or string keys), checked here at the call so that nothing is printed or
@@ -173,6 +180,7 @@ local function report_impl(t)
   end
   only(t, nil, { scenario = true, params = true, metrics = true, checks = true })
   if type(t.scenario) ~= "string" or t.scenario == "" then bad("scenario", "non-empty string", t.scenario) end
+  if not is_scenario(t.scenario) then bad("scenario", SCENARIO, t.scenario) end
   if M.written then
     error("report: this run already reported scenario '" .. M.written ..
           "' (one report per run; put all figures in one call)", 0)
@@ -221,8 +229,9 @@ grainlab.doc(report, {
   doc = [[Reports a scenario's figures: prints a readable table and, with --report FILE.json or
 GRAINLAB_REPORT=FILE, writes them as JSON (written whole; keys sorted):
   {"scenario", "params", "metrics", "checks": [{"name","value","limit","op","pass"}], "wall_s", "version"}
-Metric and check names are snake_case with the unit in the name where useful (wall_s,
-particle_steps_per_s). A check passes when `value op limit` holds (op defaults to '<='; a NaN
+The scenario is a name of letters, digits, '_', '.' and '-' (starting with a letter or digit,
+at most 64 characters). Metric and check names are snake_case with the unit in the name where
+useful (wall_s, particle_steps_per_s). A check passes when `value op limit` holds (op defaults to '<='; a NaN
 value fails), or give pass = true/false directly. Metrics and params are finite numbers, strings,
 booleans, or tables of them (arrays, or string keys); anything else (NaN, infinity, a function,
 a mixed or self-containing table, a name that is not snake_case) is refused at the call, before

@@ -1,4 +1,5 @@
 /* Argument and table-field checking: every error names the call, the field and the value. */
+#include <ctype.h>
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -48,7 +49,18 @@ void bind_describe(lua_State *L, int idx, char *buf, size_t size)
     case LUA_TSTRING: {
         size_t len;
         const char *s = lua_tolstring(L, idx, &len);
-        snprintf(buf, size, len > 40 ? "'%.37s...'" : "'%s'", s);
+        char text[48];
+        size_t n = 0; /* a NUL byte shown as \0, not ending the text there */
+        for (size_t i = 0; i < len && n < 40; i++) {
+            if (s[i] == '\0') {
+                text[n++] = '\\';
+                text[n++] = '0';
+            } else {
+                text[n++] = s[i];
+            }
+        }
+        text[n] = '\0';
+        snprintf(buf, size, len > 40 || n > 40 ? "'%.37s...'" : "'%s'", text);
         break;
     }
     case LUA_TBOOLEAN:
@@ -76,15 +88,40 @@ int bind_arg_error(lua_State *L, int arg, const char *call, const char *expected
                       expected, got);
 }
 
-const char *bind_arg_path(lua_State *L, int arg, const char *call)
+/* A file name crosses into C as a C string: a NUL byte inside it would end the name there
+ * (writing "a" for "a\0b.txt"), so the Lua length must equal the C length. */
+static int is_path(lua_State *L, int idx)
 {
     size_t len;
+    const char *path = lua_tolstring(L, idx, &len);
+    return len > 0 && strlen(path) == len;
+}
+
+const char *bind_arg_path(lua_State *L, int arg, const char *call)
+{
     /* A number would be converted into a file name ("1"): only a string is a path. */
     if (lua_type(L, arg) != LUA_TSTRING)
         bind_arg_error(L, arg, call, "file path (string)");
-    const char *path = lua_tolstring(L, arg, &len);
-    if (len == 0 || strlen(path) != len)
+    if (!is_path(L, arg))
         bind_arg_error(L, arg, call, "non-empty file path without NUL bytes");
+    return lua_tostring(L, arg);
+}
+
+const char *bind_field_path(lua_State *L, int arg, const char *call, const char *field,
+                            unsigned flags)
+{
+    if (lua_getfield(L, arg, field) == LUA_TNIL) {
+        if (flags & BIND_REQUIRED)
+            bind_field_error(L, arg, call, field, "file path (string)");
+        lua_pop(L, 1);
+        return NULL;
+    }
+    if (lua_type(L, -1) != LUA_TSTRING)
+        bind_field_error(L, arg, call, field, "file path (string)");
+    if (!is_path(L, -1))
+        bind_field_error(L, arg, call, field, "non-empty file path without NUL bytes");
+    const char *path = lua_tostring(L, -1);
+    lua_pop(L, 1); /* still referenced by the table */
     return path;
 }
 
@@ -169,11 +206,72 @@ void bind_check_table(lua_State *L, int arg, const char *call)
                    luaL_typename(L, arg));
 }
 
-void bind_check_fields(lua_State *L, int arg, const char *call, const char *const fields[])
+/* Raises the error for the unknown key on top of the stack, a key of the options table of
+ * argument arg of call (nested: of its field `nested`, "mbc"; mode: the mode the list goes with):
+ *   bad argument #2 to 'measure' (unknown field 'volum'; did you mean 'volume'? …)
+ *   bad field 'mbc' in argument #1 to 'boundary' (unknown field 'k'; did you mean 'K'? …)
+ *   bad argument #2 to 'measure' (unknown field 'foo'; measure('energy') takes no options) */
+static int unknown_field(lua_State *L, int arg, const char *call, const char *nested,
+                         const char *mode, const char *const fields[])
 {
-    arg = lua_absindex(L, arg);
+    char key[64];
+    bind_describe(L, -1, key, sizeof key);
+    const char *near =
+        lua_type(L, -1) == LUA_TSTRING ? bind_closest_name(lua_tostring(L, -1), fields) : NULL;
+    luaL_Buffer b;
+    luaL_buffinit(L, &b);
+    luaL_where(L, 1); /* as luaL_error: the position of the user's call */
+    luaL_addvalue(&b);
+    if (nested) {
+        lua_pushfstring(L, "bad field '%s' in argument #%d to '%s' (unknown field %s", nested,
+                        user_arg(L, arg), call, key);
+    } else {
+        lua_pushfstring(L, "bad argument #%d to '%s' (unknown field %s", user_arg(L, arg), call,
+                        key);
+    }
+    luaL_addvalue(&b);
+    if (!fields[0]) {
+        luaL_addstring(&b, "; ");
+        luaL_addstring(&b, call);
+        if (mode) {
+            luaL_addstring(&b, "('");
+            luaL_addstring(&b, mode);
+            luaL_addstring(&b, "')");
+        }
+        luaL_addstring(&b, " takes no options)");
+        luaL_pushresult(&b);
+        return lua_error(L);
+    }
+    if (near) {
+        luaL_addstring(&b, "; did you mean '");
+        luaL_addstring(&b, near);
+        luaL_addstring(&b, "'? Valid fields");
+    } else {
+        luaL_addstring(&b, "; valid fields");
+    }
+    if (mode) {
+        luaL_addstring(&b, " for '");
+        luaL_addstring(&b, mode);
+        luaL_addchar(&b, '\'');
+    }
+    luaL_addstring(&b, ": ");
+    for (int i = 0; fields[i]; i++) {
+        if (i)
+            luaL_addstring(&b, ", ");
+        luaL_addstring(&b, fields[i]);
+    }
+    luaL_addchar(&b, ')');
+    luaL_pushresult(&b);
+    return lua_error(L);
+}
+
+/* Every key of the table at tab is a string in fields, or unknown_field raises. */
+static void check_keys(lua_State *L, int tab, int arg, const char *call, const char *nested,
+                       const char *mode, const char *const fields[])
+{
+    tab = lua_absindex(L, tab);
     lua_pushnil(L);
-    while (lua_next(L, arg)) {
+    while (lua_next(L, tab)) {
         lua_pop(L, 1);
         int known = 0;
         if (lua_type(L, -1) == LUA_TSTRING) {
@@ -181,18 +279,38 @@ void bind_check_fields(lua_State *L, int arg, const char *call, const char *cons
             for (int i = 0; fields[i] && !known; i++)
                 known = strcmp(key, fields[i]) == 0;
         }
-        if (!known) {
-            char key[64], list[512] = "";
-            bind_describe(L, -1, key, sizeof key);
-            for (int i = 0; fields[i]; i++) {
-                if (i)
-                    strncat(list, ", ", sizeof list - strlen(list) - 1);
-                strncat(list, fields[i], sizeof list - strlen(list) - 1);
-            }
-            luaL_error(L, "bad argument #%d to '%s' (unknown field %s; valid fields: %s)",
-                       user_arg(L, arg), call, key, list);
-        }
+        if (!known)
+            unknown_field(L, arg, call, nested, mode, fields);
     }
+}
+
+void bind_check_fields(lua_State *L, int arg, const char *call, const char *const fields[])
+{
+    arg = lua_absindex(L, arg);
+    check_keys(L, arg, arg, call, NULL, NULL, fields);
+}
+
+void bind_check_nested_fields(lua_State *L, int tab, int arg, const char *call, const char *name,
+                              const char *const fields[])
+{
+    check_keys(L, tab, arg, call, name, NULL, fields);
+}
+
+int bind_mode_options(lua_State *L, int arg, const char *call, const char *mode,
+                      const char *const fields[])
+{
+    if (lua_isnoneornil(L, arg))
+        return 0;
+    if (lua_type(L, arg) != LUA_TTABLE) {
+        char expected[96];
+        if (fields[0])
+            snprintf(expected, sizeof expected, "options table for '%s'", mode);
+        else
+            snprintf(expected, sizeof expected, "nothing ('%s' takes no options)", mode);
+        bind_arg_error(L, arg, call, expected);
+    }
+    check_keys(L, arg, arg, call, NULL, mode, fields);
+    return 1;
 }
 
 /* Pushes t[field]; returns 0 (with nothing pushed) when absent and not required. */
@@ -442,11 +560,23 @@ const char *bind_closest_name(const char *s, const char *const names[])
         }
     if (nprefix == 1)
         return prefix;
+    /* A name that differs only in case ("k" for "K"). */
+    for (int i = 0; names[i]; i++) {
+        size_t k = 0;
+        while (s[k] && names[i][k] &&
+               tolower((unsigned char)s[k]) == tolower((unsigned char)names[i][k]))
+            k++;
+        if (!s[k] && !names[i][k])
+            return names[i];
+    }
     /* Else the nearest name within a third of its length (at least one edit): "stres", "Stress",
-     * "sterss" -> "stress", but nothing for a word that is merely short. */
+     * "sterss" -> "stress", but nothing for a word that is merely short, nor for a name of one or
+     * two letters (any other letter is one edit from "x"). */
     const char *best = NULL;
     size_t best_d = (size_t)-1;
     for (int i = 0; names[i]; i++) {
+        if (strlen(names[i]) < 3)
+            continue;
         size_t d = edit_distance(s, names[i]), limit = strlen(names[i]) / 3;
         if (d <= (limit > 1 ? limit : 1) && d < best_d) {
             best = names[i];

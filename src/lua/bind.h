@@ -38,8 +38,19 @@ enum {
 
 void bind_check_table(lua_State *L, int arg, const char *call);
 
-/* Refuses any key of the table at arg not in the NULL-terminated list `fields`. */
+/* Refuses any key of the table at arg not in the NULL-terminated list `fields`, naming the key,
+ * the closest valid one and all of them:
+ *   bad argument #1 to 'add_disk' (unknown field 'raduis'; did you mean 'radius'? Valid …) */
 void bind_check_fields(lua_State *L, int arg, const char *call, const char *const fields[]);
+/* The same for a table nested in argument arg (at stack index tab), whose errors name it as the
+ * field `name` ("bad field 'mbc' in argument #1 to 'boundary' (unknown field 'k'; …)"). */
+void bind_check_nested_fields(lua_State *L, int tab, int arg, const char *call, const char *name,
+                              const char *const fields[]);
+/* The options of a mode argument (s:measure('stress', { volume = })): 0 when arg is none or nil,
+ * 1 when it is a table whose keys are all in fields (empty: the mode takes no options, and any
+ * key is refused as such); any other value is refused. */
+int bind_mode_options(lua_State *L, int arg, const char *call, const char *mode,
+                      const char *const fields[]);
 
 double bind_field_number(lua_State *L, int arg, const char *call, const char *field, double def,
                          unsigned flags);
@@ -71,8 +82,13 @@ int bind_field_error(lua_State *L, int arg, const char *call, const char *field,
 /* Positional arguments, in the same grammar: "bad argument #N to 'call' (EXPECTED expected, got
  * VALUE)". A number is finite unless BIND_ALLOW_INF; flags as for fields. */
 int bind_arg_error(lua_State *L, int arg, const char *call, const char *expected);
-/* A file path: a non-empty string without NUL bytes (a number is refused, not converted). */
+/* A file path: a non-empty string without NUL bytes (a number is refused, not converted). Every
+ * file name that crosses from Lua into C goes through this or bind_field_path. */
 const char *bind_arg_path(lua_State *L, int arg, const char *call);
+/* The same for field `field` of the table at arg: NULL when absent (unless BIND_REQUIRED); the
+ * string lives in the table. */
+const char *bind_field_path(lua_State *L, int arg, const char *call, const char *field,
+                            unsigned flags);
 double bind_arg_number(lua_State *L, int arg, const char *call, unsigned flags);
 lua_Integer bind_arg_integer(lua_State *L, int arg, const char *call, lua_Integer min,
                              lua_Integer max);
@@ -205,7 +221,8 @@ void bind_open_render(lua_State *L);
  * ("invalid option 'stres'; did you mean 'stress'? Valid options: 'energy', 'stress', ...").
  * Same arguments and result as luaL_checkoption. */
 int bind_check_option(lua_State *L, int arg, const char *def, const char *const names[]);
-/* The name of `names` closest to s (a unique prefix, or within a few edits), or NULL. */
+/* The name of `names` closest to s (a unique prefix, the same name in another case, or within a
+ * few edits of a name of three letters or more), or NULL. */
 const char *bind_closest_name(const char *s, const char *const names[]);
 
 /* The kernel scene of the mpm.scene / dsmc.scene at idx, or a Lua error naming `call`; and a new

@@ -1024,27 +1024,7 @@ static void read_matrix(lua_State *L, int tab, const char *key, int arg, const c
 static void nested_check_fields(lua_State *L, int tab, int arg, const char *call, const char *name,
                                 const char *const fields[])
 {
-    tab = lua_absindex(L, tab);
-    lua_pushnil(L);
-    while (lua_next(L, tab)) {
-        lua_pop(L, 1);
-        int known = 0;
-        for (int i = 0; fields[i] && !known && lua_type(L, -1) == LUA_TSTRING; i++)
-            known = strcmp(lua_tostring(L, -1), fields[i]) == 0;
-        if (!known) {
-            char key[64], list[256] = "";
-            bind_describe(L, -1, key, sizeof key);
-            for (int i = 0; fields[i]; i++) {
-                if (i)
-                    strncat(list, ", ", sizeof list - strlen(list) - 1);
-                strncat(list, fields[i], sizeof list - strlen(list) - 1);
-            }
-            luaL_error(L,
-                       "bad field '%s' in argument #%d to '%s' (unknown field %s; valid "
-                       "fields: %s)",
-                       name, user_argn(L, arg), call, key, list);
-        }
-    }
+    bind_check_nested_fields(L, tab, arg, call, name, fields);
 }
 
 /* Field key of the nested table at tab: a finite number, > 0 (positive) or >= 0, def if absent. */
@@ -1157,7 +1137,9 @@ static int l_boundary(lua_State *L)
     if (!(def.depth > 0))
         return luaL_error(L, "%s: give depth (m): the scene has no thickness (dem.scene{ "
                              "thickness = })", call);
-    def.every = (long)bind_field_integer(L, 2, call, "every", 250, 0, LUA_MAXINTEGER, 0);
+    /* 0 would never rebuild the outline while saying it is rebuilt: edges that never change are
+     * mode = 'edges'. */
+    def.every = (long)bind_field_integer(L, 2, call, "every", 250, 1, LUA_MAXINTEGER, 0);
     double alpha = bind_field_number(L, 2, call, "alpha", 1.5, BIND_NONNEG);
     int lateral = bind_field_option(L, 2, call, "sides", SIDES, 0, 0);
     double kappa = 20, rate = 0, K = 0, mdt = 0;
@@ -1188,8 +1170,19 @@ static int l_boundary(lua_State *L)
         def.gradient = has_g;
         read_matrix(L, mbc, has_g ? "gradient" : "strain_rate", 2, call,
                     has_g ? "mbc.gradient" : "mbc.strain_rate", def.target);
-        if (lua_getfield(L, mbc, "mask") != LUA_TNIL)
+        if (lua_getfield(L, mbc, "mask") != LUA_TNIL) {
             read_matrix(L, mbc, "mask", 2, call, "mbc.mask", def.mask);
+            /* a weight of 0.5 or 2 is no component switched on or off */
+            for (int q = 0; q < 4; q++)
+                if (def.mask[q] != 0 && def.mask[q] != 1) {
+                    char got[64];
+                    snprintf(got, sizeof got, "%g at row %d, column %d", def.mask[q], q / 2 + 1,
+                             q % 2 + 1);
+                    return field_fail(L, 2, call, "mbc.mask",
+                                      "2x2 matrix of 0 (component free) and 1 (component held)",
+                                      got);
+                }
+        }
         lua_pop(L, 1);
         K = nested_number(L, mbc, "K", 2, call, "mbc.K", 0, 1);
         kappa = nested_number(L, mbc, "kappa", 2, call, "mbc.kappa", 20, 1);

@@ -193,11 +193,9 @@ static int l_progress_finish(lua_State *L)
 static int l_write_file(lua_State *L)
 {
     /* strings only: a number would silently become a file name or the file's text */
-    if (lua_type(L, 1) != LUA_TSTRING)
-        bind_arg_error(L, 1, "write_file", "string");
+    const char *path = bind_arg_path(L, 1, "write_file");
     if (lua_type(L, 2) != LUA_TSTRING)
         bind_arg_error(L, 2, "write_file", "string");
-    const char *path = lua_tostring(L, 1);
     size_t len;
     const char *data = lua_tolstring(L, 2, &len);
     core_error err;

@@ -1002,13 +1002,19 @@ static const char *const STRESS_FIELDS[] = {"volume", NULL};
 
 static const char *const DISPLACEMENT_FIELDS[] = {"affine", "center", NULL};
 
+/* The modes that take no options: a table given to them may hold no key. */
+static const char *const NO_FIELDS[] = {NULL};
+
 static int l_measure(lua_State *L)
 {
     static const char *const what_names[] = {"energy", "stress", "coordination", "slip",
                                              "contacts", "displacement", NULL};
+    static const char *const *const what_fields[] = {NO_FIELDS, STRESS_FIELDS, NO_FIELDS,
+                                                     NO_FIELDS, NO_FIELDS, DISPLACEMENT_FIELDS};
     dem_scene *s = check_scene(L, 1);
     const int D = dem_dim(s);
     int what = bind_check_option(L, 2, NULL, what_names);
+    int has_opts = bind_mode_options(L, 3, "measure", what_names[what], what_fields[what]);
     switch (what) {
     case 0: {
         dem_energy e;
@@ -1024,11 +1030,8 @@ static int l_measure(lua_State *L)
     }
     case 1: {
         double volume = 0;
-        if (!lua_isnoneornil(L, 3)) {
-            bind_check_table(L, 3, "measure");
-            bind_check_fields(L, 3, "measure", STRESS_FIELDS);
+        if (has_opts)
             volume = bind_field_number(L, 3, "measure", "volume", 0, BIND_POSITIVE);
-        }
         double sig[3][3];
         long nc = dem_measure_stress(s, volume, sig);
         static const char *const comp[3][3] = {
@@ -1087,9 +1090,7 @@ static int l_measure(lua_State *L)
     default: { /* displacement, optionally relative to an affine field */
         double grad[3][3] = {{0}}, center[3] = {0, 0, 0};
         int affine = 0;
-        if (!lua_isnoneornil(L, 3)) {
-            bind_check_table(L, 3, "measure");
-            bind_check_fields(L, 3, "measure", DISPLACEMENT_FIELDS);
+        if (has_opts) {
             /* affine: D rows of D finite numbers, the shape checked before any row is
              * indexed (a number as a row used to crash lua_rawgeti). */
             if (lua_getfield(L, 3, "affine") != LUA_TNIL) {
@@ -1844,7 +1845,11 @@ void bind_open_dem(lua_State *L)
                                                 {"wall_servo", NULL, SERVO_FIELDS},
                                                 {"timestep", NULL, TIMESTEP_FIELDS},
                                                 {"run", NULL, RUN_FIELDS},
+                                                {"measure", "energy", NO_FIELDS},
                                                 {"measure", "stress", STRESS_FIELDS},
+                                                {"measure", "coordination", NO_FIELDS},
+                                                {"measure", "slip", NO_FIELDS},
+                                                {"measure", "contacts", NO_FIELDS},
                                                 {"measure", "displacement", DISPLACEMENT_FIELDS},
                                                 {"set_forces", NULL, FORCES_FIELDS},
                                                 {"quasistatic", NULL, QUASISTATIC_FIELDS},

@@ -567,25 +567,25 @@ static const char *const PROFILE_FIELDS[] = {"axis", "bins", NULL};
 
 static const char *const VALIDITY_FIELDS[] = {"dt", NULL};
 
+/* The modes that take no options: a table given to them may hold no key. */
+static const char *const NO_FIELDS[] = {NULL};
+
 static int l_measure(lua_State *L)
 {
     static const char *const what_names[] = {"temperature", "a2", "fields", "histogram", "stats",
                                              "profile", "validity", NULL};
+    static const char *const *const what_fields[] = {
+        NO_FIELDS, NO_FIELDS, NO_FIELDS, HISTOGRAM_FIELDS, NO_FIELDS, PROFILE_FIELDS,
+        VALIDITY_FIELDS};
     dsmc_scene *s = check_scene(L, 1);
     const dsmc_scene_def *d = dsmc_def(s);
     int D = d->dim;
     int what = bind_check_option(L, 2, NULL, what_names);
+    int has_opts = bind_mode_options(L, 3, "measure", what_names[what], what_fields[what]);
     if (what == 1 || what == 2 || what == 3 || what == 5) /* a2, fields, histogram, profile */
         whole_scene(L, 1, "measure");
-    int has_opts = !lua_isnoneornil(L, 3);
-    if (has_opts)
-        bind_check_table(L, 3, "measure");
     core_error err;
     if (what == 0 || what == 1) { /* temperature, a2 */
-        if (has_opts) {
-            static const char *const none[] = {NULL};
-            bind_check_fields(L, 3, "measure", none);
-        }
         dsmc_moments m;
         dsmc_measure_moments(s, &m);
         double N = (double)m.n;
@@ -619,10 +619,6 @@ static int l_measure(lua_State *L)
         return 1;
     }
     if (what == 2) { /* fields */
-        if (has_opts) {
-            static const char *const none[] = {NULL};
-            bind_check_fields(L, 3, "measure", none);
-        }
         size_t nc = dsmc_cell_count(s);
         double *buf = malloc(9 * nc * sizeof *buf);
         if (!buf)
@@ -651,7 +647,6 @@ static int l_measure(lua_State *L)
         dsmc_measure_moments(s, &m);
         double sd = sqrt(m.t_over_m), range[2];
         if (has_opts) {
-            bind_check_fields(L, 3, "measure", HISTOGRAM_FIELDS);
             bins = (int)bind_field_integer(L, 3, "measure", "bins", 40, 1, 100000, 0);
             q = bind_field_option(L, 3, "measure", "quantity", qn, 0, 0);
         }
@@ -700,7 +695,6 @@ static int l_measure(lua_State *L)
     if (what == 5) { /* profile */
         int axis = D, bins = d->cells[D - 1];
         if (has_opts) {
-            bind_check_fields(L, 3, "measure", PROFILE_FIELDS);
             axis = (int)bind_field_integer(L, 3, "measure", "axis", D, 1, D, 0);
             bins = (int)bind_field_integer(L, 3, "measure", "bins", d->cells[axis - 1], 1, 1000000,
                                            0);
@@ -724,10 +718,8 @@ static int l_measure(lua_State *L)
     }
     /* validity */
     double dt = 0;
-    if (has_opts) {
-        bind_check_fields(L, 3, "measure", VALIDITY_FIELDS);
+    if (has_opts)
         dt = bind_field_number(L, 3, "measure", "dt", 0, BIND_NONNEG);
-    }
     dsmc_validity v;
     if (dsmc_check_validity(s, dt, &v, &err))
         return bind_raise(L, "measure", &err);
@@ -894,7 +886,11 @@ void bind_open_dsmc(lua_State *L)
                                                 {"add", NULL, ADD_FIELDS},
                                                 {"wall", NULL, WALL_FIELDS},
                                                 {"run", NULL, RUN_FIELDS},
+                                                {"measure", "temperature", NO_FIELDS},
+                                                {"measure", "a2", NO_FIELDS},
+                                                {"measure", "fields", NO_FIELDS},
                                                 {"measure", "histogram", HISTOGRAM_FIELDS},
+                                                {"measure", "stats", NO_FIELDS},
                                                 {"measure", "profile", PROFILE_FIELDS},
                                                 {"measure", "validity", VALIDITY_FIELDS},
                                                 {NULL, NULL, NULL}};

@@ -677,11 +677,15 @@ static int l_run(lua_State *L)
 }
 
 /* ---- measurements ---------------------------------------------------------------------------- */
+/* No mode of m:measure takes options: a table given to it may hold no key. */
+static const char *const NO_FIELDS[] = {NULL};
+
 static int l_measure(lua_State *L)
 {
     static const char *const what_names[] = {"energy", "momentum", "columns", "shear", NULL};
     mpm_scene *s = check_scene(L, 1);
     int what = bind_check_option(L, 2, NULL, what_names);
+    bind_mode_options(L, 3, "measure", what_names[what], NO_FIELDS);
     if (what == 2) {
         const int nx = mpm_def(s)->cells[0];
         double *c = lua_newuserdatauv(L, (size_t)nx * sizeof *c, 0);
@@ -1020,6 +1024,10 @@ void bind_open_mpm(lua_State *L)
                                                 {"timestep", NULL, TIMESTEP_FIELDS},
                                                 {"run", NULL, RUN_FIELDS},
                                                 {"set_velocities", NULL, VELOCITIES_FIELDS},
+                                                {"measure", "energy", NO_FIELDS},
+                                                {"measure", "momentum", NO_FIELDS},
+                                                {"measure", "columns", NO_FIELDS},
+                                                {"measure", "shear", NO_FIELDS},
                                                 {NULL, NULL, NULL}};
     bind_type_fields(L, SCENE, method_fields);
 

@@ -101,9 +101,7 @@ static int l_image_pixel(lua_State *L)
 static int l_image_save(lua_State *L)
 {
     render_image *img = check_image(L, 1);
-    if (lua_type(L, 2) != LUA_TSTRING) /* a number would be converted into a file name */
-        bind_arg_error(L, 2, "save", "string");
-    const char *path = lua_tostring(L, 2);
+    const char *path = bind_arg_path(L, 2, "save");
     core_error err;
     if (render_write_png(img, path, &err) != CORE_OK)
         return bind_raise(L, "save", &err);
@@ -129,7 +127,8 @@ static const char *const SHOW[] = {"force_chains", "rotation", "walls", "colorba
 typedef struct scene_opts {
     render_grains_def def;
     int want_arrows;
-    long frame; /* < 0: none given */
+    int show_walls; /* 'walls' in show: refused beside walls = false */
+    long frame;     /* < 0: none given */
 } scene_opts;
 
 /* A buffer of size bytes placed below the value on top of the stack. */
@@ -168,17 +167,20 @@ static void read_show(lua_State *L, int arg, const char *call, scene_opts *o)
         snprintf(expected + len, sizeof expected - len, "%s'%s'", k ? ", " : "", SHOW[k]);
     }
     char what[200];
-    snprintf(what, sizeof what, "one or an array of %s", expected);
-    lua_Integer n = 1;
-    if (t == LUA_TTABLE)
-        n = (lua_Integer)lua_rawlen(L, -1);
-    if ((t != LUA_TTABLE && t != LUA_TSTRING) || (t == LUA_TTABLE && !pure_array(L, -1)))
+    snprintf(what, sizeof what, "array of %s", expected);
+    /* A list, as the defaults it replaces: a single name ("walls") would read as a list of one
+     * while dropping the box and colour bar unasked. */
+    if (t == LUA_TSTRING) {
+        for (int k = 0; SHOW[k]; k++)
+            if (strcmp(SHOW[k], lua_tostring(L, -1)) == 0)
+                snprintf(what, sizeof what, "array of names (show = { '%s' })", SHOW[k]);
         bind_field_error(L, arg, call, "show", what);
+    }
+    if (t != LUA_TTABLE || !pure_array(L, -1))
+        bind_field_error(L, arg, call, "show", what);
+    lua_Integer n = (lua_Integer)lua_rawlen(L, -1);
     for (lua_Integer i = 1; i <= n; i++) {
-        if (t == LUA_TTABLE)
-            lua_rawgeti(L, -1, i);
-        else
-            lua_pushvalue(L, -1);
+        lua_rawgeti(L, -1, i);
         const char *s = lua_type(L, -1) == LUA_TSTRING ? lua_tostring(L, -1) : "";
         int k = 0;
         while (SHOW[k] && strcmp(SHOW[k], s) != 0)
@@ -189,7 +191,7 @@ static void read_show(lua_State *L, int arg, const char *call, scene_opts *o)
         switch (k) {
         case 0: d->force_chains = true; break;
         case 1: d->rotation = true; break;
-        case 2: break; /* walls are drawn unless walls = false; kept for old scripts */
+        case 2: o->show_walls = 1; break; /* walls are drawn unless walls = false */
         case 3: d->colorbar = true; break;
         case 4: d->box = true; break;
         default: o->want_arrows = 1; break;
@@ -209,6 +211,8 @@ static void read_walls(lua_State *L, int arg, const char *call, dem_scene *s, sc
                                 "{nx, ny, nz} }";
     int t = lua_getfield(L, arg, "walls");
     if (t == LUA_TBOOLEAN && !lua_toboolean(L, -1)) {
+        if (o->show_walls) /* one of the two would be ignored */
+            bind_field_error(L, arg, call, "walls", "true when show has 'walls'");
         lua_pop(L, 1);
         return;
     }
@@ -535,9 +539,7 @@ static int l_png(lua_State *L)
 {
     lua_settop(L, 3);
     check_dem(L, 1, "png");
-    if (lua_type(L, 2) != LUA_TSTRING) /* a number would be converted into a file name */
-        bind_arg_error(L, 2, "png", "string");
-    const char *pattern = lua_tostring(L, 2);
+    const char *pattern = bind_arg_path(L, 2, "png");
     scene_opts o;
     render_image *img = push_image(L); /* freed by __gc even if an error follows */
     int idx = lua_gettop(L);
@@ -631,7 +633,7 @@ static int l_plot(lua_State *L)
     bind_check_table(L, 1, "plot");
     bind_check_fields(L, 1, "plot", PLOT_FIELDS);
     render_plot_def def = render_default_plot_def();
-    const char *file = bind_field_string(L, 1, "plot", "file", NULL, 0);
+    const char *file = bind_field_path(L, 1, "plot", "file", 0);
     def.width = (int)bind_field_integer(L, 1, "plot", "width", 0, RENDER_MIN_SIZE, RENDER_MAX_SIZE, 0);
     def.height = (int)bind_field_integer(L, 1, "plot", "height", 0, RENDER_MIN_SIZE,
                                          RENDER_MAX_SIZE, 0);
@@ -961,7 +963,7 @@ static int l_field(lua_State *L)
     bind_check_table(L, 1, call);
     bind_check_fields(L, 1, call, FIELD_FIELDS);
     render_field_def d = render_default_field_def();
-    const char *file = bind_field_string(L, 1, call, "file", NULL, 0);
+    const char *file = bind_field_path(L, 1, call, "file", 0);
     long frame = (long)bind_field_integer(L, 1, call, "frame", -1, 0, LUA_MAXINTEGER, 0);
     d.width = (int)bind_field_integer(L, 1, call, "width", 0, RENDER_MIN_SIZE, RENDER_MAX_SIZE, 0);
     d.height = (int)bind_field_integer(L, 1, call, "height", 0, RENDER_MIN_SIZE, RENDER_MAX_SIZE,
@@ -1079,7 +1081,7 @@ static int l_points(lua_State *L)
     bind_check_table(L, 1, call);
     bind_check_fields(L, 1, call, POINTS_FIELDS);
     render_points_def d = render_default_points_def();
-    const char *file = bind_field_string(L, 1, call, "file", NULL, 0);
+    const char *file = bind_field_path(L, 1, call, "file", 0);
     long frame = (long)bind_field_integer(L, 1, call, "frame", -1, 0, LUA_MAXINTEGER, 0);
     d.width = (int)bind_field_integer(L, 1, call, "width", 0, RENDER_MIN_SIZE, RENDER_MAX_SIZE, 0);
     d.height = (int)bind_field_integer(L, 1, call, "height", 0, RENDER_MIN_SIZE, RENDER_MAX_SIZE,

@@ -468,14 +468,8 @@ static int l_series_add(lua_State *L)
                           KIND_NAMES[kind]);
     void *s = scene_ptr(L, 2, kind, call);
     double t = scene_time(s, kind);
-    if (!lua_isnoneornil(L, 3)) {
-        t = luaL_checknumber(L, 3);
-        if (!isfinite(t)) {
-            char msg[96];
-            snprintf(msg, sizeof msg, "finite time expected, got %g", t);
-            return luaL_argerror(L, 3, msg);
-        }
-    }
+    if (!lua_isnoneornil(L, 3)) /* a number (not "1.5"), finite, within the bindings' cap */
+        t = bind_arg_number(L, 3, call, 0);
     lua_getiuservalue(L, 1, 1);
     write_opts o = read_opts(L, lua_gettop(L), call, OPT_FIELDS);
     part parts[MAX_PARTS];

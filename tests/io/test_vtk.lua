@@ -23,7 +23,7 @@ s0:add_disk{ pos = { 0.5, 0.5 }, radius = 0.1 }
 check.errors(function() s0:write_vtk(P("x.txt")) end,
   "bad argument #1 to 'write_vtk' (file name ending in .vtu expected, got '", "extension")
 check.errors(function() s0:write_vtk(P("x.vtu"), { contact = true }) end,
-  "bad argument #2 to 'write_vtk' (unknown field 'contact'; valid fields: contacts, walls)",
+  "bad argument #2 to 'write_vtk' (unknown field 'contact'; did you mean 'contacts'? Valid fields: contacts, walls)",
   "typo in an option")
 check.errors(function() s0:write_vtk(P("x.vtu"), { walls = 1 }) end,
   "bad field 'walls' in argument #2 to 'write_vtk' (boolean expected, got 1)", "option type")
@@ -42,7 +42,7 @@ check.errors(function() grainlab.vtk.series(P("run.vtu")) end,
 check.errors(function() grainlab.vtk.series(P("r.pvd")):add({}) end,
   "bad argument #1 to 'add' (dem.scene, mpm.scene or dsmc.scene expected, got table)", "add a table")
 check.errors(function() grainlab.vtk.series(P("r.pvd")):add(s0, 0 / 0) end,
-  "bad argument #2 to 'add' (finite time expected", "NaN time")
+  "bad argument #2 to 'add' (finite number expected, got", "NaN time")
 expect("absent x.vtu")
 expect("absent r.pvd")
 

@@ -1,11 +1,17 @@
--- The generated binding test (issue 12): every registered function of a module gets one valid
--- base call (declared in the test file), then every field of its options table -- the list the
--- binding itself checks, read from grainlab.doc_of(fn).fields -- is replaced, one at a time, by
--- every bad-value class, and every positional argument likewise. Each case must end in a Lua
--- error naming the call and the field (or argument), unless the test file declares that class
--- accepted for that field, in which case the call must succeed. Methods are also called with
+-- The generated binding test: every registered function of a module gets one valid base call
+-- (declared in the test file), then every field of its options table -- the list the binding
+-- itself checks, read from grainlab.doc_of(fn).fields (or .modes[mode]) -- is replaced, one at a
+-- time, by every bad-value class, and every positional argument likewise. Each case must end in
+-- a Lua error naming the call and the field (or argument), unless the test file declares that
+-- class accepted for that field, in which case the call must succeed. The options table (and
+-- each nested table) also gets a key that is no field, which must be refused naming the key,
+-- and a misspelt field, which must be refused with "did you mean" and the field; the options
+-- argument itself gets every value that is not an options table. Methods are also called with
 -- '.' instead of ':'. A field or argument without a declaration fails the test, so a new field
 -- cannot slip through; a registered function without a base call fails it too.
+-- test_fuzz_coverage.lua runs every such test in list mode (the global FUZZ_COVERAGE set: run
+-- records what each test covers and runs no case) and fails when a function of the registry
+-- that takes options is covered by none.
 --
 -- Used by tests/lua/test_fuzz_*.lua:
 --   local fuzz = dofile("fuzz_driver.lua")
@@ -23,6 +29,8 @@
 --     nested = { mbc = { "K", ... } },            -- sub-tables args[opts].mbc (or a path such as
 --                                                  --   "checks.1"): fields fuzzed in place, declared
 --                                                  --   in accept as "mbc.K" ("checks[1].name")
+--     any_keys = { params = "why" },               -- nested tables whose keys are the user's own
+--                                                  --   names (no unknown-key case there)
 --     no_opts = true,                              -- a variant without the options table
 --     todo = { field = "why" },                    -- printed, not fuzzed (a fix pending elsewhere)
 --     name = "add_disk" }                          -- the name errors use (default: the key's)
@@ -204,6 +212,53 @@ local function fuzz_entry(key, e, fn, doc)
         function(a, v) sub(a)[sf] = v end)
     end
   end
+  -- A key that is no field, and a misspelt field, in the options table and in each nested table:
+  -- refused, naming the key (and, misspelt, the field meant). The misspelling is the longest field
+  -- name with an 'x' appended (one edit from it, and from no other field).
+  local function unknown_keys(where, names, label, get)
+    local bogus = "zz_not_a_field"
+    case(key, e, fn, where .. " unknown key '" .. bogus .. "'", function(args) get(args)[bogus] = 1 end,
+      false, { "'" .. bogus .. "'" })
+    local longest = ""
+    for _, f in ipairs(names) do if #f > #longest then longest = f end end
+    if #longest < 4 then return end
+    for _, f in ipairs(names) do
+      if f ~= longest and #f == #longest and f:sub(-1) == "x" then return end
+    end
+    local typo = longest .. "x"
+    cases = cases + 1
+    local ctx = e.setup and e.setup() or {}
+    local args = e.args and e.args(ctx) or {}
+    get(args)[typo] = 1
+    local ok, msg = try(e, e.self and e.self(ctx) or e._module, args, e.nargs or #args)
+    msg = tostring(msg)
+    local what = key .. " " .. where .. " misspelt field '" .. typo .. "'"
+    if ok then
+      fail(what, "accepted (a misspelt field must be refused)")
+    elseif not msg:find("did you mean '" .. longest .. "'", 1, true) then
+      fail(what, "error does not suggest '" .. longest .. "': " .. msg)
+    elseif label and not msg:find("'" .. label .. "'", 1, true) then
+      fail(what, "error does not name the table '" .. label .. "': " .. msg)
+    end
+  end
+  if e.opts and fields then
+    unknown_keys("options:", fields, nil, function(a) a[e.opts] = a[e.opts] or {}; return a[e.opts] end)
+  end
+  for path, subs in pairs(e.nested or {}) do
+    if not (e.any_keys and e.any_keys[path]) then
+      local steps = {}
+      for part in path:gmatch("[^.]+") do steps[#steps + 1] = math.tointeger(tonumber(part)) or part end
+      local label = path:gsub("%.(%d+)", "[%1]")
+      unknown_keys("'" .. label .. "':", subs, label, function(a)
+        local t = a[e.opts]
+        for _, st in ipairs(steps) do t = t[st] end
+        return t
+      end)
+    end
+  end
+  for path in pairs(e.any_keys or {}) do
+    if not (e.nested and e.nested[path]) then fail(key, "any_keys names '" .. path .. "', which is not nested") end
+  end
   -- The options table itself and positional arguments.
   local pos = e.pos or {}
   local probe = e.args and e.args(e.setup and e.setup() or {}) or {}
@@ -228,8 +283,10 @@ local function fuzz_entry(key, e, fn, doc)
   if e.opts and not pos[e.opts] then
     for _, c in ipairs(M.scalar) do
       local cname, v = c[1], c[2]
-      if type(v) ~= "table" and not (cname == "nil" and e.opts_optional) then
-        case(key, e, fn, "options = " .. cname, function(args) args[e.opts] = v; return e.opts end,
+      -- every value but an options table: {} may be one (all fields optional), { {{}} } and
+      -- { a = ... } have keys that are no field
+      if cname ~= "empty" and not (cname == "nil" and e.opts_optional) then
+        case(key, e, fn, "options = " .. cname, function(args) args[e.opts] = copy(v); return e.opts end,
           false, { "#" .. e.opts })
       end
     end
@@ -253,11 +310,25 @@ end
 --         skip = { key = "why" } }
 function M.run(spec)
   local listed = {}
+  local cover = rawget(_G, "FUZZ_COVERAGE")
   local function visit(key, fn, module)
     listed[key] = true
     local e = spec.calls[key]
-    if spec.skip and spec.skip[key] then return end
+    if spec.skip and spec.skip[key] then
+      if cover then cover.skipped[key] = spec.skip[key] end
+      return
+    end
     if not e then fail(key, "registered, but the test has no base call for it"); return end
+    if cover then -- list mode: what this test covers, no case run
+      local c = cover.covered[key] or { modes = {} }
+      cover.covered[key] = c
+      for _, v in ipairs(e[1] and e or { e }) do
+        if v.opts and not v.no_opts then
+          if v.mode then c.modes[v.mode] = true else c.opts = true end
+        end
+      end
+      return
+    end
     local doc = grainlab.doc_of(fn)
     local variants = e[1] and e or { e }
     local modes = {}
@@ -295,6 +366,10 @@ function M.run(spec)
     if not listed[key] then fail(key, "the test has a base call for a function that is not registered") end
   end
   collectgarbage()
+  if cover then
+    if #failures > 0 then error(table.concat(failures, "\n"), 0) end
+    return
+  end
   if #failures > 0 then
     for i = 1, math.min(#failures, 400) do io.stderr:write(failures[i], "\n") end
     error(string.format("%d of %d binding cases failed", #failures, cases), 0)

@@ -189,6 +189,17 @@ check.errors(function() s:boundary{ mode = "delaunay", mbc = { strain_rate = { {
 check.errors(function() s:boundary{ mode = "delaunay", mbc = { strain_rate = { { 1, 0 }, { 0, 1 } }, Kx = 1 } } end,
   "bad field 'mbc' in argument #1 to 'boundary' (unknown field 'Kx'; valid fields: strain_rate, gradient, mask, K, kappa, rate, dt, tau)",
   "mbc typo")
+check.errors(function() s:boundary{ mode = "delaunay", mbc = { strain_rate = { { 1, 0 }, { 0, 1 } }, k = 1 } } end,
+  "(unknown field 'k'; did you mean 'K'? Valid fields:", "mbc: a key in the wrong case")
+-- mask entries switch a component on (1) or off (0): a weight of 2 or 0.5 is refused, not used
+check.errors(function() s:boundary{ mode = "delaunay", mbc = { strain_rate = { { 1, 0 }, { 0, 1 } }, mask = { { 2, 0 }, { 0, 1 } } } } end,
+  "bad field 'mbc.mask' in argument #1 to 'boundary' (2x2 matrix of 0 (component free) and 1 (component held) expected, got 2 at row 1, column 1)",
+  "mbc mask 2")
+check.errors(function() s:boundary{ mode = "delaunay", mbc = { gradient = { { 1, 0 }, { 0, 1 } }, mask = { { 1, 0.5 }, { 1, 1 } } } } end,
+  "(2x2 matrix of 0 (component free) and 1 (component held) expected, got 0.5 at row 1, column 2)", "mbc mask 0.5")
+-- every = 0 would never rebuild the outline it says is rebuilt
+check.errors(function() s:boundary{ mode = "delaunay", every = 0 } end,
+  "bad field 'every' in argument #1 to 'boundary' (positive integer expected, got 0)", "every = 0")
 check.errors(function() s:boundary{ mode = "delaunay", mbc = 5 } end,
   "bad field 'mbc' in argument #1 to 'boundary' (table expected, got 5)", "mbc not a table")
 check.eq(s:boundary{ mode = "delaunay", ids = { 1, 2, 3, 4 } }.edges, 4, "boundary on listed ids")

@@ -10,7 +10,7 @@ check.errors(function() return grainlab.rng{ seed = 1.5 } end,
 check.errors(function() return grainlab.rng{ seed = "x" } end,
   "(non-negative integer expected, got 'x')", "string seed")
 check.errors(function() return grainlab.rng{ sed = 1 } end,
-  "bad argument #1 to 'rng' (unknown field 'sed'; valid fields: seed, stream)", "typo in a field name")
+  "bad argument #1 to 'rng' (unknown field 'sed'; did you mean 'seed'? Valid fields: seed, stream)", "typo in a field name")
 check.errors(function() return grainlab.rng(5) end,
   "bad argument #1 to 'rng' (table expected, got number)", "not a table")
 check.errors(function() return grainlab.rng{ stream = 1e9 } end,
@@ -56,5 +56,5 @@ check.eq(ok, nil, "write_file result")
 check.eq(err, "cannot write '/nonexistent_dir/x.txt': No such file or directory", "write_file message")
 
 check.errors(function() grainlab.doc(print, { nme = "x" }) end,
-  "bad argument #2 to 'doc' (unknown field 'nme'; valid fields: name, usage, doc, fields)", "doc fields")
+  "bad argument #2 to 'doc' (unknown field 'nme'; did you mean 'name'? Valid fields: name, usage, doc, fields)", "doc fields")
 check.done()

@@ -145,21 +145,21 @@ end
 
 -- ---- unknown fields (typos) --------------------------------------------------------------------
 check.errors(function() dem.scene{ box = { { 0, 0 }, { 1, 1 } }, gravty = { 0, -9.81 } } end,
-  "bad argument #1 to 'scene' (unknown field 'gravty'; valid fields: dim, box, gravity, periodic, thickness, skin)", "scene typo")
+  "bad argument #1 to 'scene' (unknown field 'gravty'; did you mean 'gravity'? Valid fields: dim, box, gravity, periodic, thickness, skin)", "scene typo")
 check.errors(function() s:add_disk{ pos = { 0.5, 0.5 }, radius = 1e-3, velocity = { 1, 0 } } end,
   "bad argument #1 to 'add_disk' (unknown field 'velocity'; valid fields: pos, radius, material, vel, omega, fixed, prescribed)", "add_disk typo")
 check.errors(function() s3:add_sphere{ pos = { 0.5, 0.5, 0.5 }, raduis = 1e-3 } end,
   "bad argument #1 to 'add_sphere' (unknown field 'raduis'", "add_sphere typo")
 check.errors(function() s:add_wall{ point = { 0, 0 }, norm = { 0, 1 } } end,
-  "bad argument #1 to 'add_wall' (unknown field 'norm'; valid fields: point, normal, velocity, friction, material)", "add_wall typo")
+  "bad argument #1 to 'add_wall' (unknown field 'norm'; did you mean 'normal'? Valid fields: point, normal, velocity, friction, material)", "add_wall typo")
 check.errors(function() s:contact{ frction = 1 } end,
   "bad argument #1 to 'contact' (unknown field 'frction'; valid fields: normal, stiffness,", "contact typo")
 check.errors(function() s:run{ step = 10 } end,
-  "bad argument #1 to 'run' (unknown field 'step'; valid fields: steps, time, dt,", "run typo")
+  "bad argument #1 to 'run' (unknown field 'step'; did you mean 'steps'? Valid fields: steps, time, dt,", "run typo")
 check.errors(function() s:timestep{ impact = 1 } end,
-  "bad argument #1 to 'timestep' (unknown field 'impact'; valid fields: impact_velocity)", "timestep typo")
+  "bad argument #1 to 'timestep' (unknown field 'impact'; did you mean 'impact_velocity'? Valid fields: impact_velocity)", "timestep typo")
 check.errors(function() grainlab.material{ densty = 2650, young = 1e9 } end,
-  "bad argument #1 to 'material' (unknown field 'densty'; valid fields: density, friction, name, poisson, restitution, rolling_friction, young)", "material typo")
+  "bad argument #1 to 'material' (unknown field 'densty'; did you mean 'density'? Valid fields: density, friction, name, poisson, restitution, rolling_friction, young)", "material typo")
 check.errors(function() s:add_disk{ pos = { 0.5, 0.5 }, radius = 1e-3, material = { density = 2650 } } end,
   "bad field 'material' in argument #1 to 'add_disk' (grainlab.material expected, got table)", "plain table as material")
 

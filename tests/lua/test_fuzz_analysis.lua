@@ -52,7 +52,7 @@ calls["dem.scene:boundary"] = {
       sides = "all", ids = { 1, 2, 3, 4, 5 }, band = true,
       mbc = { strain_rate = { { -1e-3, 0 }, { 0, 1e-3 } }, mask = { { 1, 1 }, { 1, 1 } }, K = 1e3,
               kappa = 20, rate = 1e-3, dt = 1e-6, tau = 1e-3 } } } end,
-    accept = { mode = OPT, pressure = { "nil", "zero" }, depth = OPT, every = { "nil", "zero" },
+    accept = { mode = OPT, pressure = { "nil", "zero" }, depth = OPT, every = OPT,
                alpha = { "nil", "zero" }, sides = OPT, ids = { "nil", "short" }, edges = OPT, closed = OPT,
                band = { "nil", "boolean" }, mbc = OPT,
                ["mbc.strain_rate"] = {}, ["mbc.gradient"] = OPT, ["mbc.mask"] = OPT, ["mbc.K"] = OPT,

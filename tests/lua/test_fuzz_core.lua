@@ -94,8 +94,11 @@ local calls = {
     accept = { size = {}, n = OPT, diameter = OPT, seed = { "nil", "zero" }, width = OPT,
                margin = { "nil", "zero" } },
   },
-  ["grainlab.pretty"] = { args = function() return { { 1, 2 }, { depth = 2 } } end,
-    pos = { ANY, { "nil", "empty" } } },
+  ["grainlab.pretty"] = {
+    args = function() return { { 1, 2 }, { depth = 2, items = 5, fields = 5, width = 80, string = 10 } } end,
+    pos = { ANY }, opts = 2, opts_optional = true,
+    accept = { depth = { "nil", "zero" }, items = { "nil", "zero" }, fields = { "nil", "zero" },
+               width = { "nil", "zero" }, string = { "nil", "zero" } } },
   ["grainlab.show"] = { args = function() return { 1 } end, pos = { ALL } },
   ["grainlab.rng:uniform"] = {
     setup = function() return grainlab.rng{ seed = 1 } end, self = self,
@@ -158,6 +161,7 @@ calls["grainlab.report"] = {
     checks = { { name = "ok", value = 1, limit = 2, op = "<=" }, { name = "flag", pass = true } } } } end,
   nested = { params = { "n", "name", "flags" }, metrics = { "wall_s" },
              ["checks.1"] = { "name", "value", "limit", "op", "pass" } },
+  any_keys = { params = "the scenario's own parameter names", metrics = "the scenario's own metric names" },
   accept = { scenario = { "string" }, params = { "nil", "empty", "keyed" }, metrics = { "nil", "empty", "keyed" },
              checks = { "nil", "empty", "short" },
              ["params.n"] = FIGURE, ["params.name"] = FIGURE, ["params.flags"] = FIGURE,
@@ -187,6 +191,38 @@ calls["grainlab.recorder"] = {
     accept = { file = REC.file, columns = {}, order = {}, units = REC.units, flush = REC.flush,
                ["units.t"] = REC["units.t"] } },
 }
+-- the recorder's methods, on a recorder of two columns and two rows (positive: log axes plot them)
+local function rec2()
+  local k = 0
+  local function count() k = k + 1; return k end
+  local rec = grainlab.recorder{ file = recdir .. "/m.csv", columns = { { "t", count }, { "e", count } },
+                                 units = { t = "s" }, flush = false }
+  rec:sample(0)
+  rec:sample(0)
+  return rec
+end
+calls["grainlab.recorder:sample"] = { setup = rec2, self = self, args = function() return { 0 } end, pos = { ALL } }
+calls["grainlab.recorder:add"] = {
+  -- the keys are the column names (no fixed fields): the table is fuzzed whole
+  setup = function() return grainlab.recorder{ columns = { "a", "b" } } end, self = self,
+  args = function() return { { a = 1, b = 2 } } end, pos = { {} } }
+calls["grainlab.recorder:column"] = { setup = rec2, self = self, args = function() return { "t" } end, pos = { {} } }
+calls["grainlab.recorder:names"] = { setup = rec2, self = self }
+calls["grainlab.recorder:write"] = { setup = rec2, self = self, args = function() return { recdir .. "/w.csv" } end,
+  pos = { { "nil", "string" } }, strings = { recdir .. "/w.csv" } }
+calls["grainlab.recorder:plot"] = {
+  setup = rec2, self = self, opts = 1, strings = { file = recdir .. "/p.png" },
+  args = function() return { { file = recdir .. "/p.png", x = "t", y = "e", labels = { "E" }, title = "T",
+    xlabel = "x", ylabel = "y", xlog = false, ylog = false, width = 240, height = 160, style = "line" } } end,
+  accept = { file = { "string" }, x = OPT, y = OPT, labels = { "nil", "entry_string" }, title = TEXT, xlabel = TEXT, ylabel = TEXT,
+             xlog = { "nil", "boolean" }, ylog = { "nil", "boolean" }, width = OPT, height = OPT, style = OPT } }
+-- grainlab.vtk.series's methods: frames of a small DEM scene into the scratch directory
+local function series() return grainlab.vtk.series(recdir .. "/s.pvd") end
+calls["grainlab.vtk.series:add"] = {
+  setup = function() return { series = series(), s = scene() } end, self = function(ctx) return ctx.series end,
+  args = function(ctx) return { ctx.s, 0.5 } end, pos = { {}, { "nil", "negative", "zero" } } }
+calls["grainlab.vtk.series:info"] = { setup = series, self = self }
+
 local skip = {}
 local grainlab_fns = {}
 for k, v in pairs(grainlab) do
@@ -198,7 +234,9 @@ io.stdout = { write = function(f) return f end, flush = function(f) return f end
 local ok, err = pcall(fuzz.run, {
   modules = { grainlab = grainlab_fns, ["grainlab.pack"] = grainlab.pack, ["grainlab.vtk"] = grainlab.vtk,
               ["grainlab.mpi"] = grainlab.mpi },
-  types = { ["grainlab.rng"] = grainlab.rng{}, ["grainlab.progress"] = grainlab.progress{ total = 1 } },
+  types = { ["grainlab.rng"] = grainlab.rng{}, ["grainlab.progress"] = grainlab.progress{ total = 1 },
+            ["grainlab.recorder"] = grainlab.recorder{ columns = { "a" } },
+            ["grainlab.vtk.series"] = series() },
   calls = calls, skip = skip })
 io.stdout = stdout
 os.remove(tmp)

@@ -181,7 +181,15 @@ local calls = {
                on_step = { "nil", "function" }, progress = BOOL },
   },
   ["dem.scene:measure"] = {
-    { setup = scene2, self = self, args = function() return { "energy" } end, pos = { {} } },
+    -- the modes without options: an empty table (or none), nothing else; the mode name fuzzed once
+    { setup = scene2, self = self, mode = "energy", opts = 2, opts_optional = true,
+      args = function() return { "energy", {} } end, pos = { {} } },
+    { setup = scene2, self = self, mode = "coordination", opts = 2, opts_optional = true,
+      args = function() return { "coordination", {} } end },
+    { setup = scene2, self = self, mode = "slip", opts = 2, opts_optional = true,
+      args = function() return { "slip", {} } end },
+    { setup = scene2, self = self, mode = "contacts", opts = 2, opts_optional = true,
+      args = function() return { "contacts", {} } end },
     { setup = scene2, self = self, mode = "stress", opts = 2, opts_optional = true,
       args = function() return { "stress", { volume = 1 } } end, accept = { volume = OPT } },
     { setup = function() local s = scene2(); s:set_reference(); return s end, self = self,

@@ -81,7 +81,15 @@ local calls = {
                progress = BOOL, warn = BOOL },
   },
   ["dsmc.scene:measure"] = {
-    { setup = scene, self = self, args = function() return { "temperature" } end, pos = { {} } },
+    -- the modes without options: an empty table (or none), nothing else; the mode name fuzzed once
+    { setup = scene, self = self, mode = "temperature", opts = 2, opts_optional = true,
+      args = function() return { "temperature", {} } end, pos = { {} } },
+    { setup = scene, self = self, mode = "a2", opts = 2, opts_optional = true,
+      args = function() return { "a2", {} } end },
+    { setup = scene, self = self, mode = "fields", opts = 2, opts_optional = true,
+      args = function() return { "fields", {} } end },
+    { setup = scene, self = self, mode = "stats", opts = 2, opts_optional = true,
+      args = function() return { "stats", {} } end },
     { setup = scene, self = self, mode = "histogram", opts = 2, opts_optional = true,
       args = function() return { "histogram", { bins = 10, range = { -1, 1 }, quantity = "component" } } end,
       accept = { bins = OPT, range = OPT, quantity = OPT } },

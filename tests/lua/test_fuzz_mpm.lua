@@ -98,7 +98,17 @@ local calls = {
     accept = { steps = { "zero" }, time = OPT, dt = OPT, cfl = OPT, force = BOOL, every = OPT,
                on_step = { "nil", "function" }, progress = BOOL },
   },
-  ["mpm.scene:measure"] = { setup = scene, self = self, args = function() return { "energy" } end, pos = { {} } },
+  -- no mode takes options: an empty table (or none), nothing else; the mode name fuzzed once
+  ["mpm.scene:measure"] = {
+    { setup = scene, self = self, mode = "energy", opts = 2, opts_optional = true,
+      args = function() return { "energy", {} } end, pos = { {} } },
+    { setup = scene, self = self, mode = "momentum", opts = 2, opts_optional = true,
+      args = function() return { "momentum", {} } end },
+    { setup = scene, self = self, mode = "columns", opts = 2, opts_optional = true,
+      args = function() return { "columns", {} } end },
+    { setup = scene, self = self, mode = "shear", opts = 2, opts_optional = true,
+      args = function() return { "shear", {} } end },
+  },
   ["mpm.scene:grain"] = { setup = scene, self = self, args = function() return { 1 } end, pos = { {} } },
   ["mpm.scene:points"] = { setup = scene, self = self },
   ["mpm.scene:info"] = { setup = scene, self = self },

@@ -48,7 +48,7 @@ check.eq(P({ 1, 2, 3, 4, 5, 6, 7, 8 }, { width = 13 }), "{\n  1, 2, 3, 4,\n  5, 
   "array elements fill lines")
 
 check.errors(function() P({}, { depht = 2 }) end,
-  "bad argument #2 to 'pretty' (unknown field 'depht'; valid fields: depth, items, fields, width, string)", "typo in an option")
+  "bad argument #2 to 'pretty' (unknown field 'depht'; did you mean 'depth'? Valid fields: depth, items, fields, width, string)", "typo in an option")
 check.errors(function() P({}, { depth = -1 }) end,
   "bad field 'depth' in argument #2 to 'pretty' (non-negative integer expected, got -1)", "bad option value")
 

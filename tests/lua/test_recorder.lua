@@ -78,7 +78,7 @@ check.eq((slurp(png2) or ""):sub(1, 4), "\137PNG", "log plot: zeros, NaN and -in
 -- ---- refusals, at construction or at the first sample, naming the call and the field ---------
 local function R(t) return grainlab.recorder(t) end
 check.errors(R, "bad argument #1 to 'recorder' (table expected, got nil)", "no table")
-check.errors(R, "unknown field 'colums'; valid fields: columns, file, flush, order, units", "typo", { colums = { "a" } })
+check.errors(R, "unknown field 'colums'; did you mean 'columns'? Valid fields: columns, file, flush, order, units", "typo", { colums = { "a" } })
 check.errors(R, "bad field 'columns' in argument #1 to 'recorder' (non-empty table of columns expected, got nil)", "no columns", {})
 check.errors(R, "bad field 'columns[2]' in argument #1 to 'recorder' (column name (text without , \" or a line break) expected, got 'a,b')",
              "comma in a name", { columns = { "x", "a,b" } })

@@ -90,34 +90,43 @@ bad({ width = 100000 },
   "bad field 'width' in argument #3 to 'png' (integer in [16, 8192] expected, got 100000)", "huge width")
 bad({ height = -5 }, "bad field 'height' in argument #3 to 'png' (integer in [16, 8192] expected, got -5)",
   "negative height")
-bad({ colour = "speed" }, "bad argument #3 to 'png' (unknown field 'colour'; valid fields:", "unknown field")
+bad({ colour = "speed" }, "bad argument #3 to 'png' (unknown field 'colour'; did you mean 'color'? Valid fields:", "unknown field")
 bad({ color = "texture" },
   "bad field 'color' in argument #3 to 'png' (one of 'grain', 'speed', 'rotation', 'material' or an array of numbers expected, got 'texture')",
   "unknown colour")
 bad({ color = { 1, 2 } }, "bad field 'color' in argument #3 to 'png' (array of 31 finite numbers (one per grain) expected",
   "short value array")
-bad({ show = "chains" }, "bad field 'show' in argument #3 to 'png' (one or an array of 'force_chains', 'rotation'",
+bad({ show = { "chains" } }, "bad field 'show' in argument #3 to 'png' (array of 'force_chains', 'rotation'",
   "unknown show")
+bad({ show = "chains" }, "bad field 'show' in argument #3 to 'png' (array of 'force_chains', 'rotation'",
+  "show: an unknown name alone")
+-- a single name is a list of one written without its braces: refused, the braces shown (it also
+-- drops the default box and colour bar, which a list says openly)
+bad({ show = "walls" }, "bad field 'show' in argument #3 to 'png' (array of names (show = { 'walls' }) expected, got 'walls')",
+  "show: one name without a list")
+-- 'walls' in show with walls = false: one of the two would be ignored
+bad({ show = { "walls" }, walls = false }, "bad field 'walls' in argument #3 to 'png' (true when show has 'walls' expected, got false)",
+  "show 'walls' against walls = false")
 bad({ range = { 1, 0 } }, "bad field 'range' in argument #3 to 'png' ({lo, hi} with lo < hi expected, got table)",
   "decreasing range")
 bad({ stamp = 3 }, "bad field 'stamp' in argument #3 to 'png' (boolean or string expected, got 3)", "stamp")
 bad({ walls = { { point = { 0, 0 } } } }, "bad field 'walls' in argument #3 to 'png'", "wall without normal")
 bad("big", "bad argument #3 to 'png' (table expected, got string)", "options not a table")
 check.errors(function() render.png(nil, out) end, "bad argument #1 to 'png' (dem.scene expected, got nil)", "no scene")
-check.errors(function() render.png(s) end, "bad argument #2 to 'png' (string expected, got nil)", "no file")
+check.errors(function() render.png(s) end, "bad argument #2 to 'png' (file path (string) expected, got nil)", "no file")
 check.errors(function() render.png(s, dir .. "/f_%s.png") end, "one %d, %5d or %05d-style frame number", "bad pattern")
 check.errors(function() render.png(s, dir .. "/missing/x.png") end, "png: cannot write '" .. dir .. "/missing/x.png'",
   "unwritable path")
-check.errors(function() render.png(s, out, { show = "displacement" }) end,
+check.errors(function() render.png(s, out, { show = { "displacement" } }) end,
   "png: no reference state: call set_reference first", "arrows without a reference")
 s:set_reference()
-check.errors(function() render.png(s, out, { show = "displacement", displacement = { scale = -1 } }) end,
+check.errors(function() render.png(s, out, { show = { "displacement" }, displacement = { scale = -1 } }) end,
   "bad field 'displacement.scale' in argument #3 to 'png' (non-negative number expected, got", "arrow scale")
-check.errors(function() render.png(s, out, { show = "displacement", displacement = { affine = { 1, 2 } } }) end,
+check.errors(function() render.png(s, out, { show = { "displacement" }, displacement = { affine = { 1, 2 } } }) end,
   "bad field 'displacement.affine' in argument #3 to 'png' (2 x 2 array of finite numbers", "affine")
 local s3 = dem.scene{ dim = 3, box = { { 0, 0, 0 }, { 1, 1, 1 } } }
 s3:add_sphere{ pos = { 0.5, 0.5, 0.5 }, radius = 0.2 }
-check.errors(function() render.png(s3, out, { show = "force_chains" }) end,
+check.errors(function() render.png(s3, out, { show = { "force_chains" } }) end,
   "png: force chains, rotation markers and arrows are drawn in 2D scenes only", "chains in 3D")
 check.errors(function() render.png(s3, out, { camera = { fov = 120 } }) end,
   "bad field 'camera.fov' in argument #3 to 'png' (number in (0, 90) expected, got 120)", "camera fov")

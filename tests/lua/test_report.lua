@@ -17,7 +17,7 @@ check.errors(function() json.encode(cyc) end, "contains itself", "json cycle")
 local function rep(t) return function() grainlab.report(t) end end
 check.errors(rep(nil), "bad argument #1 to 'report' (table expected, got nil)", "no table")
 check.errors(rep{ metrics = {} }, "bad field 'scenario' in argument #1 to 'report' (non-empty string expected, got nil)", "no scenario")
-check.errors(rep{ scenario = "s", metric = {} }, "(unknown field 'metric'; valid fields: checks, metrics, params, scenario)", "typo")
+check.errors(rep{ scenario = "s", metric = {} }, "(unknown field 'metric'; did you mean 'metrics'? Valid fields: checks, metrics, params, scenario)", "typo")
 check.errors(rep{ scenario = "s", metrics = { WallTime = 1 } }, "snake_case metric names", "metric name")
 check.errors(rep{ scenario = "s", metrics = { x = print } }, "bad field 'metrics.x' in argument #1 to 'report' (number, string, boolean or table expected, got function)", "metric value")
 check.errors(rep{ scenario = "s", checks = { { name = "a", value = 1 } } }, "bad field 'checks[1].limit' in argument #1 to 'report' (number (or give pass=) expected, got nil)", "missing limit")
@@ -37,6 +37,14 @@ check.errors(rep{ scenario = "s", metrics = { t = { 1, x = 2 } } }, "(not both)"
 local loop = {}
 loop.again = loop
 check.errors(rep{ scenario = "s", metrics = { t = loop } }, "bad field 'metrics.t.again' in argument #1 to 'report' (table that does not contain itself", "cycle")
+
+-- The scenario names the run in JSON and in file names: letters, digits, '_', '.', '-'.
+local SCENARIO = "(scenario name of letters, digits, '_', '.' and '-' (starting with a letter or digit, at most 64) expected, got "
+check.errors(rep{ scenario = "my run! /x" }, "bad field 'scenario' in argument #1 to 'report' " .. SCENARIO .. "'my run! /x')", "spaces and punctuation")
+check.errors(rep{ scenario = "../up" }, SCENARIO .. "'../up')", "a path")
+check.errors(rep{ scenario = "-x" }, SCENARIO .. "'-x')", "a leading dash")
+check.errors(rep{ scenario = string.rep("a", 65) }, SCENARIO, "65 characters")
+check.errors(rep{ scenario = "a\0b" }, SCENARIO, "a NUL byte")
 
 -- One passing report.
 local passed, r = grainlab.report{
