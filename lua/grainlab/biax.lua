@@ -517,4 +517,7 @@ for name, usage in pairs{ save = "grainlab.biax.save(s)", plate_forces = "grainl
   grainlab.doc(biax[name], { name = "grainlab.biax." .. name, usage = usage, doc = "See help(grainlab.biax)." })
 end
 
+-- Errors below these entries are reported at the user's line (grainlab.entry).
+require("grainlab.entry").wrap_all(biax)
+
 return biax

@@ -926,6 +926,7 @@ static int l_run(lua_State *L)
     if (lua_isnil(L, -1) || (lua_type(L, -1) == LUA_TSTRING && strcmp(lua_tostring(L, -1), "auto") == 0)) {
         /* Two timescales: the large step n dt is the one that must be the automatic step. */
         run.dt = run.integrator == DEM_TWO_TIMESCALES ? ts.dt_auto / run.tt_n : ts.dt_auto;
+        run.dt_auto = true;
     } else {
         lua_pop(L, 1);
         run.dt = bind_field_number(L, 2, "run", "dt", 0, BIND_POSITIVE);
@@ -945,6 +946,8 @@ static int l_run(lua_State *L)
         }
     }
     lua_pop(L, 1);
+    run.dt_limit = ts.limit;
+    run.dt_speed = ts.impact_velocity;
     long steps;
     double time;
     if (!bind_steps_or_time(L, 2, "run", &steps, &time))
