@@ -37,6 +37,12 @@ lines "$err" 1 syntax
 run "$G" runtime_error.lua </dev/null
 expect_rc 1 runtime; has "$err" "runtime_error.lua:2: attempt to index a nil value (local 'v')" runtime
 has "$err" "stack traceback:" runtime; has "$err" "runtime_error.lua:4: in main chunk" runtime
+run "$G" library_error.lua </dev/null
+expect_rc 1 library-error; has "$err" "grainlab: library_error.lua:6: run: particle " library-error
+has "$err" "likely cause: no wall on the " library-error
+has "$err" "stack traceback:" library-error; has "$err" "library_error.lua:6: in main chunk" library-error
+case "$err" in *lua/grainlab/*) bad "library-error: library frames or positions shown" ;; *) ok ;; esac
+lines "$err" 3 library-error
 run "$G" -e 'error({})' </dev/null
 expect_rc 1 error-object; has "$err" "(error object is a table value)" error-object
 
