@@ -148,23 +148,25 @@ static void stop_hook(lua_State *L, lua_Debug *ar)
     if (interrupt_terminating()) /* stays set: a script's pcall cannot swallow a termination */
         luaL_error(L, "terminated (SIGTERM)");
     lua_sethook(L, NULL, 0, 0);
+    /* Handled: the interrupt becomes this error. Inside a run (its on_step) the run lowers the
+     * flag when it stops; outside one, here, so that a later run starts clean. */
+    if (bind_run_depth() == 0)
+        interrupt_clear();
     luaL_error(L, "interrupted by Ctrl-C");
 }
 
-/* A second Ctrl-C before the first is handled ends the process, without leaving the temporary
- * files of writes in progress behind. */
-static void on_second_sigint(int sig)
-{
-    fileio_remove_temporaries();
-    signal(sig, SIG_DFL);
-    raise(sig);
-}
-
 /* Only async-signal-safe work: a flag for the kernels and a hook for the Lua VM (lua.c does the
- * same). */
+ * same). A second Ctrl-C before the first is handled (the flag still up: neither a run nor the
+ * hook has turned it into an error yet) ends the process, without leaving the temporary files of
+ * writes in progress behind. */
 static void on_sigint(int sig)
 {
-    signal(sig, on_second_sigint);
+    if (interrupt_pending_here() && !interrupt_terminating()) {
+        fileio_remove_temporaries();
+        signal(sig, SIG_DFL);
+        raise(sig);
+        return;
+    }
     interrupt_request();
     /* Distributed, the ranks stop together where the engines agree (between steps): a hook would
      * raise in each rank's Lua at a different place, and leave the others waiting. */

@@ -159,6 +159,23 @@ if grep -Eq 'run: interrupted at step [0-9]+ of 1000000000 of this run \(t = [0-
 then ok; else bad "run-sigint: error message"; fi
 [ "$(grep -c 'done,' <<<"$err")" -eq 0 ] && ok || bad "run-sigint: says done"
 
+# --- a caught Ctrl-C is handled: later runs go to their end, a later Ctrl-C interrupts again ---
+"$G" interrupt_resume.lua </dev/null >"$tmp/out" 2>"$tmp/err" &
+pid=$!
+for phase in 1 2; do
+  for _ in $(seq 200); do grep -q "running$phase" "$tmp/err" 2>/dev/null && break; sleep 0.05; done
+  kill -INT "$pid"
+done
+finish_long
+expect_rc 0 interrupt-resume
+if grep -Eq '^caught1	false	run: interrupted at step [0-9]+ of 1000000000 of this run' <<<"$out" \
+   || grep -Eq '^caught1	false	.*interrupted by Ctrl-C \(in on_step' <<<"$out"
+then ok; else bad "interrupt-resume: the first Ctrl-C stops the run"; fi
+if grep -Eq '^caught2	false	.*interrupted by Ctrl-C$' <<<"$out"; then ok; else bad "interrupt-resume: the hook's error"; fi
+for phase in after1 after2; do
+  for e in dem mpm dsmc; do has "$out" "$phase	$e	10" "interrupt-resume ($phase, $e)"; done
+done
+
 # --- SIGTERM: stops between steps, removes temporaries, says where, exits 128 + 15 ---
 mkdir -p "$tmp/w"
 start_long "$G" long_run.lua write=true out="$tmp/w/big.dat" </dev/null
