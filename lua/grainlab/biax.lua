@@ -502,7 +502,7 @@ function biax.axial(lab)
 end
 
 -- Errors below these entries are reported at the user's line (grainlab.entry).
-require("grainlab.entry").wrap_all(biax)
+require("grainlab.entry").wrap_all(biax, "grainlab.biax")
 
 -- Each function answers help() itself; those taking a configuration list its fields.
 for name, usage in pairs{

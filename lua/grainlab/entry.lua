@@ -34,20 +34,29 @@ local function handler(msg)
   return user_where() .. rest
 end
 
+-- The entry the script called, while it runs (the outermost one when entries nest): the C
+-- bindings name it in their notices (bind_entry_name), so that a note about a grain that
+-- grainlab.pack.deposit added says "grainlab.pack.deposit", not "add_disk".
+local state = {}
+debug.getregistry()["grainlab.entry"] = state
+
 -- The error is raised from the wrapper's own frame (not a tail call), so that a traceback goes
 -- from the user's line straight to the entry.
-function entry.wrap(fn)
+function entry.wrap(fn, name)
   return function(...)
+    local outer = state.current
+    state.current = outer or name
     local r = table.pack(xpcall(fn, handler, ...))
+    state.current = outer
     if not r[1] then error(r[2], 0) end
     return table.unpack(r, 2, r.n)
   end
 end
 
--- Wraps every function of a module table in place.
-function entry.wrap_all(module)
+-- Wraps every function of a module table in place; prefix names them ("grainlab.pack").
+function entry.wrap_all(module, prefix)
   for name, v in pairs(module) do
-    if type(v) == "function" then module[name] = entry.wrap(v) end
+    if type(v) == "function" then module[name] = entry.wrap(v, prefix .. "." .. name) end
   end
   return module
 end

@@ -707,7 +707,7 @@ function pack.slab(opts)
 end
 
 -- Errors below these entries are reported at the user's line (grainlab.entry).
-require("grainlab.entry").wrap_all(pack)
+require("grainlab.entry").wrap_all(pack, "grainlab.pack")
 
 -- Each function answers help() itself, with the fields its entry check accepts.
 for name, usage in pairs{

@@ -112,6 +112,17 @@ print("added", m:info().grains)' </dev/null
 expect_rc 0 mpm-overlap; has "$out" "added	2" mpm-overlap
 has "$err" "grainlab: warning: add_disk: grain 2 overlaps grain 1 by 0.1 m" mpm-overlap
 
+# --- the default material is named once per scene, with what it costs; --quiet silences it ---
+run "$G" default_material.lua </dev/null
+expect_rc 0 default-material; has "$out" "dt	" default-material
+dt=$(sed -n 's/^dt\t//p' <<<"$out" | head -1)
+has "$err" "grainlab: note: add_disk: no material given, using the default quartz (E = 30 GPa, rho = 2650 kg/m^3): its contact time sets dt = \"auto\" to $dt s here" default-material
+has "$err" "; pass material = grainlab.material{...}" default-material
+has "$err" "grainlab: note: grainlab.pack.random: no material given, using the default quartz" default-material
+lines "$err" 2 default-material
+run "$G" --quiet default_material.lua </dev/null
+expect_rc 0 default-material-quiet; [ -z "$err" ] && ok || bad "default-material-quiet: printed"
+
 # --- Ctrl-C (SIGINT) stops a running script with an error naming it ---
 # The signals are sent once the script says it runs: a background job of this non-interactive
 # shell starts with SIGINT ignored until grainlab's handler is in place, so a signal sent at a
