@@ -31,6 +31,12 @@ run "$G" --report </dev/null;   expect_rc 2 report-no-file; has "$err" "--report
 # --- scripts and their errors ---
 run "$G" no_such_script.lua </dev/null
 expect_rc 1 missing-script; has "$err" "cannot open no_such_script.lua" missing-script; lines "$err" 1 missing-script
+# docs/cli.md's exit status table says the same: the status of the row naming each case
+doc_status() { grep -E "^ *\| [0-9]+ \|.*$1" ../../docs/cli.md | sed -E 's/^ *\| ([0-9]+) \|.*/\1/'; }
+[ "$(doc_status 'script that cannot be read')" = 1 ] && ok || bad "docs/cli.md: a missing script's status"
+[ "$(doc_status 'unknown option')" = 2 ] && ok || bad "docs/cli.md: an unknown option's status"
+[ "$(doc_status 'argument without')" = 2 ] && ok || bad "docs/cli.md: an argument without = status"
+[ "$(doc_status 'a Lua error')" = 1 ] && ok || bad "docs/cli.md: a Lua error's status"
 run "$G" syntax_error.lua </dev/null
 expect_rc 1 syntax; has "$err" "syntax_error.lua:4: ')' expected (to close '(' at line 3) near 'end'" syntax
 lines "$err" 1 syntax
