@@ -27,13 +27,17 @@ end
 args.describe = describe
 
 -- The error is raised at the user's call: the first frame above the grainlab.* Lua modules
--- (so helpers may nest freely). A C caller (pcall) gets no position, as with the C bindings.
+-- (so helpers may nest freely), and above the C functions they call (xpcall in grainlab.entry).
+-- A C caller (pcall) gets no position, as with the C bindings.
+local function library(info) return info and info.short_src:find("grainlab/[%w_]+%.lua$") end
 local function user_level()
   local level = 3 -- 1: user_level's caller's error call site is level 2 of raise
   while true do
     local info = debug.getinfo(level, "S")
     if not info then return 1 end
-    if not info.short_src:find("grainlab/[%w_]+%.lua$") then return level - 1 end
+    if not (library(info) or info.what == "C" and library(debug.getinfo(level + 1, "S"))) then
+      return level - 1
+    end
     level = level + 1
   end
 end

@@ -501,6 +501,9 @@ function biax.axial(lab)
   return lab.cfg.rate * (s:info().time - lab.t0)
 end
 
+-- Errors below these entries are reported at the user's line (grainlab.entry).
+require("grainlab.entry").wrap_all(biax, "grainlab.biax")
+
 -- Each function answers help() itself; those taking a configuration list its fields.
 for name, usage in pairs{
   config = "grainlab.biax.config{ ... }", prepare = "grainlab.biax.prepare{ n = 400, seed = 1, ... }",

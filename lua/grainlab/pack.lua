@@ -706,6 +706,9 @@ function pack.slab(opts)
   return { x = ox, y = oy, r = or_, area_fraction = area / (L * L), shrink = worst + 1e-3, mean_radius = rsum / #ox }
 end
 
+-- Errors below these entries are reported at the user's line (grainlab.entry).
+require("grainlab.entry").wrap_all(pack, "grainlab.pack")
+
 -- Each function answers help() itself, with the fields its entry check accepts.
 for name, usage in pairs{
   random = "grainlab.pack.random(s, { n =, radius = r | {min, max}, region = {{lo},{hi}}, seed =, material =, max_tries =, speed = })",

@@ -148,23 +148,25 @@ static void stop_hook(lua_State *L, lua_Debug *ar)
     if (interrupt_terminating()) /* stays set: a script's pcall cannot swallow a termination */
         luaL_error(L, "terminated (SIGTERM)");
     lua_sethook(L, NULL, 0, 0);
+    /* Handled: the interrupt becomes this error. Inside a run (its on_step) the run lowers the
+     * flag when it stops; outside one, here, so that a later run starts clean. */
+    if (bind_run_depth() == 0)
+        interrupt_clear();
     luaL_error(L, "interrupted by Ctrl-C");
 }
 
-/* A second Ctrl-C before the first is handled ends the process, without leaving the temporary
- * files of writes in progress behind. */
-static void on_second_sigint(int sig)
-{
-    fileio_remove_temporaries();
-    signal(sig, SIG_DFL);
-    raise(sig);
-}
-
 /* Only async-signal-safe work: a flag for the kernels and a hook for the Lua VM (lua.c does the
- * same). */
+ * same). A second Ctrl-C before the first is handled (the flag still up: neither a run nor the
+ * hook has turned it into an error yet) ends the process, without leaving the temporary files of
+ * writes in progress behind. */
 static void on_sigint(int sig)
 {
-    signal(sig, on_second_sigint);
+    if (interrupt_pending_here() && !interrupt_terminating()) {
+        fileio_remove_temporaries();
+        signal(sig, SIG_DFL);
+        raise(sig);
+        return;
+    }
     interrupt_request();
     /* Distributed, the ranks stop together where the engines agree (between steps): a hook would
      * raise in each rank's Lua at a different place, and leave the others waiting. */
@@ -217,6 +219,43 @@ static int terminated(void)
     return 128 + sig;
 }
 
+/* The chunk names of the embedded library (cmake/embed_lua.cmake), as a traceback shows them. */
+static const char LIBRARY_FRAME[] = "\n\tlua/grainlab/";
+
+/* Lua's traceback without the frames of the embedded library, nor the C functions it called:
+ * an error from inside grainlab.pack.deposit shows the lines of the user's script that led to
+ * it. A message that already holds a traceback (grainlab.entry gives one to a runtime error in
+ * the library's code) or whose position is in the library (such an error outside an entry) keeps
+ * every frame. */
+static void push_traceback(lua_State *L, const char *msg)
+{
+    if (strstr(msg, "\nstack traceback:\n")) {
+        lua_pushstring(L, msg);
+        return;
+    }
+    luaL_traceback(L, L, msg, 1);
+    if (strncmp(msg, LIBRARY_FRAME + 2, sizeof LIBRARY_FRAME - 3) == 0)
+        return;
+    const char *tb = lua_tostring(L, -1), *head = strstr(tb, "\nstack traceback:");
+    luaL_Buffer b;
+    luaL_buffinit(L, &b);
+    luaL_addlstring(&b, tb, (size_t)(head - tb) + 17);
+    /* one line per frame, innermost first: a C frame goes with the library when its caller, on
+     * the next line, is a library frame */
+    for (const char *p = head + 17; *p;) {
+        const char *end = strchr(p + 1, '\n');
+        size_t n = end ? (size_t)(end - p) : strlen(p);
+        int library = strncmp(p, LIBRARY_FRAME, sizeof LIBRARY_FRAME - 1) == 0;
+        if (!library && strncmp(p, "\n\t[C]: ", 7) == 0 && end)
+            library = strncmp(end, LIBRARY_FRAME, sizeof LIBRARY_FRAME - 1) == 0;
+        if (!library)
+            luaL_addlstring(&b, p, n);
+        p += n;
+    }
+    luaL_pushresult(&b);
+    lua_remove(L, -2);
+}
+
 static int message_handler(lua_State *L)
 {
     const char *msg = lua_tostring(L, 1);
@@ -225,7 +264,7 @@ static int message_handler(lua_State *L)
             return 1;
         msg = lua_pushfstring(L, "(error object is a %s value)", luaL_typename(L, 1));
     }
-    luaL_traceback(L, L, msg, 1);
+    push_traceback(L, msg);
     return 1;
 }
 

@@ -276,6 +276,12 @@ typedef struct dem_run_def {
     int tt_m, tt_n, tt_q;  /* TWO_TIMESCALES: cycles of one step n dt and q steps dt; m only names
                             * the macro step N_S = m (n + q) of the paper (the cycle repeats) */
     progress *progress;    /* may be NULL */
+    /* How dt was chosen, for the likely cause an instability names (a blow-up is blamed on dt
+     * only when the user forced it above the limit): */
+    bool dt_auto;          /* dt is the automatic step (dem_timestep.dt_auto) */
+    double dt_limit;       /* the stability limit dt (for TWO_TIMESCALES n dt) was checked
+                            * against; 0 = unknown */
+    double dt_speed;       /* the impact velocity of that limit, m/s; 0 = unknown */
 } dem_run_def;
 
 dem_run_def dem_default_run_def(void);

@@ -138,6 +138,9 @@ struct dem_scene {
     int watch_on;
     long watch_next, watch_min_step;
     double watch_min, watch_min_t, watch_scale;
+
+    /* The run in progress (integrate.c), for the likely cause of an instability. */
+    const dem_run_def *run;
 };
 
 /* domain.c: the decomposition over MPI ranks (comm.h). dem_domain_start decomposes a replicated

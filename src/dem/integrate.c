@@ -65,15 +65,135 @@ static core_status prepare(dem_scene *s, const dem_run_def *run, core_error *err
     return CORE_OK;
 }
 
-/* The step being taken when a check fails is s->steps + 1 (steps counts completed ones). */
+/* ---- the likely cause of an instability ------------------------------------------------------
+ * Read from what the scene shows, in this order: a time step the user forced above the stability
+ * limit (only then is dt blamed); a particle that left the box by a side that has no wall;
+ * contacts so soft that gravity alone, or an impact at the speed the step was chosen for,
+ * squeezes a grain by a large part of its radius (no time step cures that: a modulus in the
+ * wrong units, E = 5 Pa for 5 MPa). Local data only (particle i, the walls, the run's settings):
+ * on several ranks only the one that holds the particle writes the message. */
+#define DEM_SOFT_LOAD 0.1   /* overlap under a grain's own weight, of its radius */
+#define DEM_SOFT_IMPACT 0.5 /* overlap of a head-on impact at the reference speed, of its radius */
+
+static const char AXES[3] = {'x', 'y', 'z'};
+
+/* A side of the box (axis d, sign +1 for hi, -1 for lo) that no wall closes: no plane faces it,
+ * and no wall beyond planes (a drum, a hopper) may hold the particles in. */
+static int side_open(const dem_scene *s, int d, int sign)
+{
+    for (int w = 0; w < s->nwalls; w++) {
+        const dem_wall *wl = &s->walls[w];
+        if (wl->active && (wl->shape || sign * wl->normal[d] < -0.5))
+            return 0;
+    }
+    return 1;
+}
+
+/* The "k = ..." of a pair of particle i's material, as the user gave it. */
+static void stiffness_text(const dem_scene *s, size_t i, char *buf, size_t n)
+{
+    const dem_contact_def *c = &s->contact;
+    if (c->normal == DEM_NORMAL_HERTZ)
+        snprintf(buf, n, "E = %.3g Pa", s->mats[s->mat[i]].young);
+    else if (c->normal == DEM_NORMAL_LINEAR)
+        snprintf(buf, n, "k = %.3g N/m", c->stiffness);
+    else
+        snprintf(buf, n, "k = %.3g N/m^%g", c->stiffness, c->beta);
+}
+
+static void likely_cause(const dem_scene *s, size_t i, char *buf, size_t n)
+{
+    const int D = s->dim;
+    const dem_run_def *run = s->run;
+    double dt = run ? run->dt * (run->integrator == DEM_TWO_TIMESCALES ? run->tt_n : 1) : 0;
+    if (run && !run->dt_auto && run->dt_limit > 0 && dt > run->dt_limit) {
+        snprintf(buf, n,
+                 "the time step is too large: dt = %.3g s is %.3g times the stability limit "
+                 "%.3g s (forced); use dt = \"auto\" or a smaller dt",
+                 dt, dt / run->dt_limit, run->dt_limit);
+        return;
+    }
+    for (int d = 0; d < D; d++) { /* out of the box: by which side, and is it open? */
+        int sign = s->x[d][i] > s->hi[d] ? 1 : s->x[d][i] < s->lo[d] ? -1 : 0;
+        if (s->periodic[d] || !sign || !side_open(s, d, sign))
+            continue;
+        char point[96], normal[32];
+        int pl = 0, nl = 0;
+        for (int e = 0; e < D; e++) {
+            double p = e == d ? (sign > 0 ? s->hi[e] : s->lo[e]) : s->lo[e];
+            pl += snprintf(point + pl, sizeof point - (size_t)pl, "%s%.6g", e ? ", " : "", p);
+            nl += snprintf(normal + nl, sizeof normal - (size_t)nl, "%s%d", e ? ", " : "",
+                           e == d ? -sign : 0);
+        }
+        snprintf(buf, n,
+                 "no wall on the %c%c side of the box (%c = %.6g m): add one, s:add_wall{ point "
+                 "= {%s}, normal = {%s} }, or make the %c axis periodic",
+                 sign > 0 ? '+' : '-', AXES[d], AXES[d], sign > 0 ? s->hi[d] : s->lo[d], point,
+                 normal, AXES[d]);
+        return;
+    }
+    double g = 0, h = 0;
+    for (int d = 0; d < D; d++) {
+        g += s->gravity[d] * s->gravity[d];
+        if (s->gravity[d] != 0)
+            h = fmax(h, s->len[d]);
+    }
+    g = sqrt(g);
+    const double r = s->r[i], m = s->m[i];
+    const dem_contact_def *c = &s->contact;
+    double beta = c->normal == DEM_NORMAL_LINEAR  ? 1
+                  : c->normal == DEM_NORMAL_POWER ? c->beta
+                                                  : 1.5;
+    double k = 0, gamma = 0;
+    if (r > 0 && m > 0 && isfinite(m))
+        dem_probe_parameters(s, s->mat[i], r, m, &k, &gamma);
+    char stiff[64];
+    stiffness_text(s, i, stiff, sizeof stiff);
+    if (k > 0) {
+        /* on a grain like it: k delta^beta = m g */
+        double load = pow(m * g / k, 1 / beta) / r;
+        if (load > DEM_SOFT_LOAD) {
+            snprintf(buf, n,
+                     "the contact stiffness is too small for the load: %s gives overlaps of %.3g "
+                     "times the radius (r = %.3g m) under gravity alone; check the units (Pa)",
+                     stiff, load, r);
+            return;
+        }
+        /* a head-on impact on a grain like it at the speed the step was chosen for, or of a
+         * fall through the box: (beta + 1)/2 m_eff v^2 = k delta^(beta + 1), m_eff = m/2 */
+        double v = run && run->dt_speed > 0 ? run->dt_speed : fmax(sqrt(2 * g * h), 0.1);
+        double impact = pow((beta + 1) * 0.25 * m * v * v / k, 1 / (beta + 1)) / r;
+        if (impact > DEM_SOFT_IMPACT) {
+            snprintf(buf, n,
+                     "the contact stiffness is too small for the impacts: %s gives overlaps of "
+                     "%.3g times the radius (r = %.3g m) at %.3g m/s; check the units (Pa)",
+                     stiff, impact, r, v);
+            return;
+        }
+    }
+    if (run && run->dt_limit > 0 && run->dt_speed > 0) {
+        snprintf(buf, n,
+                 "a contact faster or stiffer than the time step was chosen for (dt = %.3g s%s, "
+                 "for impacts up to %.3g m/s at the limit %.3g s): a driver (a moving wall, a "
+                 "prescribed particle, an inserter) or a fall from higher up; give run{ "
+                 "impact_velocity = ... } the fastest impact, or a smaller dt",
+                 dt, run->dt_auto ? ", \"auto\"" : "", run->dt_speed, run->dt_limit);
+        return;
+    }
+    snprintf(buf, n,
+             "the time step is too large for the contact stiffness or the impact speed (use dt = "
+             "\"auto\" or a smaller dt)");
+}
+
+/* The step being taken when a check fails is s->steps + 1 (steps counts completed ones); i is the
+ * local index. */
 static core_status unstable(dem_scene *s, size_t i, const char *what, core_error *err)
 {
     dem_invalidate(s, 1); /* a later run must not reuse this step's forces */
-    return core_fail(err, CORE_ERR_UNSTABLE,
-                     "particle %zu %s at step %ld (t = %.6g s); likely cause: the time step is "
-                     "too large for the contact stiffness or the impact speed (use dt = \"auto\" "
-                     "or a smaller dt)",
-                     i + 1, what, s->steps + 1, s->time);
+    char cause[400];
+    likely_cause(s, i, cause, sizeof cause);
+    return core_fail(err, CORE_ERR_UNSTABLE, "particle %zu %s at step %ld (t = %.6g s); likely cause: %s",
+                     dem_gid(s, i) + 1, what, s->steps + 1, s->time, cause);
 }
 
 /* ---- energy watch ---------------------------------------------------------------------------- *
@@ -148,14 +268,18 @@ static core_status energy_watch(dem_scene *s, double dt, core_error *err)
                  ts.limit);
     s->watch_on = 0;
     dem_invalidate(s, 1);
+    const bool automatic = s->run && s->run->dt_auto; /* then "use dt = auto" would not help */
     return core_fail(err, CORE_ERR_UNSTABLE,
                      "energy grew in a scene without drivers: %.6g J at step %ld (t = %.6g s), "
                      "%.6g J at step %ld (t = %.6g s), +%.3g J = %.3g of the largest mechanical "
                      "energy %.6g J (kinetic + rotational + elastic; limit %.3g); likely cause: "
-                     "the time step %.3g s is too large for the contact stiffness%s; use dt = "
-                     "\"auto\" or a smaller dt, without force",
+                     "the time step %.3g s%s is too large for the contact stiffness%s; %s",
                      s->watch_min, s->watch_min_step, s->watch_min_t, e.total, s->steps, s->time,
-                     grow, grow / scale, scale, DEM_WATCH_GROWTH, dt, limit);
+                     grow, grow / scale, scale, DEM_WATCH_GROWTH, dt, automatic ? " (\"auto\")" : "",
+                     limit,
+                     automatic ? "give run{ impact_velocity = ... } the fastest impact, or a "
+                                 "smaller dt"
+                               : "use dt = \"auto\" or a smaller dt, without force");
 }
 
 /* A particle outside the domain on an axis that is not periodic (index, or (size_t)-1). */
@@ -307,7 +431,7 @@ static core_status forces_distributed(dem_scene *s, double dt, double disp2, cor
         servo |= s->walls[w].active && s->walls[w].servo;
     st = dem_domain_walls_due(s, servo, err);
     if (!st && t != (size_t)-1)
-        st = unstable(s, dem_gid(s, t), "went through a wall", err);
+        st = unstable(s, t, "went through a wall", err);
     /* A local error waits for the end of the step, where every rank agrees on the first one:
      * the rest of the step makes the same collective calls on every rank. */
     dem_domain_defer(s, st, err);
@@ -736,9 +860,9 @@ static core_status full_checks(dem_scene *s, core_error *err)
 {
     size_t bad = check_finite(s);
     if (bad != (size_t)-1)
-        return unstable(s, dem_gid(s, bad), "has a non-finite position or velocity", err);
+        return unstable(s, bad, "has a non-finite position or velocity", err);
     if ((bad = check_domain(s)) != (size_t)-1)
-        return unstable(s, dem_gid(s, bad),
+        return unstable(s, bad,
                         "left the domain (a box side without a wall and not periodic)", err);
     return CORE_OK;
 }
@@ -754,7 +878,9 @@ core_status dem_run(dem_scene *s, const dem_run_def *run, core_error *err)
     comm_stats c0, c1; /* distributed: the time inside communication, for the stats */
     if (multi)
         comm_get_stats(&c0);
+    s->run = run;
     core_status st = run_steps(s, run, err);
+    s->run = NULL;
     if (multi) {
         comm_get_stats(&c1);
         s->dstats.comm_s += c1.seconds - c0.seconds;

@@ -4,6 +4,7 @@
  * cell's particles are taken in identity order, so the result does not depend on the number of
  * threads, nor on the number of MPI ranks (domain.c). */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -683,13 +684,38 @@ static collide_totals collide(dsmc_scene *s, double dt)
 
 /* ---- the run ----------------------------------------------------------------------------------
  */
-static core_status overflow_error(const dsmc_scene *s, core_error *err)
+/* The likely cause of values out of range, from the run's numbers only (every rank gives the
+ * same words): DSMC's collisions conserve or lose energy, so only a huge step, gravity or speed
+ * given can overflow. */
+static void out_of_range(const dsmc_scene *s, double dt, char *buf, size_t n)
 {
+    double g = 0, L = INFINITY;
+    for (int k = 0; k < s->D; k++) {
+        g += s->def.gravity[k] * s->def.gravity[k];
+        L = fmin(L, s->h[k] * s->def.cells[k]);
+    }
+    g = sqrt(g);
+    if (g > 0 && 0.5 * g * dt * dt > L)
+        snprintf(buf, n,
+                 "the time step dt = %.3g s is out of range for the gravity: one step moves a "
+                 "particle |g| dt^2 / 2 = %.3g m against a box of %.3g m; use dt = \"auto\" or a "
+                 "smaller dt",
+                 dt, 0.5 * g * dt * dt, L);
+    else
+        snprintf(buf, n,
+                 "the time step dt = %.3g s or the speeds given are out of range (speeds near the "
+                 "largest double); use dt = \"auto\" and speeds of the gas's scale",
+                 dt);
+}
+
+static core_status overflow_error(const dsmc_scene *s, double dt, core_error *err)
+{
+    char cause[300];
+    out_of_range(s, dt, cause, sizeof cause);
     return core_fail(err, CORE_ERR_UNSTABLE,
                      "step %ld (t = %.6g s): a cell's number of collision candidates overflowed "
-                     "(relative speeds near the largest double): the time step or the speeds "
-                     "are out of range",
-                     s->steps - 1, s->t);
+                     "(relative speeds near the largest double); likely cause: %s",
+                     s->steps - 1, s->t, cause);
 }
 
 core_status dsmc_run(dsmc_scene *s, const dsmc_run_def *run, long *done, core_error *err)
@@ -726,7 +752,7 @@ core_status dsmc_run(dsmc_scene *s, const dsmc_run_def *run, long *done, core_er
             comm_max_i64(q, 4);
             intr = q[0] != 0;
             if (q[3]) {
-                st = overflow_error(s, err);
+                st = overflow_error(s, run->dt, err);
                 break;
             }
             if (q[2]) {
@@ -759,10 +785,12 @@ core_status dsmc_run(dsmc_scene *s, const dsmc_run_def *run, long *done, core_er
         if (multi && (st = dsmc_domain_migrate(s, bcount, &bad, &lost, err)))
             break;
         if (bad) {
+            char cause[300];
+            out_of_range(s, dt, cause, sizeof cause);
             st = core_fail(err, CORE_ERR_UNSTABLE,
                            "step %ld (t = %.6g s): a particle's position or velocity is not "
-                           "finite",
-                           s->steps, s->t);
+                           "finite; likely cause: %s",
+                           s->steps, s->t, cause);
             break;
         }
         dsmc_sort_counted(s, bcount);
@@ -773,7 +801,7 @@ core_status dsmc_run(dsmc_scene *s, const dsmc_run_def *run, long *done, core_er
         ++*done;
         overflow = ct.overflow; /* several ranks: agreed at the next reduction */
         if (!multi && overflow) {
-            st = overflow_error(s, err);
+            st = overflow_error(s, run->dt, err);
             break;
         }
         nsteps++;
@@ -805,7 +833,7 @@ core_status dsmc_run(dsmc_scene *s, const dsmc_run_def *run, long *done, core_er
         comm_max_double(most, 5);
     }
     if (s->distributed && st == CORE_OK && most[4] > 0) /* at the last step */
-        st = overflow_error(s, err);
+        st = overflow_error(s, run->dt, err);
     if (most[3] > 0 && st == CORE_OK)
         st = core_fail(err, CORE_ERR_NOMEM,
                        "out of memory on a rank storing %.0f particles that migrated to it; "

@@ -138,6 +138,11 @@ int bind_steps_or_time(lua_State *L, int arg, const char *call, long *steps, dou
 long bind_time_steps(lua_State *L, int arg, const char *call, double time, double dt);
 /* The run in progress of the scene at idx (its on_step is calling), or NULL. */
 const bind_run *bind_running(lua_State *L, int idx);
+/* The public name of the Lua-side library function the script called and that is running now
+ * ("grainlab.pack.deposit", set by grainlab.entry), copied into buf; 0 when none is. */
+int bind_entry_name(lua_State *L, char *buf, size_t size);
+/* Runs in progress, nested ones included (0: none). */
+int bind_run_depth(void);
 
 /* When the scene at idx is running, raises
  *   "CALL: this dem.scene is running (called from its on_step); WHY"

@@ -29,6 +29,8 @@ static void push_running_table(lua_State *L)
     lua_setfield(L, LUA_REGISTRYINDEX, RUNNING);
 }
 
+int bind_run_depth(void) { return depth; }
+
 const bind_run *bind_running(lua_State *L, int idx)
 {
     idx = lua_absindex(L, idx);
@@ -121,6 +123,12 @@ static int fail(lua_State *L, int guard, progress *prog, const bind_run *r, cons
         char where[160];
         snprintf(where, sizeof where, "step %ld%s of '%s'", done, of, r->label);
         interrupt_note(where);
+        /* The interrupt is handled: it becomes the error raised below. The outermost run lowers
+         * the flag (a run nested in on_step leaves it to the run around it), so that a script
+         * catching the error runs its next run to the end, and a later Ctrl-C interrupts again
+         * instead of counting as the second one. A termination stays (interrupt_clear). */
+        if (depth == 0)
+            interrupt_clear();
     }
     if (!err) { /* from on_step; a Ctrl-C there says where the run stood */
         if (interrupted && lua_type(L, -1) == LUA_TSTRING) {

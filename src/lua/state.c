@@ -10,6 +10,18 @@
 
 void bind_open_lammps(lua_State *L);
 
+int bind_entry_name(lua_State *L, char *buf, size_t size)
+{
+    int found = 0;
+    if (lua_getfield(L, LUA_REGISTRYINDEX, "grainlab.entry") == LUA_TTABLE &&
+        lua_getfield(L, -1, "current") == LUA_TSTRING) {
+        snprintf(buf, size, "%s", lua_tostring(L, -1));
+        found = 1;
+    }
+    lua_pop(L, lua_type(L, -1) == LUA_TTABLE ? 1 : 2);
+    return found;
+}
+
 /* package.preload loader for embedded module number upvalue(1). */
 static int load_embedded(lua_State *L)
 {

@@ -4,6 +4,7 @@
  * grid-to-particle update (Eqs. 10-11, FLIP with an optional PIC blend) and the constitutive
  * update; the CFL time step and the run loop with Ctrl-C and instability checks. */
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 #include <stdlib.h>
@@ -1844,6 +1845,83 @@ static core_status unstable(const mpm_scene *s, size_t p, const char *what, cons
                      p + 1, s->grain[p] + 1, what, s->steps + 1, s->time, s->x[p], s->y[p], cause);
 }
 
+/* ---- the likely cause of an instability ------------------------------------------------------
+ * From what the scene shows, in this order: a time step the user forced above the CFL limit (only
+ * then is dt blamed); a point out of the grid by an edge without a wall; a material so soft that
+ * gravity alone strains its grain by more than half (a modulus in the wrong units). */
+enum { MPM_BAD_INVERTED, MPM_BAD_LEFT, MPM_BAD_NONFINITE };
+#define MPM_SOFT_STRAIN 0.5 /* rho g h / G over the grain's height h */
+
+static void likely_cause(const mpm_scene *s, size_t p, int kind, const mpm_run_def *run,
+                         const mpm_timestep *ts, char *buf, size_t n)
+{
+    if (run->dt > 0 && run->dt > ts->limit) {
+        snprintf(buf, n,
+                 "the time step is too large: dt = %.3g s is %.3g times the CFL limit %.3g s "
+                 "(forced); use dt = \"auto\" or a smaller dt",
+                 run->dt, run->dt / ts->limit, ts->limit);
+        return;
+    }
+    static const char *const edge[4] = {"left", "right", "bottom", "top"};
+    if (kind == MPM_BAD_LEFT) {
+        const double c[2] = {s->x[p], s->y[p]};
+        for (int a = 0; a < 2; a++) {
+            const double o = s->def.origin[a], L = s->def.size[a];
+            int e = c[a] < o ? 2 * a : c[a] > o + L ? 2 * a + 1 : -1;
+            if (s->def.periodic[a] || e < 0 || s->def.walls[e] != MPM_WALL_NONE)
+                continue;
+            snprintf(buf, n,
+                     "no wall on the %s edge of the grid: give it one (walls = { %s = 'noslip' "
+                     "}, or 'slip', 'friction') or make the %c axis periodic",
+                     edge[e], edge[e], a ? 'y' : 'x');
+            return;
+        }
+    }
+    const double g = sqrt(s->def.gravity[0] * s->def.gravity[0] +
+                          s->def.gravity[1] * s->def.gravity[1]);
+    const int gr = s->grain[p];
+    const mpm_material *m = &s->mats[s->mat[p]];
+    double h = 0; /* the grain's height along gravity */
+    if (g > 0) {
+        const int a = fabs(s->def.gravity[1]) >= fabs(s->def.gravity[0]); /* 1: y */
+        h = s->def.size[a];
+        if (s->gdef && gr >= 0 && (size_t)gr < s->ngrains) {
+            const mpm_grain_def *gd = &s->gdef[gr];
+            if (gd->shape == MPM_DISK)
+                h = 2 * gd->radius;
+            else if (gd->shape == MPM_RECT)
+                h = gd->hi[a] - gd->lo[a];
+        }
+    }
+    double strain = m->shear > 0 ? m->density * g * h / m->shear : 0;
+    if (strain > MPM_SOFT_STRAIN) {
+        snprintf(buf, n,
+                 "the material is too soft for the load: shear = %.3g Pa gives strains of %.3g "
+                 "under gravity alone (rho g h / G over the grain's height h = %.3g m); check the "
+                 "units (Pa)",
+                 m->shear, strain, h);
+        return;
+    }
+    const bool fixed = run->dt > 0;
+    if (kind == MPM_BAD_LEFT)
+        snprintf(buf, n,
+                 "a point faster than the step allows through a wall (dt = %.3g s, CFL limit "
+                 "%.3g s at the start of the run)%s",
+                 fixed ? run->dt : ts->dt_auto, ts->limit,
+                 fixed ? "; use dt = \"auto\" or a smaller dt" : "; use a smaller cfl");
+    else if (fixed)
+        snprintf(buf, n,
+                 "the time step dt = %.3g s (CFL limit %.3g s at the start of the run) is too "
+                 "large for the wave speed, or a point is too strongly compressed between walls "
+                 "or grains; use dt = \"auto\" or a smaller dt",
+                 run->dt, ts->limit);
+    else
+        snprintf(buf, n,
+                 "a point too strongly compressed between walls or grains, or a grain too coarse "
+                 "(too few cells across) for its deformation (dt = \"auto\" keeps to the CFL "
+                 "limit; a smaller cfl rarely helps)");
+}
+
 /* The check of every point, for USF (whose stress update comes before the positions'); the
  * other orders check each point right after its stress update (constitutive). Returns the first
  * bad point, or (size_t)-1. */
@@ -1974,12 +2052,12 @@ static core_status run_steps(mpm_scene *s, const mpm_run_def *run, long *done, c
         }
         const double tend = clock_wall(); /* the end of the region, then the checks */
         s->tstage[usf ? T_G2P : T_MATERIAL] += tend - tlast;
+        char cause[400];
         for (int t = 0; t < s->nt; t++)
-            if (tbad[t] != (size_t)-1)
-                return unstable(s, tbad[t], "was inverted (det F <= 0)",
-                                "the time step is too large for the wave speed, or a point too "
-                                "strongly compressed between walls",
-                                err);
+            if (tbad[t] != (size_t)-1) {
+                likely_cause(s, tbad[t], MPM_BAD_INVERTED, run, &ts, cause, sizeof cause);
+                return unstable(s, tbad[t], "was inverted (det F <= 0)", cause, err);
+            }
         size_t bad = (size_t)-1;
         if (usf)
             bad = check_points(s);
@@ -1987,15 +2065,13 @@ static core_status run_steps(mpm_scene *s, const mpm_run_def *run, long *done, c
             for (int t = 0; t < s->nt; t++)
                 bad = tcheck[t] < bad ? tcheck[t] : bad;
         const int why = bad != (size_t)-1 ? bad_why(s, bad) : 0;
-        if (bad != (size_t)-1)
-            return why ? unstable(s, bad, "left the grid",
-                                  "an edge without a wall (walls = 'none'), or a time step too "
-                                  "large for the speed",
-                                  err)
-                       : unstable(s, bad, "has a non-finite position, velocity or stress",
-                                  "the time step is too large for the wave speed (use dt = "
-                                  "\"auto\" or a smaller cfl)",
-                                  err);
+        if (bad != (size_t)-1) {
+            likely_cause(s, bad, why ? MPM_BAD_LEFT : MPM_BAD_NONFINITE, run, &ts, cause,
+                         sizeof cause);
+            return unstable(s, bad,
+                            why ? "left the grid" : "has a non-finite position, velocity or stress",
+                            cause, err);
+        }
         s->time += dt;
         s->steps++;
         ++*done;

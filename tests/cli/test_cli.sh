@@ -31,12 +31,24 @@ run "$G" --report </dev/null;   expect_rc 2 report-no-file; has "$err" "--report
 # --- scripts and their errors ---
 run "$G" no_such_script.lua </dev/null
 expect_rc 1 missing-script; has "$err" "cannot open no_such_script.lua" missing-script; lines "$err" 1 missing-script
+# docs/cli.md's exit status table says the same: the status of the row naming each case
+doc_status() { grep -E "^ *\| [0-9]+ \|.*$1" ../../docs/cli.md | sed -E 's/^ *\| ([0-9]+) \|.*/\1/'; }
+[ "$(doc_status 'script that cannot be read')" = 1 ] && ok || bad "docs/cli.md: a missing script's status"
+[ "$(doc_status 'unknown option')" = 2 ] && ok || bad "docs/cli.md: an unknown option's status"
+[ "$(doc_status 'argument without')" = 2 ] && ok || bad "docs/cli.md: an argument without = status"
+[ "$(doc_status 'a Lua error')" = 1 ] && ok || bad "docs/cli.md: a Lua error's status"
 run "$G" syntax_error.lua </dev/null
 expect_rc 1 syntax; has "$err" "syntax_error.lua:4: ')' expected (to close '(' at line 3) near 'end'" syntax
 lines "$err" 1 syntax
 run "$G" runtime_error.lua </dev/null
 expect_rc 1 runtime; has "$err" "runtime_error.lua:2: attempt to index a nil value (local 'v')" runtime
 has "$err" "stack traceback:" runtime; has "$err" "runtime_error.lua:4: in main chunk" runtime
+run "$G" library_error.lua </dev/null
+expect_rc 1 library-error; has "$err" "grainlab: library_error.lua:6: run: particle " library-error
+has "$err" "likely cause: no wall on the " library-error
+has "$err" "stack traceback:" library-error; has "$err" "library_error.lua:6: in main chunk" library-error
+case "$err" in *lua/grainlab/*) bad "library-error: library frames or positions shown" ;; *) ok ;; esac
+lines "$err" 3 library-error
 run "$G" -e 'error({})' </dev/null
 expect_rc 1 error-object; has "$err" "(error object is a table value)" error-object
 
@@ -106,6 +118,17 @@ print("added", m:info().grains)' </dev/null
 expect_rc 0 mpm-overlap; has "$out" "added	2" mpm-overlap
 has "$err" "grainlab: warning: add_disk: grain 2 overlaps grain 1 by 0.1 m" mpm-overlap
 
+# --- the default material is named once per scene, with what it costs; --quiet silences it ---
+run "$G" default_material.lua </dev/null
+expect_rc 0 default-material; has "$out" "dt	" default-material
+dt=$(sed -n 's/^dt\t//p' <<<"$out" | head -1)
+has "$err" "grainlab: note: add_disk: no material given, using the default quartz (E = 30 GPa, rho = 2650 kg/m^3): its contact time sets dt = \"auto\" to $dt s here" default-material
+has "$err" "; pass material = grainlab.material{...}" default-material
+has "$err" "grainlab: note: grainlab.pack.random: no material given, using the default quartz" default-material
+lines "$err" 2 default-material
+run "$G" --quiet default_material.lua </dev/null
+expect_rc 0 default-material-quiet; [ -z "$err" ] && ok || bad "default-material-quiet: printed"
+
 # --- Ctrl-C (SIGINT) stops a running script with an error naming it ---
 # The signals are sent once the script says it runs: a background job of this non-interactive
 # shell starts with SIGINT ignored until grainlab's handler is in place, so a signal sent at a
@@ -152,6 +175,23 @@ if grep -Eq '^dem run: interrupted at step [0-9]+ of 1000000000 after' <<<"$err"
 if grep -Eq 'run: interrupted at step [0-9]+ of 1000000000 of this run \(t = [0-9.e-]+ s\); the scene is intact|interrupted by Ctrl-C \(in on_step: the run stopped at step [0-9]+ of 1000000000 of this run; the scene is intact\)' <<<"$err"
 then ok; else bad "run-sigint: error message"; fi
 [ "$(grep -c 'done,' <<<"$err")" -eq 0 ] && ok || bad "run-sigint: says done"
+
+# --- a caught Ctrl-C is handled: later runs go to their end, a later Ctrl-C interrupts again ---
+"$G" interrupt_resume.lua </dev/null >"$tmp/out" 2>"$tmp/err" &
+pid=$!
+for phase in 1 2; do
+  for _ in $(seq 200); do grep -q "running$phase" "$tmp/err" 2>/dev/null && break; sleep 0.05; done
+  kill -INT "$pid"
+done
+finish_long
+expect_rc 0 interrupt-resume
+if grep -Eq '^caught1	false	run: interrupted at step [0-9]+ of 1000000000 of this run' <<<"$out" \
+   || grep -Eq '^caught1	false	.*interrupted by Ctrl-C \(in on_step' <<<"$out"
+then ok; else bad "interrupt-resume: the first Ctrl-C stops the run"; fi
+if grep -Eq '^caught2	false	.*interrupted by Ctrl-C$' <<<"$out"; then ok; else bad "interrupt-resume: the hook's error"; fi
+for phase in after1 after2; do
+  for e in dem mpm dsmc; do has "$out" "$phase	$e	10" "interrupt-resume ($phase, $e)"; done
+done
 
 # --- SIGTERM: stops between steps, removes temporaries, says where, exits 128 + 15 ---
 mkdir -p "$tmp/w"

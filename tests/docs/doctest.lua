@@ -3,6 +3,11 @@
 -- out/ there), so a block sees what a user pasting it sees; a block that raises, or whose report
 -- fails a check, fails the test with the file and line where the block starts. API sketches with
 -- placeholders belong in tables or ```text blocks, which are not run.
+-- Shown output is checked too: a line of a block that calls print and ends in a comment
+-- `--> what it prints` must print exactly that, whitespace runs aside (print's tabs may be shown as
+-- spaces), every time it prints, and at least once:
+--   print(#rec, rec:column("height")[#rec])          --> 110  0.00099937850657244
+-- (a multi-line print call carries the comment on its first line).
 --   grainlab tests/docs/doctest.lua file=README.md exe=build/grainlab [keep=true]
 -- (keep=true keeps the scratch directories)
 local file, exe = params.file, params.exe
@@ -37,6 +42,58 @@ if open then
   os.exit(1)
 end
 
+-- The outputs a block shows: { [line in the block] = expected text }.
+local function shown(b)
+  local want = {}
+  for i, l in ipairs(b.lines) do
+    local text = l:match("%-%->%s*(.-)%s*$")
+    if text and l:find("print", 1, true) then want[i] = text end
+  end
+  return want
+end
+
+-- Run before the block (grainlab -e): print also records, for each line of block.lua, what it
+-- printed, one "LINE<TAB>TEXT" line per call in prints.txt (%q-quoted: newlines stay on one line).
+local PRELUDE = [[
+local raw, log = print, assert(io.open("prints.txt", "w"))
+print = function(...)
+  local info = debug.getinfo(2, "Sl")
+  if info and info.source == "@block.lua" then
+    local parts = {}
+    for i = 1, select("#", ...) do parts[i] = tostring((select(i, ...))) end
+    log:write(info.currentline, "\t", string.format("%q", table.concat(parts, "\t")), "\n")
+    log:flush()
+  end
+  return raw(...)
+end]]
+
+local function words(text) return (text:gsub("%s+", " "):gsub("^ ", ""):gsub(" $", "")) end
+
+-- The mismatches between what the block printed and what its `-->` comments show.
+local function compare(dir, b, want)
+  local got, bad = {}, {}
+  local f = io.open(dir .. "/prints.txt", "r")
+  for line in f and f:lines() or function() end do
+    local n, q = line:match("^(%d+)\t(.*)$")
+    n = tonumber(n)
+    if n and want[n] then
+      local text = load("return " .. q)()
+      got[n] = true
+      if words(text) ~= words(want[n]) then
+        bad[#bad + 1] = { n, string.format("%s:%d: printed '%s', the docs show '%s'", file, b.line + n, text, want[n]) }
+      end
+    end
+  end
+  if f then f:close() end
+  for n in pairs(want) do
+    if not got[n] then bad[#bad + 1] = { n, string.format("%s:%d: never printed (the docs show '%s')", file, b.line + n, want[n]) } end
+  end
+  table.sort(bad, function(x, y) return x[1] < y[1] end) -- stable enough: one message per print
+  local out = {}
+  for i, m in ipairs(bad) do out[i] = m[2] end
+  return out
+end
+
 -- Scratch directory: one per block, removed afterwards (a failure prints the block's output).
 local base = os.tmpname()
 os.remove(base)
@@ -50,14 +107,22 @@ for k, b in ipairs(blocks) do
   out:close()
   local log = dir .. "/log.txt"
   local t0 = grainlab.clock()
-  local ok = os.execute(string.format("cd %s && %s --quiet block.lua > log.txt 2>&1",
-                                      quote(dir), quote(exe)))
+  local want = shown(b)
+  local ok = os.execute(string.format("cd %s && %s --quiet %s block.lua > log.txt 2>&1",
+                                      quote(dir), quote(exe), next(want) and "-e " .. quote(PRELUDE) or ""))
   local secs = grainlab.clock() - t0
   local lf = io.open(log, "r")
   local text = lf and lf:read("a") or ""
   if lf then lf:close() end
-  if ok then
-    print(string.format("ok    %s:%d (%d lines, %.2f s)", file, b.line, #b.lines, secs))
+  local mismatch = ok and compare(dir, b, want) or {}
+  local nshown = 0
+  for _ in pairs(want) do nshown = nshown + 1 end
+  if ok and #mismatch == 0 then
+    print(string.format("ok    %s:%d (%d lines, %d shown outputs, %.2f s)", file, b.line, #b.lines, nshown, secs))
+  elseif ok then
+    failed = failed + 1
+    print(string.format("FAIL  %s:%d: the ```lua block starting here does not print what it shows:\n%s",
+                        file, b.line, table.concat(mismatch, "\n")))
   else
     failed = failed + 1
     -- Error positions inside the block ("block.lua:7:") point into the Markdown file.

@@ -420,4 +420,70 @@ do -- drivers are not watched: gravity along a periodic axis (a chute) gains ene
   g:add_wall{ point = { 0.0198, 0 }, normal = { -1, 0 }, velocity = { -0.5, 0 } }
   check.eq(g:run{ steps = 4000, dt = limit, progress = false }.steps, 4000, "moving wall: not stopped")
 end
+-- ---- the likely cause comes from the scene, and the error from the user's line -------------
+-- dt was "auto" in each of these: the message must not blame it.
+do -- the README's pile without its side walls: a grain rolls off the floor's end
+  local sand = grainlab.material{ density = 2650, young = 5e6, poisson = 0.3, friction = 0.5 }
+  local s = dem.scene{ dim = 2, box = { { 0, 0 }, { 0.03, 0.04 } }, gravity = { 0, -9.81 } }
+  s:add_wall{ point = { 0, 0 }, normal = { 0, 1 } }
+  local line = debug.getinfo(1, "l").currentline + 1
+  local msg = check.errors(function() grainlab.pack.deposit(s, { n = 100, radius = { 0.5e-3, 1e-3 }, seed = 7, material = sand }) end,
+    "left the domain", "no side walls: the pile spreads out of the box")
+  check.contains(msg, "test_dem_stability.lua:" .. line .. ": run: particle ", "no side walls: at the user's line")
+  check.is_true(not msg:find("lua/grainlab/", 1, true), "no side walls: no library position: " .. msg)
+  local sign = msg:match("likely cause: no wall on the ([+-])x side of the box %(x = ")
+  check.is_true(sign ~= nil, "no side walls: names the open side: " .. msg)
+  check.contains(msg, sign == "+" and "s:add_wall{ point = {0.03, 0}, normal = {-1, 0} }"
+                                   or "s:add_wall{ point = {0, 0}, normal = {1, 0} }", "no side walls: the wall to add")
+  check.contains(msg, "or make the x axis periodic", "no side walls: the other remedy")
+  check.is_true(not msg:find("time step", 1, true), "no side walls: dt not blamed")
+end
+do -- a modulus in the wrong units: gravity alone squeezes a grain by 11 radii
+  local soft = grainlab.material{ density = 2650, young = 5, poisson = 0.3, friction = 0.5 }
+  local s = dem.scene{ dim = 2, box = { { 0, 0 }, { 0.03, 0.04 } }, gravity = { 0, -9.81 } }
+  s:add_wall{ point = { 0, 0 }, normal = { 0, 1 } }
+  s:add_wall{ point = { 0, 0 }, normal = { 1, 0 } }
+  s:add_wall{ point = { 0.03, 0 }, normal = { -1, 0 } }
+  for i = 1, 10 do s:add_disk{ pos = { i * 2.5e-3, 0.02 }, radius = 1e-3, material = soft } end
+  local msg = check.errors(function() s:run{ time = 0.1 } end, "run: particle ", "E = 5 Pa: stops")
+  check.contains(msg, "likely cause: the contact stiffness is too small for the load: E = 5 Pa gives overlaps of ",
+                 "E = 5 Pa: the cause")
+  check.contains(msg, "under gravity alone; check the units (Pa)", "E = 5 Pa: the remedy")
+  -- the overlap named is the static one of a grain's weight on a grain like it: m g = K d^1.5,
+  -- K = 4/3 E* sqrt(r/2), E* = E / (2 (1 - nu^2))
+  local id = tonumber(msg:match("run: particle (%d+) "))
+  local p = s:particles()
+  local K = 4 / 3 * 5 / (2 * (1 - 0.09)) * math.sqrt(p.radius[id] / 2)
+  check.near(tonumber(msg:match("gives overlaps of (%S+) times")), (p.mass[id] * 9.81 / K) ^ (2 / 3) / p.radius[id], 1e-3,
+             "E = 5 Pa: the overlap named")
+end
+do -- soft for the impacts (no gravity): 10 m/s against a wall with E = 1 Pa
+  local soft = grainlab.material{ density = 2650, young = 1, poisson = 0.3 }
+  local s = dem.scene{ dim = 2, box = { { 0, 0 }, { 0.01, 0.01 } } }
+  s:add_wall{ point = { 0, 0 }, normal = { 1, 0 } }
+  s:add_disk{ pos = { 0.005, 0.005 }, radius = 0.5e-3, vel = { -10, 0 }, material = soft }
+  local msg = check.errors(function() s:run{ time = 0.01 } end, "run: particle 1 went through a wall", "E = 1 Pa impact")
+  check.contains(msg, "likely cause: the contact stiffness is too small for the impacts: E = 1 Pa gives overlaps of ",
+                 "E = 1 Pa impact: the cause")
+  check.contains(msg, " at 10 m/s; check the units (Pa)", "E = 1 Pa impact: the speed")
+end
+do -- a driver faster than dt = "auto" was chosen for: named as such, dt not called too large
+  local q = grainlab.material{ density = 2650, young = 30e9, poisson = 0.3 }
+  local s = dem.scene{ dim = 2, box = { { 0, 0 }, { 0.01, 0.01 } } }
+  s:add_wall{ point = { 0, 0 }, normal = { 1, 0 } }
+  local w = s:add_wall{ point = { 0.01, 0 }, normal = { -1, 0 } }
+  s:add_disk{ pos = { 0.005, 0.005 }, radius = 0.5e-3, material = q }
+  s:wall_velocity(w, { -20, 0 })
+  local msg = check.errors(function() s:run{ time = 0.001 } end, "run: particle 1 went through a wall", "driver")
+  check.contains(msg, 'likely cause: a contact faster or stiffer than the time step was chosen for (dt = ', "driver: the cause")
+  check.contains(msg, ', "auto", for impacts up to 0.1 m/s', "driver: the speed dt was chosen for")
+  check.contains(msg, "give run{ impact_velocity = ... } the fastest impact", "driver: the remedy")
+end
+do -- forced above the limit: dt is blamed, with the factor
+  local s = pile()
+  local limit = s:timestep().limit
+  local msg = check.errors(function() s:run{ steps = 1000, dt = 30 * limit, force = true } end, "run: particle ", "forced")
+  check.contains(msg, string.format("likely cause: the time step is too large: dt = %.3g s is 30 times the stability limit %.3g s (forced)",
+                                    30 * limit, limit), "forced: dt, the factor and the limit")
+end
 check.done()

@@ -131,6 +131,22 @@ local open = mpm.scene{ cells = { 10, 10 }, size = { 1, 1 }, walls = "none" }
 open:add_disk{ center = { 0.8, 0.5 }, radius = 0.1, material = mat, velocity = { 5, 0 } }
 msg = check.errors(function() open:run{ time = 0.1 } end, "run: point ", "leaving the grid")
 check.contains(msg, "of grain 1 left the grid at step ", "names the grain and the step")
+check.contains(msg, "likely cause: no wall on the right edge of the grid: give it one (walls = { right = 'noslip' }",
+               "names the open edge")
+check.is_true(not msg:find("time step", 1, true), "an open edge: dt not blamed")
+-- a point through an edge that has a wall is not blamed on the edge
+local walled = mpm.scene{ cells = { 10, 10 }, size = { 1, 1 }, walls = { left = "none" } }
+walled:add_disk{ center = { 0.8, 0.5 }, radius = 0.1, material = mat, velocity = { 5, 0 } }
+msg = check.errors(function() walled:run{ steps = 3, dt = 0.05, force = true } end, "run: point ", "through the right wall")
+check.contains(msg, "likely cause: the time step is too large: dt = 0.05 s is ", "through a wall at a forced dt: dt blamed")
+-- a modulus in the wrong units: gravity alone strains the disk by 1.2e4
+local soft = mpm.scene{ cells = { 40, 40 }, size = { 2, 2 }, gravity = { 0, -9.8 } }
+soft:add_disk{ center = { 1, 0.5 }, radius = 0.5, points_per_cell = 3,
+               material = mpm.material{ model = "elastic", density = 3000, shear = 2.5, bulk = 10 } }
+msg = check.errors(function() soft:run{ time = 2 } end, "run: point ", "shear = 2.5 Pa")
+check.contains(msg, string.format("likely cause: the material is too soft for the load: shear = 2.5 Pa gives strains of %.3g under gravity alone",
+                                  3000 * 9.8 * 1 / 2.5), "shear = 2.5 Pa: the strain rho g h / G")
+check.contains(msg, "h = 1 m); check the units (Pa)", "shear = 2.5 Pa: the grain's height and the remedy")
 
 -- forced large dt blows up with an error naming the step and the grain
 local blow = mpm.scene{ cells = { 10, 10 }, size = { 1, 1 } }
@@ -139,5 +155,7 @@ msg = check.errors(function() blow:run{ steps = 200, dt = 20 * blow:timestep().l
   "run: point ", "forced unstable step")
 check.contains(msg, "of grain 1 ", "blow-up names the grain")
 check.contains(msg, "at step ", "blow-up names the step")
+check.contains(msg, "likely cause: the time step is too large: dt = ", "blow-up: the forced dt blamed")
+check.contains(msg, " is 20 times the CFL limit ", "blow-up: by how much")
 check.is_true(tostring(m):find("mpm.scene") ~= nil, "tostring")
 check.done()
