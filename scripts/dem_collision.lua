@@ -17,6 +17,10 @@
 --   linear, clipped at f >= 0: f vanishes when k d + gamma d' = 0, i.e. tan(w t) = -2bw/(w^2 - b^2),
 --     w t* = pi - 2 theta with theta = atan(b/w); afterwards d + (gamma/k) d' only decreases, so the
 --     grains separate in free flight: e = exp(-b t*) and t_c = (pi - 2 theta + sin(2 theta))/w.
+--     With z = b/w0: e = exp(-z (pi - 2 asin z)/sqrt(1 - z^2)) (z < 1), exp(-2 z acosh z/
+--     sqrt(z^2 - 1)) (z > 1) (Schwager & Poeschel 2007). The clipped law (the default) takes its
+--     gamma from the materials' e through this form (the kernel solves the same contact, src/dem/
+--     restitution.c), so it rebounds with the materials' e; z(e) is found here by bisection.
 --   hertz, elastic: energy 1/2 m_eff d'^2 + 2/5 K d^{5/2} = 1/2 m_eff v0^2 gives
 --     d_max = (5 m_eff v0^2/(4K))^{2/5}, t_c = 2 d_max/v0 int_0^1 (1 - x^{5/2})^{-1/2} dx
 --     = 2.94328 d_max/v0 (the integral is evaluated here by quadrature), and e = 1.
@@ -282,19 +286,38 @@ metrics.linear_unclipped_wall_s = grainlab.clock() - wall
 -- ---- 2. linear law, clipped at zero: RK4 of the clipped ODE (and its closed form) -----------
 wall = grainlab.clock()
 local clip_rows = {}
+local function clipped_e(z)
+  if z < 1 then return math.exp(-z * (pi - 2 * math.asin(z)) / math.sqrt(1 - z * z)) end
+  if z == 1 then return math.exp(-2) end
+  return math.exp(-2 * z * math.log(z + math.sqrt(z * z - 1)) / math.sqrt(z * z - 1))
+end
+local function clipped_z(e) -- e falls with z
+  local lo, hi = 0, 1e3
+  for _ = 1, 200 do
+    local mid = 0.5 * (lo + hi)
+    if clipped_e(mid) > e then lo = mid else hi = mid end
+  end
+  return 0.5 * (lo + hi)
+end
 for _, e_mat in ipairs{ 0.9, 0.5, 0.1 } do
   local ma = { density = quartz.density, young = quartz.young, poisson = quartz.poisson, restitution = e_mat }
   local mb = { density = glass.density, young = glass.young, poisson = glass.poisson, restitution = e_mat }
   local m_eff = m_eff_of(ma, mb)
   local w0 = math.sqrt(k / m_eff)
-  local lne = math.log(e_mat)
-  local b = -lne * w0 / math.sqrt(pi ^ 2 + lne ^ 2)
-  local w = math.sqrt(w0 ^ 2 - b ^ 2)
-  local theta = math.atan(b, w)
-  local tc_closed = (pi - 2 * theta + math.sin(2 * theta)) / w
-  local e_closed = math.exp(-b * (pi - 2 * theta) / w)
-  local rtc, re = rk4(linear_accel(w0 ^ 2, b, true), v0, tc_closed, rk4_steps)
-  rk4_closed_err = math.max(rk4_closed_err, rel(rtc, tc_closed), rel(re, e_closed))
+  local z = clipped_z(e_mat)
+  local b = z * w0
+  local rtc, re
+  if z < 1 then -- the closed forms of the contact time and e
+    local w = math.sqrt(w0 ^ 2 - b ^ 2)
+    local theta = math.atan(b, w)
+    local tc_closed = (pi - 2 * theta + math.sin(2 * theta)) / w
+    local e_closed = math.exp(-b * (pi - 2 * theta) / w)
+    rtc, re = rk4(linear_accel(w0 ^ 2, b, true), v0, tc_closed, rk4_steps)
+    rk4_closed_err = math.max(rk4_closed_err, rel(rtc, tc_closed), rel(re, e_closed), rel(e_closed, e_mat))
+  else -- overdamped: e in closed form, the contact time from RK4 alone
+    rtc, re = rk4(linear_accel(w0 ^ 2, b, true), v0, pi / w0, rk4_steps)
+    rk4_closed_err = math.max(rk4_closed_err, rel(re, e_mat))
+  end
   clip_rows[#clip_rows + 1] = { e_material = e_mat, e_clipped = re, t_c_clipped_s = rtc }
   for D = 2, 3 do
     local r = sweep({ dim = D, mat1 = ma, mat2 = mb, v = v0, dt = rtc / steps, t_est = rtc,

@@ -6,6 +6,7 @@
  * contact history (keyed by the particle pair i < j, in (i, j) order), the walls with their
  * candidates and histories, the energy watch. Nothing is recomputed on load except tables that
  * are a pure function of stored values (the power table, the list's incidence arrays). */
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -84,6 +85,27 @@ static core_status write_rolling(const dem_scene *s, ckpt_writer *w, core_error 
     for (int k = 0; k < s->nwalls; k++)
         for (int d = 0; d < 3; d++)
             put_opt(w, s->walls[k].hist[DEM_HIST_ROLL + d], s->n);
+    return end(w, err);
+}
+
+/* Damping solved from a restitution (restitution.c) has its own section, written only by a
+ * scene whose law uses it: the coefficients of s:contact's restitution and of each material, as
+ * they were solved (a file without it, from a scene whose law needs it, is refused). */
+static int uses_solved_damping(const dem_contact_def *c)
+{
+    return dem_damping_solved(c) ||
+           (c->damping == DEM_DAMPING_VISCOUS && c->restitution > 0 && c->gamma_n < 0 &&
+            (c->clip || dem_law_beta(c) != 1));
+}
+
+static core_status write_damping(const dem_scene *s, ckpt_writer *w, core_error *err)
+{
+    core_status st;
+    if ((st = ckpt_section_begin(w, "damping", CKPT_REQUIRED, err)))
+        return st;
+    ckpt_put_f64(w, s->damp_c);
+    static const double none = 0; /* a scene without materials may have no table */
+    ckpt_put_f64s(w, s->nmat > 0 ? s->mat_damp : &none, (size_t)s->nmat); /* count, values */
     return end(w, err);
 }
 
@@ -231,6 +253,8 @@ static core_status write_scene(const dem_scene *s, ckpt_writer *w, core_error *e
         return st;
     if (uses_rolling(s) && (st = write_rolling(s, w, err)))
         return st;
+    if (uses_solved_damping(&s->contact) && (st = write_damping(s, w, err)))
+        return st;
     if (s->bnd && (st = dem_boundary_save(s, w, err)))
         return st;
     return s->flow ? dem_flow_save(s, w, err) : CORE_OK;
@@ -341,6 +365,18 @@ static void read_contact(reader *r, dem_contact_def *c)
     c->normal = (dem_normal_law)normal;
     c->damping = (dem_damping_law)damping;
     c->tangential = (dem_tangential_law)tangential;
+}
+
+static void read_damping(reader *r, dem_scene *s)
+{
+    s->damp_c = f64(r);
+    if (!(s->damp_c >= 0 && s->damp_c < INFINITY))
+        bad(r, "bad damping coefficient");
+    if (!r->st)
+        r->st = ckpt_get_f64s(&r->sec, s->mat_damp, (size_t)s->nmat, r->err);
+    for (int k = 0; k < s->nmat && !r->st; k++)
+        if (!(s->mat_damp[k] >= 0 && s->mat_damp[k] < INFINITY))
+            bad(r, "bad damping coefficient");
 }
 
 /* The list's per-particle index arrays from the stored (i, j) order. */
@@ -563,6 +599,11 @@ static void read_all(reader *r, ckpt_reader *ck, const dem_boundary_restorer *re
         r->st = core_fail(r->err, CORE_ERR_NOMEM, "out of memory loading a checkpoint");
         return;
     }
+    s->mat_damp = calloc(nmat ? nmat : 1, sizeof *s->mat_damp);
+    if (!s->mat_damp) {
+        r->st = core_fail(r->err, CORE_ERR_NOMEM, "out of memory loading a checkpoint");
+        return;
+    }
     s->cap_mat = (int)(nmat ? nmat : 1);
     s->nmat = (int)nmat;
     for (int k = 0; k < s->nmat && !r->st; k++) {
@@ -689,6 +730,19 @@ static void read_all(reader *r, ckpt_reader *ck, const dem_boundary_restorer *re
         open_section(r, ck, "rolling");
         read_rolling(r, s);
         close_section(r);
+    }
+    if (!r->st && ckpt_has(ck, "damping")) {
+        open_section(r, ck, "damping");
+        read_damping(r, s);
+        close_section(r);
+    } else if (!r->st && uses_solved_damping(&s->contact)) {
+        r->st = core_fail(r->err, CORE_ERR_IO,
+                          "'%s' has no section 'damping', which its contact law (%s damping from "
+                          "a restitution) needs: a file from a grainlab whose damping of this "
+                          "law did not honour the restitution cannot continue; build the scene "
+                          "again",
+                          ckpt_reader_path(ck),
+                          s->contact.damping == DEM_DAMPING_VISCOUS ? "viscous" : "brilliantov");
     }
     if (!r->st && ckpt_has(ck, "boundary")) {
         open_section(r, ck, "boundary");

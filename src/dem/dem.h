@@ -68,7 +68,8 @@ typedef struct dem_material {
     double young;        /* Pa (Hertz laws) */
     double poisson;      /* [0, 0.5) */
     double friction;     /* Coulomb mu >= 0; a pair uses the smaller of its two */
-    double restitution;  /* (0, 1]: sets the linear law's damping; 1 = none */
+    double restitution;  /* (0, 1]: the damping's restitution unless the contact sets one (a
+                          * pair takes the smaller of its two); 1 = none */
     double rolling_friction; /* rolling resistance mu_r >= 0 (the torque limit is mu_r R_eff
                               * F_n); a pair uses the smaller of its two; 0 (default) = none */
 } dem_material;
@@ -86,9 +87,10 @@ typedef enum dem_normal_law {
 
 typedef enum dem_damping_law {
     DEM_DAMPING_NONE,
-    DEM_DAMPING_VISCOUS,     /* f = gamma ddelta/dt (Herrmann Eq. 1b); gamma per pair from the
-                              * materials' restitution (linear law) or the given gamma_n */
-    DEM_DAMPING_BRILLIANTOV  /* f = T K delta^{1/2} ddelta/dt (Padbidri Eq. 2.16) */
+    DEM_DAMPING_VISCOUS,     /* f = gamma ddelta/dt (Herrmann Eq. 1b); gamma = gamma_n, or per
+                              * pair from a restitution (dem_contact_damping) */
+    DEM_DAMPING_BRILLIANTOV  /* f = T K delta^{1/2} ddelta/dt (Padbidri Eq. 2.16), Hertz only; T =
+                              * damping_time, or per pair from a restitution */
 } dem_damping_law;
 
 typedef enum dem_tangential_law {
@@ -114,11 +116,14 @@ typedef struct dem_contact_def {
     double stiffness;        /* k for LINEAR / POWER, N/m^beta */
     double beta;             /* POWER exponent */
     dem_damping_law damping;
-    double gamma_n;          /* VISCOUS: N s/m; < 0 = from the materials' restitution */
-    double damping_time;     /* BRILLIANTOV: a fixed T in seconds (used when restitution < 0) */
-    double restitution;      /* BRILLIANTOV: < 0 = unset; in (0, 1] = every pair (walls too)
-                              * rebounds with e from a head-on impact at impact_velocity */
-    double impact_velocity;  /* BRILLIANTOV with restitution: m/s */
+    double gamma_n;          /* VISCOUS: N s/m; < 0 = from a restitution */
+    double damping_time;     /* BRILLIANTOV: a fixed T in seconds; < 0 = from a restitution */
+    double restitution;      /* < 0 = unset: the materials' (the smaller of a pair's two); in
+                              * (0, 1] = every pair (walls too) rebounds with e from a head-on
+                              * impact at impact_velocity (with damping NONE only 1; not with a
+                              * given gamma_n or damping_time) */
+    double impact_velocity;  /* m/s: the speed at which a restitution holds (the linear spring
+                              * with viscous damping: every speed) */
     dem_tangential_law tangential;
     double gamma_t;          /* VISCOUS tangential, N s/m */
     double kt;               /* SPRING stiffness, N/m; < 0 = 2/7 of the normal stiffness scale */
@@ -366,6 +371,17 @@ double dem_brilliantov_restitution(double lambda, bool clip);
 /* T for one pair of effective mass m_eff and stiffness K at speed v (clipped law). */
 core_status dem_brilliantov_time(double e, double m_eff, double K, double v, double *T,
                                  core_error *err);
+/* Every normal law with viscous or Brilliantov damping: in lengths d* = (m* v^2 / k)^{1/(beta+1)}
+ * and times d* / v the head-on contact is x'' = -x^beta - c x^a x', x(0) = 0, x'(0) = 1, with
+ * a = 0, c = gamma d* / (m* v) (viscous) or a = 1/2, c = T v / d* (Brilliantov; beta = 3/2: c is
+ * lambda above). dem_contact_restitution gives e(c) (adaptive Dormand-Prince to 1e-11, the end
+ * located within the step; clip: the grains part when the force falls to zero, then fly apart;
+ * 0 when the contact never ends); dem_contact_damping solves c(e). A pair then takes
+ * gamma = c m* v / d* or T = c d* / v: for beta = 1 with viscous damping gamma = c sqrt(m* k)
+ * holds at every speed, otherwise e holds at the speed v it was solved for. */
+double dem_contact_restitution(double beta, double a, double c, bool clip);
+core_status dem_contact_damping(double e, double beta, double a, bool clip, double *c,
+                                core_error *err);
 /* The normal damping the force loop uses for particles i and j (0-based), or, when wall >= 0,
  * for particle i against wall `wall` (j ignored): the Brilliantov time T in s, or the viscous
  * gamma in N s/m (0 without damping). */

@@ -99,6 +99,10 @@ struct dem_scene {
     int nmat, cap_mat;
     dem_contact_def contact;
     double brill_c;        /* Brilliantov from a restitution: lambda(e) v^{-1/5} (dem.h) */
+    double damp_c;         /* viscous from s:contact's restitution: c(e) (restitution.c) */
+    double *mat_damp;      /* per material (cap_mat): the coefficient of its restitution when
+                            * the law takes the materials' (restitution.c); a pair takes the
+                            * larger of its two, the smaller restitution */
     dem_power slip_pow;    /* x^(1/exponent) of the regularised Coulomb law */
 
     dem_wall *walls;
@@ -205,6 +209,19 @@ void dem_flow_free(dem_scene *s);
 core_status dem_flow_save(const dem_scene *s, struct ckpt_writer *w, core_error *err);
 struct dem_reader; /* dem/checkpoint_reader.h: the section being read, with its sticky status */
 core_status dem_flow_load(dem_scene *s, struct dem_reader *r);
+
+/* restitution.c: damping from a restitution (dem.h, dem_contact_damping) */
+double dem_law_beta(const dem_contact_def *c); /* the normal law's exponent */
+/* The law takes each pair's damping from its materials' restitution through a solved
+ * coefficient (mat_damp): viscous without gamma_n (except the unclipped linear spring, a closed
+ * form), Brilliantov without damping_time; neither with s:contact's restitution. */
+int dem_damping_solved(const dem_contact_def *c);
+/* Viscous: c(e); Brilliantov: lambda(e) v^{-1/5} (v = impact_velocity). */
+core_status dem_damping_coefficient(const dem_contact_def *c, double e, double *out,
+                                    core_error *err);
+/* The coefficients of n materials (0 each when the law does not take them). */
+core_status dem_damping_table(const dem_contact_def *c, const dem_material *mats, int n,
+                              double *out, core_error *err);
 
 /* neighbor.c */
 /* The law parameters of two particles of material mat, radius r and mass m each. */

@@ -35,24 +35,46 @@ static double linear_gamma(double k, double m_eff, double e)
     return 2 * m_eff * (-lne * w0 / sqrt(DEM_PI * DEM_PI + lne * lne));
 }
 
-static void law_parameters(const dem_scene *s, const dem_material *a, const dem_material *b,
-                           double r_eff, double m_eff, double mu, double *k, double *gamma,
-                           double *mu_out)
+/* Damping a pair of materials ma, mb takes from a restitution: s:contact's if given, else the
+ * smaller of its materials' (the larger coefficient: c falls as e rises), at the impact velocity
+ * v (restitution.c): viscous gamma = c m* v / d*, d* = (m* v^2 / k)^{1/(beta+1)} (for beta = 1,
+ * c sqrt(m* k) at every speed; the unclipped linear spring keeps its closed form); Brilliantov
+ * T = lambda v^{-1/5} (m* / K)^{2/5}. Walls: R* = r, m* = m, the wall's material. */
+static void law_parameters(const dem_scene *s, int ma, int mb, double r_eff, double m_eff,
+                           double mu, double *k, double *gamma, double *mu_out)
 {
     const dem_contact_def *c = &s->contact;
+    const dem_material *a = &s->mats[ma], *b = &s->mats[mb];
     *k = c->normal == DEM_NORMAL_HERTZ ? 4.0 / 3.0 * effective_modulus(a, b) * sqrt(r_eff)
                                        : c->stiffness;
     *gamma = 0;
+    const int given = c->restitution > 0; /* s:contact's restitution */
     if (c->damping == DEM_DAMPING_VISCOUS) {
-        if (c->gamma_n >= 0)
+        const double beta = dem_law_beta(c);
+        if (c->gamma_n >= 0) {
             *gamma = c->gamma_n;
-        else /* the linear law's closed form; for other laws it sets the scale */
-            *gamma = linear_gamma(*k, m_eff, fmin(a->restitution, b->restitution));
+        } else if (beta == 1 && !c->clip) { /* the linear law's closed form */
+            *gamma = linear_gamma(*k, m_eff,
+                                  given ? c->restitution : fmin(a->restitution, b->restitution));
+        } else {
+            double cc = given ? s->damp_c : fmax(s->mat_damp[ma], s->mat_damp[mb]);
+            if (beta == 1) {
+                *gamma = cc * sqrt(m_eff * *k);
+            } else {
+                double v = c->impact_velocity;
+                *gamma = cc * m_eff * v / pow(m_eff * v * v / *k, 1 / (beta + 1));
+            }
+        }
     } else if (c->damping == DEM_DAMPING_BRILLIANTOV) {
         /* gamma carries the damping time T. From a restitution each pair gets its own
          * T = lambda (m_eff / K)^{2/5} v^{-1/5} (dem.h), so a head-on impact at the impact
          * velocity rebounds with e for every pair; brill_c = lambda v^{-1/5} is set once. */
-        *gamma = c->restitution > 0 ? s->brill_c * pow(m_eff / *k, 0.4) : c->damping_time;
+        if (given)
+            *gamma = s->brill_c * pow(m_eff / *k, 0.4);
+        else if (c->damping_time >= 0)
+            *gamma = c->damping_time;
+        else
+            *gamma = fmax(s->mat_damp[ma], s->mat_damp[mb]) * pow(m_eff / *k, 0.4);
     }
     *mu_out = mu;
 }
@@ -64,26 +86,26 @@ void dem_pair_parameters(dem_scene *s, size_t i, size_t j, double *k, double *ga
     /* A fixed or prescribed particle acts with infinite mass. */
     double inv = s->inv_m[i] + s->inv_m[j];
     double m_eff = inv > 0 ? 1 / inv : 0.5 * (s->m[i] + s->m[j]);
-    law_parameters(s, a, b, ri * rj / (ri + rj), m_eff, fmin(a->friction, b->friction), k, gamma,
-                   mu);
+    law_parameters(s, s->mat[i], s->mat[j], ri * rj / (ri + rj), m_eff,
+                   fmin(a->friction, b->friction), k, gamma, mu);
 }
 
 void dem_probe_parameters(const dem_scene *s, int mat, double r, double m, double *k, double *gamma)
 {
     const dem_material *a = &s->mats[mat];
     double mu;
-    law_parameters(s, a, a, 0.5 * r, 0.5 * m, a->friction, k, gamma, &mu);
+    law_parameters(s, mat, mat, 0.5 * r, 0.5 * m, a->friction, k, gamma, &mu);
 }
 
 void dem_wall_parameters(const dem_scene *s, const dem_wall *w, size_t i, double *k,
                          double *gamma, double *mu)
 {
-    const dem_material *a = &s->mats[s->mat[i]];
-    const dem_material *b = w->material >= 0 ? &s->mats[w->material] : a;
+    const int ma = s->mat[i], mb = w->material >= 0 ? w->material : ma;
+    const dem_material *a = &s->mats[ma], *b = &s->mats[mb];
     double m_eff = s->inv_m[i] > 0 ? 1 / s->inv_m[i] : s->m[i];
     /* The wall's own friction if given; else the pair rule with the wall's material. */
     double mu_w = w->friction >= 0 ? w->friction : fmin(a->friction, b->friction);
-    law_parameters(s, a, b, s->r[i], m_eff, mu_w, k, gamma, mu);
+    law_parameters(s, ma, mb, s->r[i], m_eff, mu_w, k, gamma, mu);
 }
 
 static core_status alloc_u32(uint32_t **a, size_t n, core_error *err)

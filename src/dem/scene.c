@@ -28,7 +28,7 @@ dem_contact_def dem_default_contact_def(void)
                              .beta = 1.5,
                              .damping = DEM_DAMPING_NONE,
                              .gamma_n = -1,
-                             .damping_time = 0,
+                             .damping_time = -1,
                              .restitution = -1,
                              .impact_velocity = 1,
                              .tangential = DEM_TANGENT_NONE,
@@ -137,7 +137,7 @@ void dem_destroy(dem_scene *s)
         free(s->walls[w].cand), free(s->walls[w].cand_par);
         dem_shape_free(s->walls[w].shape);
     }
-    free(s->walls), free(s->mats);
+    free(s->walls), free(s->mats), free(s->mat_damp);
     dem_free_pairs(&s->pairs);
     free(s->cell_start), free(s->cell_items);
     free(s);
@@ -163,15 +163,29 @@ int dem_add_material(dem_scene *s, const dem_material *m, core_error *err)
         return core_fail(err, CORE_ERR_ARG, "rolling_friction must be >= 0, got %g",
                          m->rolling_friction),
                -1;
+    /* the damping its restitution gives under the scene's law (restitution.c) */
+    double coef = 0;
+    int same = 0;
+    while (same < s->nmat && s->mats[same].restitution != m->restitution)
+        same++;
+    if (same < s->nmat)
+        coef = s->mat_damp[same];
+    else if (dem_damping_table(&s->contact, m, 1, &coef, err) != CORE_OK)
+        return -1;
     if (s->nmat == s->cap_mat) {
         int cap = s->cap_mat ? 2 * s->cap_mat : 4;
         dem_material *p = realloc(s->mats, (size_t)cap * sizeof *p);
         if (!p)
             return core_fail(err, CORE_ERR_NOMEM, "cannot allocate materials"), -1;
         s->mats = p;
+        double *q = realloc(s->mat_damp, (size_t)cap * sizeof *q);
+        if (!q)
+            return core_fail(err, CORE_ERR_NOMEM, "cannot allocate materials"), -1;
+        s->mat_damp = q;
         s->cap_mat = cap;
     }
     s->mats[s->nmat] = *m;
+    s->mat_damp[s->nmat] = coef;
     dem_invalidate(s, 1); /* pair parameters depend on materials */
     return s->nmat++;
 }
@@ -186,27 +200,52 @@ core_status dem_set_contact(dem_scene *s, const dem_contact_def *c, core_error *
     }
     if (c->normal == DEM_NORMAL_POWER && c->beta != 1 && c->beta != 1.5 && c->beta != 2)
         return core_fail(err, CORE_ERR_ARG, "beta must be 1, 1.5 or 2, got %g", c->beta);
-    if (c->damping == DEM_DAMPING_BRILLIANTOV) {
-        if (c->normal != DEM_NORMAL_HERTZ)
-            return core_fail(err, CORE_ERR_ARG, "brilliantov damping needs the hertz normal law");
-        if (c->restitution < 0 && (!(c->damping_time >= 0) || !isfinite(c->damping_time)))
-            return core_fail(err, CORE_ERR_ARG, "damping_time must be >= 0, got %g",
-                             c->damping_time);
-        if (c->restitution >= 0 && !(c->impact_velocity > 0 && isfinite(c->impact_velocity)))
-            return core_fail(err, CORE_ERR_ARG, "impact_velocity must be > 0, got %g",
-                             c->impact_velocity);
+    if (c->damping == DEM_DAMPING_BRILLIANTOV && c->normal != DEM_NORMAL_HERTZ)
+        return core_fail(err, CORE_ERR_ARG,
+                         "brilliantov damping needs the hertz normal law (with the %s law, "
+                         "damping 'viscous' honours a restitution)",
+                         c->normal == DEM_NORMAL_LINEAR ? "linear" : "power");
+    if (c->damping == DEM_DAMPING_BRILLIANTOV && !(c->damping_time < 0 || isfinite(c->damping_time)))
+        return core_fail(err, CORE_ERR_ARG, "damping_time must be finite, got %g", c->damping_time);
+    if (c->damping == DEM_DAMPING_VISCOUS && !(c->gamma_n < 0 || isfinite(c->gamma_n)))
+        return core_fail(err, CORE_ERR_ARG, "gamma_n must be finite, got %g", c->gamma_n);
+    /* A restitution asked of the contact: every law that can honour it does, or it is refused. */
+    if (!(c->restitution < 0)) {
+        if (!(c->restitution > 0 && c->restitution <= 1))
+            return core_fail(err, CORE_ERR_ARG, "restitution must be in (0, 1], got %g",
+                             c->restitution);
+        if (c->damping == DEM_DAMPING_NONE && c->restitution < 1)
+            return core_fail(err, CORE_ERR_ARG,
+                             "restitution %g needs damping: damping 'none' rebounds with 1 (choose "
+                             "damping 'viscous'%s)",
+                             c->restitution, c->normal == DEM_NORMAL_HERTZ ? " or 'brilliantov'" : "");
+        if (c->damping == DEM_DAMPING_VISCOUS && c->gamma_n >= 0)
+            return core_fail(err, CORE_ERR_ARG,
+                             "give gamma_n or restitution, not both (gamma_n is one coefficient "
+                             "for every pair, restitution one per pair)");
+        if (c->damping == DEM_DAMPING_BRILLIANTOV && c->damping_time >= 0)
+            return core_fail(err, CORE_ERR_ARG,
+                             "give damping_time or restitution, not both (damping_time is one T "
+                             "for every pair, restitution one per pair)");
     }
-    /* Solved once here; each pair's damping time is then a power of its m_eff / K (neighbor.c). */
-    double brill_c = 0;
-    if (c->damping == DEM_DAMPING_BRILLIANTOV && !(c->restitution < 0)) {
+    if (c->damping != DEM_DAMPING_NONE && !(c->impact_velocity > 0 && isfinite(c->impact_velocity)))
+        return core_fail(err, CORE_ERR_ARG, "impact_velocity must be > 0, got %g",
+                         c->impact_velocity);
+    /* Solved once here; each pair's damping is then a power of its m_eff / k (neighbor.c). */
+    double brill_c = 0, damp_c = 0;
+    if (c->damping == DEM_DAMPING_BRILLIANTOV && c->restitution > 0) {
         double lambda;
         core_status st = dem_brilliantov_lambda(c->restitution, c->clip, &lambda, err);
         if (st != CORE_OK)
             return st;
         brill_c = lambda * pow(c->impact_velocity, -0.2);
     }
-    if (c->damping == DEM_DAMPING_VISCOUS && !(c->gamma_n < 0 || isfinite(c->gamma_n)))
-        return core_fail(err, CORE_ERR_ARG, "gamma_n must be finite, got %g", c->gamma_n);
+    if (c->damping == DEM_DAMPING_VISCOUS && c->restitution > 0 && c->gamma_n < 0 &&
+        (c->clip || dem_law_beta(c) != 1)) {
+        core_status st = dem_damping_coefficient(c, c->restitution, &damp_c, err);
+        if (st != CORE_OK)
+            return st;
+    }
     if (c->tangential == DEM_TANGENT_VISCOUS && !(c->gamma_t >= 0 && isfinite(c->gamma_t)))
         return core_fail(err, CORE_ERR_ARG, "gamma_t must be >= 0, got %g", c->gamma_t);
     if (c->tangential == DEM_TANGENT_SPRING && !(c->kt < 0 || (c->kt > 0 && isfinite(c->kt))))
@@ -231,10 +270,24 @@ core_status dem_set_contact(dem_scene *s, const dem_contact_def *c, core_error *
         if (!(c->exponent >= 1) || !isfinite(c->exponent))
             return core_fail(err, CORE_ERR_ARG, "exponent must be >= 1, got %g", c->exponent);
     }
+    double *mat_damp = NULL; /* the materials' coefficients under the new law */
+    if (s->cap_mat > 0) {
+        mat_damp = calloc((size_t)s->cap_mat, sizeof *mat_damp);
+        if (!mat_damp)
+            return core_fail(err, CORE_ERR_NOMEM, "cannot allocate materials");
+        core_status st = dem_damping_table(c, s->mats, s->nmat, mat_damp, err);
+        if (st != CORE_OK) {
+            free(mat_damp);
+            return st;
+        }
+    }
     int spring_before = s->contact.tangential == DEM_TANGENT_SPRING;
     int roll_before = s->contact.rolling_law;
     s->contact = *c;
     s->brill_c = brill_c;
+    s->damp_c = damp_c;
+    free(s->mat_damp);
+    s->mat_damp = mat_damp;
     dem_power_init(&s->slip_pow, c->tangential == DEM_TANGENT_REGULARIZED ? 1 / c->exponent : 0);
     if (c->tangential != DEM_TANGENT_NONE || c->rolling || c->rolling_law != DEM_ROLLING_NONE) {
         core_status st = dem_ensure_rotation(s, err);

@@ -251,6 +251,13 @@ static int l_contact(lua_State *L)
     c.tangential = (dem_tangential_law)bind_field_option(L, 2, "contact", "tangential",
                                                          TANGENT_NAMES, DEM_TANGENT_NONE, 0);
     lua_settop(L, 2);
+    if (c.damping == DEM_DAMPING_BRILLIANTOV && c.normal != DEM_NORMAL_HERTZ) {
+        lua_getfield(L, 2, "damping");
+        return bind_field_error(L, 2, "contact", "damping",
+                                "'none' or 'viscous' with the linear and power laws (brilliantov "
+                                "damping needs normal = 'hertz'; viscous damping honours a "
+                                "restitution with every law)");
+    }
     only_with(L, "stiffness", c.normal != DEM_NORMAL_HERTZ,
               "'normal' is 'linear' or 'power' (hertz takes the materials' moduli)");
     only_with(L, "beta", c.normal == DEM_NORMAL_POWER, "'normal' is 'power'");
@@ -263,8 +270,6 @@ static int l_contact(lua_State *L)
               "'tangential' is 'coulomb_regularized'");
     only_with(L, "exponent", c.tangential == DEM_TANGENT_REGULARIZED,
               "'tangential' is 'coulomb_regularized'");
-    only_with(L, "impact_velocity", c.damping == DEM_DAMPING_BRILLIANTOV,
-              "'damping' is 'brilliantov' (with 'restitution')");
     unsigned need_k = c.normal == DEM_NORMAL_HERTZ ? 0 : BIND_REQUIRED;
     c.stiffness = bind_field_number(L, 2, "contact", "stiffness", 0, BIND_POSITIVE | need_k);
     c.beta = bind_field_number(L, 2, "contact", "beta", c.normal == DEM_NORMAL_LINEAR ? 1 : 1.5,
@@ -282,21 +287,42 @@ static int l_contact(lua_State *L)
                                 "nothing when 'damping_time' is given: give damping_time (one T "
                                 "for every pair) or restitution (a T per pair), not both");
     lua_settop(L, 2);
+    if (c.gamma_n >= 0 && lua_getfield(L, 2, "restitution") != LUA_TNIL)
+        return bind_field_error(L, 2, "contact", "restitution",
+                                "nothing when 'gamma_n' is given: give gamma_n (one coefficient "
+                                "for every pair) or restitution (one per pair), not both");
+    lua_settop(L, 2);
     if (e >= 0 || lua_getfield(L, 2, "restitution") != LUA_TNIL) {
         lua_getfield(L, 2, "restitution");
-        if (c.damping != DEM_DAMPING_BRILLIANTOV)
-            return bind_field_error(L, 2, "contact", "restitution",
-                                    "nothing unless 'damping' is 'brilliantov' (viscous damping "
-                                    "takes the materials' restitution)");
         if (!(e > 0 && e <= 1))
             return bind_field_error(L, 2, "contact", "restitution", "number in (0, 1]");
+        if (c.damping == DEM_DAMPING_NONE && e < 1)
+            return bind_field_error(L, 2, "contact", "restitution",
+                                    c.normal == DEM_NORMAL_HERTZ
+                                        ? "1 when 'damping' is 'none' (for a rebound below 1 "
+                                          "give damping = 'viscous' or 'brilliantov')"
+                                        : "1 when 'damping' is 'none' (for a rebound below 1 "
+                                          "give damping = 'viscous')");
         lua_pop(L, 1);
     }
+    /* The speed at which a restitution holds: meaningful when the damping comes from one (the
+     * contact's or the materials') and e depends on speed, i.e. all but the linear spring with
+     * viscous damping. */
+    const char *no_speed =
+        c.damping == DEM_DAMPING_NONE ? "nothing unless 'damping' is 'viscous' or 'brilliantov' "
+                                        "(the speed at which a restitution holds)"
+        : c.gamma_n >= 0      ? "nothing when 'gamma_n' is given (the speed at which a "
+                                "restitution holds)"
+        : c.damping_time >= 0 ? "nothing when 'damping_time' is given (the speed at which a "
+                                "restitution holds)"
+        : c.damping == DEM_DAMPING_VISCOUS && c.beta == 1
+            ? "nothing with viscous damping of a linear spring (beta = 1): its restitution holds "
+              "at every speed"
+            : NULL;
+    if (no_speed && lua_getfield(L, 2, "impact_velocity") != LUA_TNIL)
+        return bind_field_error(L, 2, "contact", "impact_velocity", no_speed);
+    lua_settop(L, 2);
     double v_imp = bind_field_number(L, 2, "contact", "impact_velocity", 1, BIND_POSITIVE);
-    if (e < 0 && lua_getfield(L, 2, "impact_velocity") != LUA_TNIL)
-        return bind_field_error(
-            L, 2, "contact", "impact_velocity",
-            "nothing unless restitution is given (the speed at which 'restitution' holds)");
     lua_settop(L, 2);
     c.gamma_t = bind_field_number(L, 2, "contact", "gamma_t", 0, BIND_NONNEG);
     c.kt = bind_field_number(L, 2, "contact", "kt", -1, 0);
@@ -328,21 +354,14 @@ static int l_contact(lua_State *L)
         return bind_field_error(L, 2, "contact", "rolling_damping", "number in [0, 1]");
     }
     c.rolling_rate = bind_field_number(L, 2, "contact", "rolling_rate", 0, BIND_POSITIVE);
-    if (c.damping == DEM_DAMPING_BRILLIANTOV) {
-        if (c.damping_time < 0 && e < 0)
-            return luaL_error(L, "bad argument #1 to 'contact' (damping = 'brilliantov' needs "
-                                 "field 'damping_time' (s) or 'restitution' (with "
-                                 "'impact_velocity', default 1 m/s))");
-        /* From a restitution each pair gets its own T when the pair list is built: nothing
-         * depends on the particles present now. (damping_time and restitution together are
-         * refused above, naming the fields.) */
-        c.restitution = e;
-        c.impact_velocity = v_imp;
-    }
+    /* From a restitution (this one, else the materials') each pair gets its own damping when
+     * the pair list is built: nothing depends on the particles present now. */
+    c.restitution = e;
+    c.impact_velocity = v_imp;
     core_error err;
     if (dem_set_contact(s, &c, &err) != CORE_OK)
         return bind_raise(L, "contact", &err);
-    if (c.damping == DEM_DAMPING_BRILLIANTOV && e < 0) {
+    if (c.damping == DEM_DAMPING_BRILLIANTOV && c.damping_time >= 0) {
         lua_pushnumber(L, c.damping_time);
         return 1;
     }
@@ -1724,13 +1743,16 @@ void bind_open_dem(lua_State *L)
          "rolling_rate = }",
          "Sets the contact law of the scene. Normal: linear f = k d (Herrmann Eq. 1a, beta = 1), "
          "power f = k d^beta (beta 1, 1.5 or 2), hertz f = 4/3 E* sqrt(R) d^1.5 (Padbidri Eq. "
-         "1.1). Damping: viscous gamma_n d' (Eq. 1b; gamma_n per pair from the materials' "
-         "restitution unless given), brilliantov T K d^0.5 d' (Eq. 2.16) with T = damping_time for "
-         "every pair, or, from restitution = e at impact_velocity (default 1 m/s), a T per pair "
-         "(walls too): T = lambda(e) (m*/K)^(2/5) v^(-1/5) with K = 4/3 E* sqrt(R*), so a "
-         "head-on impact at that speed rebounds with e for every pair whatever its radii, masses "
-         "and materials (at other speeds e follows Brilliantov's law: higher when slower); "
-         "s:damping_time(i, j) gives a pair's T. Tangential: "
+         "1.1). Damping: viscous gamma_n d' (Eq. 1b), brilliantov T K d^0.5 d' (Eq. 2.16, hertz "
+         "only). gamma_n or damping_time, when given, holds for every pair; otherwise each pair "
+         "(walls too) gets its own from a restitution e, restitution = e here or else the smaller "
+         "of the pair's two materials' restitution, so that a head-on impact at impact_velocity "
+         "(default 1 m/s) rebounds with e whatever the radii, masses and materials: with "
+         "d* = (m* v^2/k)^(1/(beta+1)), gamma = c(e) m* v/d* or T = lambda(e) (m*/K)^(2/5) "
+         "v^(-1/5), K = 4/3 E* sqrt(R*). The linear spring with viscous damping holds e at every "
+         "speed (no impact_velocity); elsewhere e moves with speed (viscous: lower when slower; "
+         "brilliantov: higher when slower). damping = 'none' rebounds with 1 (restitution < 1 is "
+         "refused). s:damping_time(i, j) gives a pair's T. Tangential: "
          "viscous -gamma_t s (Eq. 2a), spring (Cundall-Strack, Eq. 2b; kt defaults to 2/7 of "
          "the normal tangent stiffness), coulomb_regularized mu f_n min(1, (s/v_r)^(1/exponent)) "
          "(Eq. 2.18). clip = true forbids attractive normal forces; rolling = true allocates "

@@ -1,6 +1,7 @@
-/* Brilliantov damping from a restitution (src/dem): every pair, whatever its radii, masses and
- * materials, and a particle against a wall, rebounds from a head-on impact at the impact velocity
- * with the requested e. The dimensionless solve is checked against its own first-order limit
+/* Damping from a restitution (src/dem): the general dimensionless contact of every normal law
+ * with viscous or Brilliantov damping against closed forms; Brilliantov damping: every pair,
+ * whatever its radii, masses and materials, and a particle against a wall, rebounds from a
+ * head-on impact at the impact velocity with the requested e. The dimensionless solve is checked against its own first-order limit
  * (re-derived here by quadrature), and the scenes against the requested e within the time-step
  * error (dt = contact time / 400 gives |e - e_asked| ~ 1e-4; tolerance 1e-3). No Lua. */
 #include <math.h>
@@ -154,9 +155,74 @@ static void test_every_pair(void **state)
     assert_true(fabs(es - eq) < 1e-3);
 }
 
+/* The general dimensionless contact x'' = -x^beta - c x^a x' (dem_contact_restitution) against
+ * closed forms re-derived here: the linear spring-dashpot (z = c/2) rebounds unclipped with
+ * e = exp(-pi z / sqrt(1 - z^2)); clipped, the force k x + c x' falls to zero at w t = pi - 2 asin z
+ * and the grains leave at that speed, e = exp(-z (pi - 2 asin z) / sqrt(1 - z^2)) (z < 1),
+ * exp(-2 z acosh z / sqrt(z^2 - 1)) (z > 1) (Schwager & Poeschel 2007). Brilliantov's case
+ * (beta = 3/2, a = 1/2) against the fixed-step solve above. */
+#define PI 3.14159265358979323846
+
+static double linear_clipped(double z)
+{
+    if (z < 1)
+        return exp(-z * (PI - 2 * asin(z)) / sqrt(1 - z * z));
+    return exp(-2 * z * acosh(z) / sqrt(z * z - 1));
+}
+
+static void test_general_law(void **state)
+{
+    (void)state;
+    core_error err;
+    const double zs[] = {0.01, 0.1, 0.25, 0.5, 0.9};
+    for (size_t k = 0; k < sizeof zs / sizeof *zs; k++) {
+        double z = zs[k], open = exp(-PI * z / sqrt(1 - z * z));
+        assert_true(fabs(dem_contact_restitution(1, 0, 2 * z, false) / open - 1) < 1e-8);
+        assert_true(fabs(dem_contact_restitution(1, 0, 2 * z, true) / linear_clipped(z) - 1) < 1e-8);
+    }
+    for (double z = 1.5; z < 200; z *= 4) /* overdamped: the clip still lets the grains part */
+        assert_true(fabs(dem_contact_restitution(1, 0, 2 * z, true) / linear_clipped(z) - 1) < 1e-7);
+    /* the clip matters at the percent level: e = 0.7 unclipped is 0.718 clipped */
+    double z7 = -log(0.7) / sqrt(PI * PI + log(0.7) * log(0.7));
+    assert_true(fabs(linear_clipped(z7) - 0.7181) < 1e-3);
+    for (double lam = 0.05; lam < 5; lam *= 3)
+        assert_true(fabs(dem_contact_restitution(1.5, 0.5, lam, true) -
+                         dem_brilliantov_restitution(lam, true)) < 2e-6);
+    /* elastic at c = 0; e falls with c for every law; the solve inverts it */
+    const double betas[] = {1, 1.5, 2};
+    for (size_t b = 0; b < 3; b++)
+        for (int clip = 0; clip < 2; clip++)
+            for (int a2 = 0; a2 < 2; a2++) {
+                double beta = betas[b], a = 0.5 * a2;
+                assert_true(fabs(dem_contact_restitution(beta, a, 0, clip) - 1) < 1e-9);
+                double prev = 1;
+                for (double c = 0.02; c < 0.6; c *= 2) {
+                    double e = dem_contact_restitution(beta, a, c, clip);
+                    assert_true(e < prev && e > 0);
+                    prev = e;
+                }
+                const double es[] = {0.05, 0.5, 0.9, 0.999};
+                for (size_t k = 0; k < 4; k++) {
+                    double c;
+                    assert_int_equal(dem_contact_damping(es[k], beta, a, clip, &c, &err), CORE_OK);
+                    assert_true(fabs(dem_contact_restitution(beta, a, c, clip) - es[k]) < 1e-9);
+                }
+            }
+    double c;
+    assert_int_equal(dem_contact_damping(1, 2, 0, true, &c, &err), CORE_OK);
+    assert_true(c == 0);
+    assert_int_equal(dem_contact_damping(1e-3, 1.5, 0, true, &c, &err), CORE_OK); /* heavy damping */
+    assert_true(fabs(dem_contact_restitution(1.5, 0, c, true) - 1e-3) < 1e-9);
+    assert_int_not_equal(dem_contact_damping(0, 1.5, 0, true, &c, &err), CORE_OK);
+    assert_int_not_equal(dem_contact_damping(1.5, 1.5, 0, true, &c, &err), CORE_OK);
+    assert_int_not_equal(dem_contact_damping(NAN, 1.5, 0, true, &c, &err), CORE_OK);
+    assert_int_not_equal(dem_contact_damping(1e-300, 1.5, 0, true, &c, &err), CORE_OK);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_dimensionless),
-                                       cmocka_unit_test(test_every_pair)};
+                                       cmocka_unit_test(test_every_pair),
+                                       cmocka_unit_test(test_general_law)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

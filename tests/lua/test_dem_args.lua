@@ -139,8 +139,8 @@ do
     "bad field 'restitution' in argument #1 to 'contact' (number in (0, 1] expected, got 0)", "brilliantov restitution 0")
   check.errors(function() b:contact{ damping = "brilliantov", restitution = 1.01 } end,
     "bad field 'restitution' in argument #1 to 'contact' (number in (0, 1] expected, got 1.01)", "brilliantov restitution > 1")
-  check.errors(function() b:contact{ damping = "brilliantov" } end,
-    "bad argument #1 to 'contact' (damping = 'brilliantov' needs field 'damping_time' (s) or 'restitution'", "brilliantov without a time")
+  check.eq(b:contact{ damping = "brilliantov" }, nil,
+    "brilliantov without damping_time or restitution: a T per pair from the materials' restitution")
 end
 
 -- ---- unknown fields (typos) --------------------------------------------------------------------
@@ -214,7 +214,7 @@ end
 -- Values given out of range are refused rather than read as "not given".
 local c = dem.scene{ dim = 2, box = { { 0, 0 }, { 1, 1 } } }
 check.errors(function() c:contact{ normal = "linear", stiffness = 1, damping = "viscous", restitution = 7 } end,
-  "bad field 'restitution' in argument #1 to 'contact' (nothing unless 'damping' is 'brilliantov'", "restitution with viscous damping")
+  "bad field 'restitution' in argument #1 to 'contact' (number in (0, 1] expected, got 7)", "restitution 7 with viscous damping")
 check.errors(function() c:contact{ normal = "hertz", damping = "viscous", gamma_n = -1 } end,
   "bad field 'gamma_n' in argument #1 to 'contact' (non-negative number expected, got -1)", "negative gamma_n")
 check.errors(function() c:contact{ normal = "hertz", damping = "brilliantov", damping_time = -1 } end,

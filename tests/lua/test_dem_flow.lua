@@ -290,7 +290,8 @@ end
 -- the same in 3D (every 3D array: positions, three angular velocities and torques, wall history)
 local function pile3(with_p)
   local s = dem.scene{ dim = 3, box = { { 0, 0, 0 }, { 0.03, 0.03, 0.05 } }, gravity = { 0, 0, -9.81 } }
-  s:contact{ damping = "viscous", tangential = "spring" }
+  -- a damped pile (e = 0.1 at 1 m/s) that has settled into contacts by the end
+  s:contact{ damping = "viscous", tangential = "spring", restitution = 0.1 }
   s:add_wall{ point = { 0, 0, 0 }, normal = { 0, 0, 1 } }
   if with_p then s:add_sphere{ pos = { 0.027, 0.027, 0.045 }, radius = 0.002, vel = { 0, 0, -3 }, material = mat } end
   for k = 0, 17 do

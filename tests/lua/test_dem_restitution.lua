@@ -68,7 +68,7 @@ check.eq(f:damping_time(1, 2), 2e-6, "a fixed damping_time holds for every pair"
 check.errors(function() f:contact{ damping = "brilliantov", damping_time = 1e-6, restitution = 0.5 } end,
              "give damping_time (one T for every pair) or restitution (a T per pair), not both", "both")
 check.errors(function() f:contact{ damping = "brilliantov", damping_time = 1e-6, impact_velocity = 2 } end,
-             "bad field 'impact_velocity' in argument #1 to 'contact' (nothing unless restitution is given", "impact_velocity alone")
+             "bad field 'impact_velocity' in argument #1 to 'contact' (nothing when 'damping_time' is given (the speed at which a restitution holds)", "impact_velocity with damping_time")
 check.errors(function() f:damping_time(1, 3) end, "particle id in [1, 2] expected, got 3", "pair out of range")
 check.errors(function() f:damping_time(1, { wall = 1 }) end, "wall 1 out of range", "no such wall")
 local nd = dem.scene{ dim = 2, box = { { 0, 0 }, { 1, 1 } } }
