@@ -577,7 +577,8 @@ function M.drive(p)
       local f = io.open(out, "r")
       local text = f and f:read("a") or ""
       if f then f:close() end
-      local lines = lines_of(text)
+      local lines = {} -- whole lines only: the worker may be writing the last one
+      for l in text:gmatch("([^\n]*)\n") do lines[#lines + 1] = l end
       for i = seen + 1, #lines do
         local l = lines[i]
         local b = l:match("^begin (%d+)$")
