@@ -434,6 +434,11 @@ static core_status parse(reader *r, dem_lammps_data *d, core_error *err)
                        bad_line(err, r, msg);
             if (have_box[a])
                 return bad_line(err, r, "the box bounds of this axis are given twice");
+            if (fabs(lo) > 1e100 || fabs(hi) > 1e100) /* what dem.scene takes for a box */
+                return snprintf(msg, sizeof msg,
+                                "%clo %chi %g %g: box bounds of magnitude at most 1e100 expected",
+                                'x' + a, 'x' + a, lo, hi),
+                       bad_line(err, r, msg);
             d->lo[a] = lo, d->hi[a] = hi, have_box[a] = 1;
             continue;
         }
@@ -711,10 +716,9 @@ core_status dem_lammps_add(dem_scene *s, const dem_lammps_data *d, const dem_lam
             double boxes = (x < s->lo[a] ? s->lo[a] - x : x - s->hi[a]) / s->len[a];
             if (s->periodic[a] && boxes > 512)
                 return core_fail(err, CORE_ERR_ARG,
-                                 "%s:%ld: atom %lld: %c = %.17g lies %.3g box lengths outside the "
-                                 "periodic box [%g, %g] (at most 512, LAMMPS's image range)",
-                                 d->path, d->line[k], d->id[k], 'x' + a, x, boxes, s->lo[a],
-                                 s->hi[a]);
+                                 "%s:%ld: atom %lld: %c = %.17g is more than 512 box lengths "
+                                 "(LAMMPS's image range) outside the periodic box [%g, %g]",
+                                 d->path, d->line[k], d->id[k], 'x' + a, x, s->lo[a], s->hi[a]);
         }
         /* a speed whose kinetic energy overflows is no grain's (the energy measures sum v^2) */
         for (int a = 0; a < 3; a++) {

@@ -5,8 +5,8 @@
 -- child that dies (a sanitizer report, under the sanitizer build).
 --   1. named cases, one per class: a LAMMPS header counting 10^8 or 2^31 atoms over a few hundred
 --      lines; a data file cut in its Velocities section, inside its last number, inside a z;
---      image flags on an axis that is not periodic and on z in 2D; +-1e308 as a coordinate; a NUL
---      byte; DEM, MPM and DSMC step counters near 2^63; a boundary spring joining particle
+--      image flags on an axis that is not periodic and on z in 2D; +-1e308 as a coordinate or a
+--      box bound; a NUL byte; DEM, MPM and DSMC step counters near 2^63; a boundary spring joining particle
 --      2^63 - 1; a checkpoint without its rolling-resistance section; MPM and DSMC grids inflated;
 --      a FIFO, /dev/zero and a directory given to each reader;
 --   2. 300 generated mutations (seed 1): bit flips with and without the checksum, cuts at section
@@ -90,6 +90,8 @@ case("x = 1e308, not periodic", "lammps", first_atom(t2, coordinate("1e308")),
      "x = 1e+308 is outside the scene's box [0, 0.1] on an axis that is not periodic")
 case("x = -1e308, periodic", "lammps", first_atom(t3, coordinate("-1e308")),
      "x = -1e+308 is more than 512 box lengths (LAMMPS's image range) outside the periodic box [0, 0.1]", p3)
+case("xlo = -1e308", "lammps", (t2:gsub("\n0 0.10000000000000001 xlo xhi\n", "\n-1e308 0.10000000000000001 xlo xhi\n", 1)),
+     ":6: xlo xhi -1e+308 0.1: box bounds of magnitude at most 1e100 expected")
 case("NUL byte", "lammps", first_atom(t2, function(line) return line:sub(1, 5) .. "\0" .. line:sub(6) end),
      "the line holds a NUL byte")
 
