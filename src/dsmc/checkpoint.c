@@ -280,10 +280,15 @@ static core_status read_particles(reader *rd, dsmc_scene *s)
     /* between steps the particles are sorted by cell; re-adding them in that order keeps it */
     uint32_t prev = 0;
     for (size_t i = 0; i < n; i++) {
-        for (int k = 0; k < D; k++)
+        double v2 = 0;
+        for (int k = 0; k < D; k++) {
             if (!isfinite(a[k][i]) || !isfinite(a[D + k][i]) || a[k][i] < s->def.lo[k] ||
                 a[k][i] > s->def.hi[k])
                 TRY(corrupt(rd, "a particle is outside the box or not finite"));
+            v2 += a[D + k][i] * a[D + k][i];
+        }
+        if (!isfinite(v2 * s->mass))
+            TRY(corrupt(rd, "a particle's kinetic energy is not finite"));
         const uint32_t c = dsmc_cell_of(s, a[0][i], a[1][i], D == 3 ? a[2][i] : 0);
         if (c < prev)
             TRY(corrupt(rd, "the particles are not in cell order"));

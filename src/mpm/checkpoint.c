@@ -469,6 +469,8 @@ static core_status read_points(reader *rd, mpm_scene *s)
                 return corrupt(rd, "a point has a non-finite value");
         if (!(s->m[p] > 0) || !(s->v0[p] > 0))
             return corrupt(rd, "a point has no mass or volume");
+        if (!isfinite(s->m[p] * (s->vx[p] * s->vx[p] + s->vy[p] * s->vy[p])))
+            return corrupt(rd, "a point's kinetic energy is not finite");
         const double c[2] = {s->x[p], s->y[p]};
         for (int ax = 0; ax < 2; ax++) {
             const double o = d->origin[ax], L = d->size[ax];
