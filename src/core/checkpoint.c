@@ -51,7 +51,11 @@ struct ckpt_writer {
     uint32_t flags;
     unsigned char *buf;
     size_t len, cap;
+    char (*tags)[16]; /* every section written, for "contents" */
+    size_t ntags, cap_tags;
 };
+
+static const char CONTENTS[] = "contents";
 
 static void fail_w(ckpt_writer *w, core_status st, const char *what)
 {
@@ -124,6 +128,9 @@ core_status ckpt_section_begin(ckpt_writer *w, const char *tag, uint32_t flags, 
     if (!tag || !*tag || strlen(tag) > CKPT_TAG_MAX)
         return core_fail(err, CORE_ERR_ARG, "checkpoint section tag must be 1 to %d characters",
                          CKPT_TAG_MAX);
+    if (strcmp(tag, CONTENTS) == 0)
+        return core_fail(err, CORE_ERR_ARG, "checkpoint section tag '%s' is the container's own",
+                         tag);
     w->in_section = 1;
     padded(w->tag, sizeof w->tag, tag);
     w->flags = flags;
@@ -210,8 +217,17 @@ core_status ckpt_section_end(ckpt_writer *w, core_error *err)
     emit(w, w->buf, w->len);
     static const unsigned char zeros[8] = {0};
     emit(w, zeros, (8 - w->len % 8) % 8);
+    if (w->status == CORE_OK && w->ntags == w->cap_tags) {
+        size_t cap = w->cap_tags ? 2 * w->cap_tags : 16;
+        char(*t)[16] = realloc(w->tags, cap * sizeof *t);
+        if (!t)
+            fail_w(w, CORE_ERR_NOMEM, "out of memory");
+        else
+            w->tags = t, w->cap_tags = cap;
+    }
     if (w->status != CORE_OK)
         return core_fail(err, w->status, "%s", w->msg);
+    memcpy(w->tags[w->ntags++], w->tag, 16);
     return CORE_OK;
 }
 
@@ -219,6 +235,17 @@ core_status ckpt_writer_commit(ckpt_writer *w, core_error *err)
 {
     if (w->in_section)
         fail_w(w, CORE_ERR_STATE, "a section is still open");
+    if (w->status == CORE_OK) { /* "contents": the tags of every section above */
+        w->in_section = 1;
+        padded(w->tag, sizeof w->tag, CONTENTS);
+        w->flags = 0;
+        w->len = 0;
+        const size_t ntags = w->ntags;
+        ckpt_put_u64(w, ntags);
+        ckpt_put_bytes(w, w->tags, ntags * sizeof *w->tags);
+        core_error ignored;
+        ckpt_section_end(w, &ignored); /* a failure is sticky: reported below */
+    }
     emit(w, END_MAGIC, 8);
     const uint64_t size = w->written + 16;
     emit(w, &size, 8);
@@ -231,6 +258,7 @@ core_status ckpt_writer_commit(ckpt_writer *w, core_error *err)
     }
     core_status st = atomic_commit(&w->f, err);
     free(w->buf);
+    free(w->tags);
     free(w);
     return st;
 }
@@ -242,6 +270,7 @@ void ckpt_writer_abort(ckpt_writer *w)
     if (w->f.fp)
         atomic_abort(&w->f);
     free(w->buf);
+    free(w->tags);
     free(w);
 }
 
@@ -271,17 +300,17 @@ static core_status slurp(const char *path, unsigned char **out, size_t *size, co
 {
     *out = NULL;
     *size = 0;
-    FILE *fp = fopen(path, "rb");
-    if (!fp)
-        return core_fail(err, CORE_ERR_IO, "cannot read checkpoint '%s': %s", path,
-                         strerror(errno));
-    struct stat st;
-    if (fstat(fileno(fp), &st) != 0 || !S_ISREG(st.st_mode)) {
+    FILE *fp;
+    uint64_t bytes;
+    core_status st = fileio_open_read(path, "checkpoint", &fp, &bytes, err);
+    if (st != CORE_OK)
+        return st;
+    if (bytes > SIZE_MAX - 1) {
         fclose(fp);
-        return core_fail(err, CORE_ERR_IO, "cannot read checkpoint '%s': %s", path,
-                         S_ISDIR(st.st_mode) ? "is a directory" : "not a regular file");
+        return core_fail(err, CORE_ERR_NOMEM, "checkpoint '%s' is too large (%llu bytes)", path,
+                         (unsigned long long)bytes);
     }
-    size_t n = (size_t)st.st_size;
+    size_t n = (size_t)bytes;
     unsigned char *buf = malloc(n ? n : 1);
     if (!buf) {
         fclose(fp);
@@ -397,6 +426,57 @@ static core_status check_frame(ckpt_reader *r, const char *engine, core_error *e
     return CORE_OK;
 }
 
+/* The last section, "contents", against the sections before it (see checkpoint.h); then it is
+ * dropped from the index. */
+static core_status check_contents(ckpt_reader *r, core_error *err)
+{
+    for (int k = 0; k + 1 < r->nsec; k++)
+        if (strcmp(r->sec[k].tag, CONTENTS) == 0)
+            return core_fail(err, CORE_ERR_IO,
+                             "'%s' is corrupt (section '%s' is section %d of %d, not the last)",
+                             r->path, CONTENTS, k + 1, r->nsec);
+    if (r->nsec == 0 || strcmp(r->sec[r->nsec - 1].tag, CONTENTS) != 0)
+        return CORE_OK; /* written before "contents" existed */
+    const entry *c = &r->sec[r->nsec - 1];
+    const int n = r->nsec - 1;
+    uint64_t listed = c->size >= 8 ? rd64(c->data) : UINT64_MAX;
+    if (c->size < 8 || (c->size - 8) % 16 != 0 || listed != (c->size - 8) / 16)
+        return core_fail(err, CORE_ERR_IO,
+                         "'%s' is corrupt (section '%s' of %zu bytes does not hold a list of "
+                         "tags)",
+                         r->path, CONTENTS, c->size);
+    const unsigned char *t = c->data + 8;
+    /* a listed section the file lacks: the first one, by name */
+    for (uint64_t q = 0; q < listed; q++) {
+        char tag[CKPT_TAG_MAX + 1];
+        if (!text_field(t + 16 * q, 16, tag) || !tag[0])
+            return core_fail(err, CORE_ERR_IO,
+                             "'%s' is corrupt (section '%s': entry %llu is not a tag)", r->path,
+                             CONTENTS, (unsigned long long)q + 1);
+        int want = 0, have = 0;
+        for (uint64_t p = 0; p < listed; p++)
+            want += memcmp(t + 16 * p, t + 16 * q, 16) == 0;
+        for (int k = 0; k < n; k++)
+            have += strcmp(r->sec[k].tag, tag) == 0;
+        if (have < want)
+            return core_fail(err, CORE_ERR_IO,
+                             "'%s' is incomplete: section '%s' (number %llu of the %llu its "
+                             "writer listed) is missing",
+                             r->path, tag, (unsigned long long)q + 1, (unsigned long long)listed);
+    }
+    for (int k = 0; k < n; k++)
+        if ((uint64_t)k >= listed || strncmp((const char *)t + 16 * k, r->sec[k].tag, 16) != 0)
+            return core_fail(err, CORE_ERR_IO,
+                             "'%s' is corrupt (section '%s', number %d of the file, is not where "
+                             "its writer listed it)",
+                             r->path, r->sec[k].tag, k + 1);
+    if ((uint64_t)n != listed)
+        return core_fail(err, CORE_ERR_IO, "'%s' is corrupt (%d sections, %llu listed)", r->path, n,
+                         (unsigned long long)listed);
+    r->nsec = n;
+    return CORE_OK;
+}
+
 static core_status index_sections(ckpt_reader *r, core_error *err)
 {
     const size_t end = r->size - TRAILER;
@@ -433,7 +513,7 @@ static core_status index_sections(ckpt_reader *r, core_error *err)
         }
         r->sec[r->nsec++] = e;
     }
-    return CORE_OK;
+    return check_contents(r, err);
 }
 
 core_status ckpt_reader_open(ckpt_reader **rp, const char *path, const char *engine,

@@ -14,8 +14,16 @@
  *   sections, each
  *     char[16] tag, NUL-padded; uint32 flags (CKPT_REQUIRED); uint32 0; uint64 payload size;
  *     payload, then zero padding to a multiple of 8 bytes
+ *   last, the section "contents" (flags 0): uint64 count, then the tags (char[16]) of every
+ *     section before it, in order
  *   trailer, 24 bytes
  *     char[8] "GRAINEND"; uint64 file size; uint64 FNV-1a 64 of every byte before this field
+ *
+ * The checksum cannot tell a section that was cut out of a file and the checksum recomputed
+ * (a tool, a forged file) from a file written without it; "contents" can: a reader refuses a
+ * file that lacks a section its contents list, or holds one they do not. Files written before
+ * "contents" existed (none at the end) are read as they are. The reader checks and drops it:
+ * ckpt_reader_nsections and ckpt_has do not see it, and a writer cannot use the tag.
  *
  * The header fields up to the version, and the trailer, keep this layout in every format version,
  * so that any grainlab can tell a newer file from a corrupt one. A reader refuses a section it does
@@ -32,6 +40,11 @@
 enum { CKPT_FORMAT_VERSION = 1 };
 enum { CKPT_REQUIRED = 1u }; /* section flag: a reader that does not know the tag must refuse */
 enum { CKPT_TAG_MAX = 15, CKPT_ENGINE_MAX = 7, CKPT_VERSION_MAX = 31 };
+
+/* Step counters and other counts a run accumulates: a reader refuses more than 2^53 (9.0e15; a
+ * run of 10^9 steps a second takes 104 days to get there). Beyond it a counter is no longer exact
+ * as a double, and a run continued from near 2^63 would overflow a signed counter. */
+#define CKPT_COUNTER_MAX (INT64_C(1) << 53)
 
 /* FNV-1a 64 of len bytes, continuing from h (start with CKPT_FNV_OFFSET). */
 #define CKPT_FNV_OFFSET UINT64_C(0xcbf29ce484222325)

@@ -1,8 +1,9 @@
-/* Whole-file writes through a temporary file and rename(2). */
+/* Whole-file writes through a temporary file and rename(2); reads of regular files only. */
 #define _POSIX_C_SOURCE 200809L
 #include "core/fileio.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -145,4 +146,58 @@ core_status atomic_write(const char *path, const void *data, size_t len, core_er
         return core_fail(err, CORE_ERR_IO, "cannot write '%s': %s", path, strerror(e));
     }
     return atomic_commit(&f, err);
+}
+
+/* What a file that is not a regular file is, for a refusal. */
+static const char *file_kind(mode_t m)
+{
+    if (S_ISDIR(m))
+        return "a directory";
+    if (S_ISFIFO(m))
+        return "a FIFO (named pipe)";
+    if (S_ISCHR(m))
+        return "a character device";
+    if (S_ISBLK(m))
+        return "a block device";
+    if (S_ISSOCK(m))
+        return "a socket";
+    return "not a regular file";
+}
+
+core_status fileio_open_read(const char *path, const char *what, FILE **fp, uint64_t *size,
+                             core_error *err)
+{
+    *fp = NULL;
+    if (size)
+        *size = 0;
+    if (!path || !*path)
+        return core_fail(err, CORE_ERR_ARG, "empty %s file name", what);
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0)
+        return core_fail(err, CORE_ERR_IO, "cannot read %s '%s': %s", what, path, strerror(errno));
+    struct stat st;
+    if (fstat(fd, &st) != 0) {
+        int e = errno;
+        close(fd);
+        return core_fail(err, CORE_ERR_IO, "cannot read %s '%s': %s", what, path, strerror(e));
+    }
+    if (!S_ISREG(st.st_mode)) {
+        close(fd);
+        const char *kind = file_kind(st.st_mode);
+        return core_fail(err, CORE_ERR_IO, "cannot read %s '%s': it is %s%s", what, path, kind,
+                         strncmp(kind, "a ", 2) == 0 ? ", not a regular file" : "");
+    }
+    int flags = fcntl(fd, F_GETFL);
+    FILE *f = NULL;
+    if (flags >= 0 && fcntl(fd, F_SETFL, flags & ~O_NONBLOCK) == 0)
+        f = fdopen(fd, "rb");
+    if (!f) {
+        int e = errno;
+        close(fd);
+        return core_fail(err, CORE_ERR_IO, "cannot read %s '%s': %s", what, path, strerror(e));
+    }
+    *fp = f;
+    if (size)
+        *size = st.st_size > 0 ? (uint64_t)st.st_size : 0;
+    return CORE_OK;
 }

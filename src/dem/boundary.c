@@ -611,6 +611,31 @@ static core_status corrupt(ckpt_section *sec, const char *what, core_error *err)
                      ckpt_reader_path(sec->r), sec->tag, what);
 }
 
+/* A particle index stored in the file: [0, n), or "'PATH' is corrupt (section 'boundary': WHAT
+ * joins particle index V, outside [0, n))" (before any call that would print V + 1). */
+static core_status index_in(ckpt_section *sec, const char *what, size_t k, int64_t v, size_t n,
+                            core_error *err)
+{
+    if (v >= 0 && (uint64_t)v < n)
+        return CORE_OK;
+    return core_fail(err, CORE_ERR_IO,
+                     "'%s' is corrupt (section '%s': %s %zu joins particle index %lld, outside "
+                     "[0, %zu))",
+                     ckpt_reader_path(sec->r), sec->tag, what, k + 1, (long long)v, n);
+}
+
+/* Finite values, or "... WHAT = V, a finite number expected". */
+static core_status finite_all(ckpt_section *sec, const char *what, const double *v, size_t n,
+                              core_error *err)
+{
+    for (size_t k = 0; k < n; k++)
+        if (!isfinite(v[k]))
+            return core_fail(err, CORE_ERR_IO,
+                             "'%s' is corrupt (section '%s': %s = %g, a finite number expected)",
+                             ckpt_reader_path(sec->r), sec->tag, what, v[k]);
+    return CORE_OK;
+}
+
 /* Reads a count of records of at least `size` bytes each (bounded by the section). */
 static core_status count(ckpt_section *sec, size_t size, size_t *n, core_error *err)
 {
@@ -648,6 +673,8 @@ core_status dem_boundary_load(dem_scene *s, ckpt_section *sec, core_error *err)
         st = ckpt_get_f64(sec, &d.tau, err);
     if (st)
         return st;
+    if (has_def > 1 || gradient > 1 || every < 0 || every > CKPT_COUNTER_MAX)
+        return corrupt(sec, "bad definition flags or update interval", err);
     d.every = (long)every;
     d.gradient = (int)gradient;
     if ((st = ensure(s, err)))
@@ -663,7 +690,8 @@ core_status dem_boundary_load(dem_scene *s, ckpt_section *sec, core_error *err)
         int64_t x, y;
         uint32_t l;
         if (!(st = ckpt_get_i64(sec, &x, err)) && !(st = ckpt_get_i64(sec, &y, err)) &&
-            !(st = ckpt_get_u32(sec, &l, err))) {
+            !(st = ckpt_get_u32(sec, &l, err)) && !(st = index_in(sec, "edge", k, x, s->n, err)) &&
+            !(st = index_in(sec, "edge", k, y, s->n, err))) {
             a[k] = (long)x;
             bb[k] = (long)y;
             loaded[k] = (unsigned char)(l != 0);
@@ -673,6 +701,8 @@ core_status dem_boundary_load(dem_scene *s, ckpt_section *sec, core_error *err)
         st = core_fail(err, CORE_ERR_NOMEM, "out of memory loading the boundary");
     if (!st)
         st = ckpt_get_u32(sec, &closed, err);
+    if (!st && closed > 1)
+        st = corrupt(sec, "bad closed flag", err);
     if (!st && ne > 0 && dem_set_boundary_edges(s, ne, a, bb, loaded, (int)closed, err))
         st = corrupt(sec, err->msg, err);
     free(a), free(bb), free(loaded);
@@ -686,7 +716,10 @@ core_status dem_boundary_load(dem_scene *s, ckpt_section *sec, core_error *err)
         int64_t i, j;
         double kk, rest;
         if (!(st = ckpt_get_i64(sec, &i, err)) && !(st = ckpt_get_i64(sec, &j, err)) &&
-            !(st = ckpt_get_f64(sec, &kk, err)) && !(st = ckpt_get_f64(sec, &rest, err))) {
+            !(st = ckpt_get_f64(sec, &kk, err)) && !(st = ckpt_get_f64(sec, &rest, err)) &&
+            !(st = index_in(sec, "spring", k, i, s->n, err)) &&
+            !(st = index_in(sec, "spring", k, j, s->n, err)) &&
+            !(st = finite_all(sec, "a spring's rest length", &rest, 1, err))) {
             long li = (long)i, lj = (long)j;
             if (dem_add_springs(s, 1, &li, &lj, kk, &rest, err))
                 st = corrupt(sec, err->msg, err);
@@ -713,7 +746,7 @@ core_status dem_boundary_load(dem_scene *s, ckpt_section *sec, core_error *err)
     for (size_t k = 0; k < nspin && !st; k++) {
         int64_t i;
         if (!(st = ckpt_get_i64(sec, &i, err)) && !(st = ckpt_get_f64(sec, &b->spin_w[k], err))) {
-            if (i < 0 || (size_t)i >= s->n)
+            if (i < 0 || (size_t)i >= s->n || !isfinite(b->spin_w[k]))
                 return corrupt(sec, "bad spin", err);
             b->spin_i[k] = (long)i;
         }
@@ -741,6 +774,17 @@ core_status dem_boundary_load(dem_scene *s, ckpt_section *sec, core_error *err)
     if (!st)
         st = ckpt_get_f64s(sec, b->eint, 4, err);
     if (st)
+        return st;
+    if (last_update < 0 || last_update > s->steps || updates < 0 || updates > CKPT_COUNTER_MAX)
+        return core_fail(err, CORE_ERR_IO,
+                         "'%s' is corrupt (section '%s': last update at step %lld, %lld updates; "
+                         "the scene is at step %ld)",
+                         ckpt_reader_path(sec->r), sec->tag, (long long)last_update,
+                         (long long)updates, s->steps);
+    const double sums[] = {b->update_s, b->apply_s,  b->pen_sum[0], b->pen_sum[1],
+                           b->pen_max,  b->pres_max, b->stiffness,  b->eint[0],
+                           b->eint[1],  b->eint[2],  b->eint[3]};
+    if ((st = finite_all(sec, "a sum of the boundary's statistics", sums, 11, err)))
         return st;
     b->last_update = (long)last_update;
     b->updates = (long)updates;

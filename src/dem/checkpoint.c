@@ -344,21 +344,22 @@ static void close_section(reader *r)
 
 static void read_contact(reader *r, dem_contact_def *c)
 {
+    /* every value finite: s:contact checks those of the chosen laws only (check_contact) */
     uint32_t normal = u32(r);
-    c->stiffness = f64(r);
-    c->beta = f64(r);
+    c->stiffness = get_finite(r, "stiffness");
+    c->beta = get_finite(r, "beta");
     uint32_t damping = u32(r);
-    c->gamma_n = f64(r);
-    c->damping_time = f64(r);
-    c->restitution = f64(r);
-    c->impact_velocity = f64(r);
+    c->gamma_n = get_finite(r, "gamma_n");
+    c->damping_time = get_finite(r, "damping_time");
+    c->restitution = get_finite(r, "restitution");
+    c->impact_velocity = get_finite(r, "impact_velocity");
     uint32_t tangential = u32(r);
-    c->gamma_t = f64(r);
-    c->kt = f64(r);
-    c->v_r = f64(r);
-    c->exponent = f64(r);
-    c->clip = u32(r) != 0;
-    c->rolling = u32(r) != 0;
+    c->gamma_t = get_finite(r, "gamma_t");
+    c->kt = get_finite(r, "kt");
+    c->v_r = get_finite(r, "v_r");
+    c->exponent = get_finite(r, "exponent");
+    c->clip = get_flag(r, "clip");
+    c->rolling = get_flag(r, "rolling");
     if (normal > DEM_NORMAL_HERTZ || damping > DEM_DAMPING_BRILLIANTOV ||
         tangential > DEM_TANGENT_REGULARIZED)
         bad(r, "unknown contact law");
@@ -377,6 +378,184 @@ static void read_damping(reader *r, dem_scene *s)
     for (int k = 0; k < s->nmat && !r->st; k++)
         if (!(s->mat_damp[k] >= 0 && s->mat_damp[k] < INFINITY))
             bad(r, "bad damping coefficient");
+}
+
+/* A refusal of an engine call made for a stored value (dem_create, dem_add_material, ...),
+ * said as the file's: "'PATH' is corrupt (section 'TAG': young must be > 0, got -1)". Returns 1
+ * on failure. */
+static int relay(reader *r, core_status st)
+{
+    if (!st || r->st)
+        return st != CORE_OK;
+    char why[sizeof r->err->msg];
+    snprintf(why, sizeof why, "%s", r->err ? r->err->msg : "refused");
+    bad(r, why);
+    return 1;
+}
+
+/* The contact law passes s:contact's checks: they are made on a scratch scene of the same box,
+ * so that the loaded scene's state is not touched by them. */
+static void check_contact(reader *r, const dem_scene_def *def, const dem_contact_def *c)
+{
+    dem_scene *scratch = NULL;
+    if (relay(r, dem_create(def, &scratch, r->err)))
+        return;
+    relay(r, dem_set_contact(scratch, c, r->err));
+    dem_destroy(scratch);
+}
+
+/* The index of the first entry of a that is not finite, or n (a may be NULL: absent). */
+static size_t nonfinite(const double *a, size_t n)
+{
+    for (size_t i = 0; a && i < n; i++)
+        if (!isfinite(a[i]))
+            return i;
+    return n;
+}
+
+/* Every particle value against the physics: finite state, positive radius and mass within the
+ * box's scales, positions no further than one box length outside the box (a step between the
+ * run's checks may leave a grain just outside; far outside, the cell index of a position would
+ * overflow), known flags. */
+static core_status check_particles(reader *r, const dem_scene *s)
+{
+    const size_t n = s->n;
+    const int D = s->dim;
+    char what[96];
+    double extent = INFINITY;
+    for (int d = 0; d < D; d++) {
+        if (!isfinite(s->hi[d] - s->lo[d]))
+            return bad_num(r, "box length", s->hi[d] - s->lo[d], "a finite length");
+        extent = fmin(extent, s->hi[d] - s->lo[d]);
+    }
+    double rmax = 0;
+    for (size_t i = 0; i < n && !r->st; i++) {
+        for (int d = 0; d < D; d++) {
+            const double x = s->x[d][i], len = s->hi[d] - s->lo[d];
+            if (!(x >= s->lo[d] - len && x <= s->hi[d] + len)) {
+                snprintf(what, sizeof what, "particle %zu's %c", i + 1, 'x' + d);
+                return bad_num(r, what, x, "a position within a box length of the box");
+            }
+        }
+        if (!(s->r[i] > 0 && s->r[i] <= 0.5 * extent)) {
+            snprintf(what, sizeof what, "particle %zu's radius", i + 1);
+            return bad_num(r, what, s->r[i], "a positive radius at most half the box");
+        }
+        rmax = fmax(rmax, s->r[i]);
+        if (!(s->m[i] > 0 && isfinite(s->m[i])) || !(s->inv_m[i] >= 0 && isfinite(s->inv_m[i])) ||
+            !(s->inv_inertia[i] >= 0 && isfinite(s->inv_inertia[i]))) {
+            snprintf(what, sizeof what, "particle %zu's mass", i + 1);
+            return bad_num(r, what, s->m[i], "a positive mass with finite inverses");
+        }
+        /* a speed whose kinetic energy overflows is no grain's (the energy measures sum v^2) */
+        double v2 = 0, w2 = 0;
+        for (int d = 0; d < 3; d++) {
+            v2 += d < D ? s->v[d][i] * s->v[d][i] : 0;
+            w2 += s->w[d] ? s->w[d][i] * s->w[d][i] * s->r[i] * s->r[i] : 0;
+        }
+        if (!isfinite(v2 * s->m[i]) || !isfinite(w2 * s->m[i])) {
+            snprintf(what, sizeof what, "particle %zu's speed", i + 1);
+            return bad_num(r, what, sqrt(isfinite(v2 * s->m[i]) ? w2 : v2),
+                           "a speed whose kinetic energy is finite");
+        }
+        if (s->flags[i] & ~(DEM_FIXED | DEM_PRESCRIBED)) {
+            snprintf(what, sizeof what, "particle %zu's flags", i + 1);
+            return bad_int(r, what, s->flags[i], 0, DEM_FIXED | DEM_PRESCRIBED);
+        }
+    }
+    if (!r->st && !(s->r_max >= rmax && s->r_max <= 0.5 * extent))
+        return bad_num(r, "largest radius", s->r_max, "the particles' largest radius or more");
+    const double *arrays[64]; /* 3 D + 5 x 3 + 1 + 6 (D + 3) at most */
+    const char *names[64];
+    int na = 0;
+    for (int d = 0; d < D; d++) {
+        arrays[na] = s->v[d], names[na++] = "velocity";
+        arrays[na] = s->f[d], names[na++] = "force";
+        arrays[na] = s->x_build[d], names[na++] = "list position";
+        arrays[na] = s->fext[d], names[na++] = "external force";
+        arrays[na] = s->x_ref[d], names[na++] = "reference position";
+        arrays[na] = s->x_prev[d], names[na++] = "previous position";
+    }
+    for (int d = 0; d < 3; d++) {
+        arrays[na] = s->w[d], names[na++] = "angular velocity";
+        arrays[na] = s->tq[d], names[na++] = "torque";
+    }
+    arrays[na] = s->angle, names[na++] = "angle";
+    for (int k = 0; k < 6; k++)
+        for (int d = 0; d < 3; d++) {
+            if (d < D)
+                arrays[na] = s->gear[k][d], names[na++] = "Gear derivative";
+            arrays[na] = s->gear_w[k][d], names[na++] = "Gear rotation derivative";
+        }
+    for (int q = 0; q < na && !r->st; q++) {
+        size_t i = nonfinite(arrays[q], n);
+        if (i < n) {
+            snprintf(what, sizeof what, "particle %zu's %s", i + 1, names[q]);
+            return bad_num(r, what, arrays[q][i], "a finite number");
+        }
+    }
+    return r->st;
+}
+
+/* Walls and the pair list: finite, unit normals, flags 0 or 1, a servo as s:wall_servo makes
+ * it, the pairs' parameters >= 0. */
+static core_status check_walls_pairs(reader *r, const dem_scene *s)
+{
+    char what[96];
+    for (int k = 0; k < s->nwalls && !r->st; k++) {
+        const dem_wall *w = &s->walls[k];
+        const double v[16] = {
+            w->point[0],       w->point[1],    w->point[2],       w->velocity[0],
+            w->velocity[1],    w->velocity[2], w->normal[0],      w->normal[1],
+            w->normal[2],      w->friction,    w->point_build[0], w->point_build[1],
+            w->point_build[2], w->fn,          w->servo_force,    w->servo_rate};
+        snprintf(what, sizeof what, "wall %d's point, velocity, normal or friction", k + 1);
+        if (nonfinite(v, 16) < 16)
+            return bad_num(r, what, v[nonfinite(v, 16)], "finite values");
+        const double len = sqrt(v[6] * v[6] + v[7] * v[7] + v[8] * v[8]);
+        snprintf(what, sizeof what, "wall %d's normal length", k + 1);
+        if (!w->shape && !(fabs(len - 1) < 1e-9))
+            return bad_num(r, what, len, "1");
+        snprintf(what, sizeof what, "wall %d's active and servo flags", k + 1);
+        if (w->active != 0 && w->active != 1)
+            return bad_int(r, what, w->active, 0, 1);
+        if (w->servo != 0 && w->servo != 1)
+            return bad_int(r, what, w->servo, 0, 1);
+        snprintf(what, sizeof what, "wall %d's servo mass", k + 1);
+        if (!(w->servo_mass >= 0 && isfinite(w->servo_mass)) || w->servo != (w->servo_mass > 0) ||
+            !(w->servo_force >= 0) || !(w->servo_rate >= 0))
+            return bad_num(r, what, w->servo_mass, "a servo with mass > 0, force and rate >= 0");
+        for (int d = 0; d < DEM_HIST; d++) {
+            size_t i = nonfinite(w->hist[d], s->n);
+            snprintf(what, sizeof what, "wall %d's contact history of particle %zu", k + 1, i + 1);
+            if (i < s->n)
+                return bad_num(r, what, w->hist[d][i], "a finite number");
+        }
+    }
+    const dem_pairs *p = &s->pairs;
+    const double *pa[3 + 6 + DEM_HIST] = {p->k, p->gamma, p->mu};
+    static const char *const law[3] = {"stiffness", "damping", "friction"};
+    int na = 3;
+    for (int d = 0; d < 3; d++)
+        pa[na++] = p->f[d], pa[na++] = p->c[d];
+    for (int d = 0; d < DEM_HIST; d++)
+        pa[na++] = p->hist[d];
+    for (int q = 0; q < na && !r->st; q++) {
+        size_t i = nonfinite(pa[q], p->n);
+        if (i < p->n) {
+            snprintf(what, sizeof what, "pair %zu's %s", i + 1,
+                     q < 3   ? law[q]
+                     : q < 9 ? "force"
+                             : "contact history");
+            return bad_num(r, what, pa[q][i], "a finite number");
+        }
+        for (size_t j = 0; q < 3 && j < p->n; j++)
+            if (!(pa[q][j] >= 0)) {
+                snprintf(what, sizeof what, "pair %zu's %s", j + 1, law[q]);
+                return bad_num(r, what, pa[q][j], "a number >= 0");
+            }
+    }
+    return r->st;
 }
 
 /* The list's per-particle index arrays from the stored (i, j) order. */
@@ -461,9 +640,7 @@ static void read_rolling(reader *r, dem_scene *s)
     if (u64(r) != (uint64_t)s->nmat)
         bad(r, "material count");
     for (int k = 0; k < s->nmat && !r->st; k++) {
-        s->mats[k].rolling_friction = f64(r);
-        if (!(s->mats[k].rolling_friction >= 0))
-            bad(r, "negative rolling friction");
+        s->mats[k].rolling_friction = get_num_in(r, "a material's rolling friction", 0, DBL_MAX);
     }
     dem_pairs *p = &s->pairs;
     for (int d = 0; d < 3; d++)
@@ -544,44 +721,51 @@ static void read_all(reader *r, ckpt_reader *ck, const dem_boundary_restorer *re
         def.periodic[d] = u32(r) != 0;
     bytes(r, def.gravity, sizeof def.gravity);
     def.thickness = f64(r);
-    double drag = f64(r);
+    double drag = get_num_in(r, "drag", 0, DBL_MAX);
     def.skin = f64(r);
     if (r->st)
         return;
-    if ((r->st = dem_create(&def, out, r->err)))
+    if (relay(r, dem_create(&def, out, r->err)))
         return;
     dem_scene *s = *out;
     const int D = s->dim, d0 = D == 2 ? 2 : 0;
     s->drag = drag;
-    s->skin = f64(r);
-    s->r_max = f64(r);
+    s->skin = get_num_in(r, "skin", 0, DBL_MAX);
+    s->r_max = get_num_in(r, "largest radius", 0, DBL_MAX);
     const uint64_t n64 = u64(r);
-    if (n64 >= UINT32_MAX - 1)
-        bad(r, "too many particles");
+    if (!r->st && n64 >= UINT32_MAX - 1)
+        bad_int(r, "particle count", (long long)n64, 0, UINT32_MAX - 2);
     const size_t n = (size_t)n64;
-    s->rot = (int)u32(r);
-    s->time = f64(r);
-    s->steps = (long)i64(r);
-    s->force_evals = (long)i64(r);
-    s->last_integrator = (int)i64(r);
-    s->tt_phase = (long)i64(r);
+    s->rot = get_flag(r, "rotation");
+    s->time = get_finite(r, "time");
+    s->steps = get_counter(r, "steps");
+    s->force_evals = get_counter(r, "force evaluations");
+    s->last_integrator = (int)get_int_in(r, "last integrator", 0, DEM_TWO_TIMESCALES);
+    s->tt_phase = get_counter(r, "two-timescales phase");
     /* set at the end: restoring the boundary goes through calls that reset them */
-    const int gear_ready = (int)u32(r), prev_ready = (int)u32(r), forces_ready = (int)u32(r);
-    s->suspect = (int)u32(r);
-    const int need_rebuild = (int)u32(r);
-    s->gear_dt = f64(r);
-    s->prev_dt = f64(r);
-    const int watch_on = (int)u32(r);
-    s->watch_next = (long)i64(r);
-    s->watch_min_step = (long)i64(r);
+    const int gear_ready = get_flag(r, "gear_ready"), prev_ready = get_flag(r, "prev_ready");
+    const int forces_ready = get_flag(r, "forces_ready");
+    s->suspect = get_flag(r, "suspect");
+    const int need_rebuild = get_flag(r, "need_rebuild");
+    s->gear_dt = get_num_in(r, "Gear dt", 0, DBL_MAX);
+    s->prev_dt = get_num_in(r, "position Verlet dt", 0, DBL_MAX);
+    const int watch_on = get_flag(r, "energy watch");
+    s->watch_next = get_counter(r, "energy watch step");
+    s->watch_min_step = get_counter(r, "energy watch minimum step");
     s->watch_min = f64(r);
     s->watch_min_t = f64(r);
     s->watch_scale = f64(r);
-    s->brill_c = f64(r);
+    if (watch_on && !r->st &&
+        !(isfinite(s->watch_min) && isfinite(s->watch_min_t) && s->watch_scale >= 0 &&
+          isfinite(s->watch_scale)))
+        bad(r, "the energy watch's reference is not finite");
+    s->brill_c = get_num_in(r, "Brilliantov coefficient", 0, DBL_MAX);
     close_section(r);
 
     open_section(r, ck, "contact");
     read_contact(r, &s->contact);
+    if (!r->st)
+        check_contact(r, &def, &s->contact);
     close_section(r);
     if (r->st)
         return;
@@ -605,12 +789,14 @@ static void read_all(reader *r, ckpt_reader *ck, const dem_boundary_restorer *re
         return;
     }
     s->cap_mat = (int)(nmat ? nmat : 1);
-    s->nmat = (int)nmat;
-    for (int k = 0; k < s->nmat && !r->st; k++) {
+    for (int k = 0; k < (int)nmat && !r->st; k++) {
         double v[5];
         if ((r->st = ckpt_get_f64s(&r->sec, v, 5, r->err)))
             break;
-        s->mats[k] = (dem_material){v[0], v[1], v[2], v[3], v[4], 0}; /* rolling: its section */
+        /* the checks of s:add_material; rolling friction: its own section */
+        const dem_material m = {v[0], v[1], v[2], v[3], v[4], 0};
+        if (relay(r, dem_add_material(s, &m, r->err) < 0 ? CORE_ERR_ARG : CORE_OK))
+            break;
     }
     close_section(r);
 
@@ -729,6 +915,8 @@ static void read_all(reader *r, ckpt_reader *ck, const dem_boundary_restorer *re
     if (!r->st && ckpt_has(ck, "rolling")) {
         open_section(r, ck, "rolling");
         read_rolling(r, s);
+        if (!r->st)
+            check_contact(r, &def, &s->contact);
         close_section(r);
     }
     if (!r->st && ckpt_has(ck, "damping")) {
@@ -759,6 +947,12 @@ static void read_all(reader *r, ckpt_reader *ck, const dem_boundary_restorer *re
         if (!r->st)
             r->st = dem_flow_load(s, r);
         close_section(r);
+    }
+    if (!r->st) { /* values, named by the section that holds them */
+        r->sec.tag = "particles";
+        check_particles(r, s);
+        r->sec.tag = "walls";
+        check_walls_pairs(r, s);
     }
     const char *wrong = r->st ? NULL : inconsistent(s, gear_ready, prev_ready, need_rebuild);
     if (wrong)

@@ -4,8 +4,10 @@
 #ifndef GRAINLAB_DEM_CHECKPOINT_READER_H
 #define GRAINLAB_DEM_CHECKPOINT_READER_H
 
+#include <float.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 
 #include "core/checkpoint.h"
 #include "core/error.h"
@@ -59,6 +61,74 @@ static inline void bad(dem_reader *r, const char *what)
     if (!r->st)
         r->st = core_fail(r->err, CORE_ERR_IO, "'%s' is corrupt (section '%s': %s)",
                           ckpt_reader_path(r->sec.r), r->sec.tag, what);
+}
+
+/* A value that cannot be: "'PATH' is corrupt (section 'TAG': WHAT = V is outside [LO, HI])". */
+static inline core_status bad_int(dem_reader *r, const char *what, long long v, long long lo,
+                                  long long hi)
+{
+    if (!r->st)
+        r->st = core_fail(r->err, CORE_ERR_IO,
+                          "'%s' is corrupt (section '%s': %s = %lld is outside [%lld, %lld])",
+                          ckpt_reader_path(r->sec.r), r->sec.tag, what, v, lo, hi);
+    return r->st;
+}
+
+/* "'PATH' is corrupt (section 'TAG': WHAT = V, WANT expected)" */
+static inline core_status bad_num(dem_reader *r, const char *what, double v, const char *want)
+{
+    if (!r->st)
+        r->st =
+            core_fail(r->err, CORE_ERR_IO, "'%s' is corrupt (section '%s': %s = %g, %s expected)",
+                      ckpt_reader_path(r->sec.r), r->sec.tag, what, v, want);
+    return r->st;
+}
+
+/* An int64 in [lo, hi]. */
+static inline long long get_int_in(dem_reader *r, const char *what, long long lo, long long hi)
+{
+    int64_t v = i64(r);
+    if (!r->st && (v < lo || v > hi)) {
+        bad_int(r, what, v, lo, hi);
+        return lo;
+    }
+    return v;
+}
+
+/* A step counter or count of a run: [0, CKPT_COUNTER_MAX]. */
+static inline long get_counter(dem_reader *r, const char *what)
+{
+    return (long)get_int_in(r, what, 0, CKPT_COUNTER_MAX);
+}
+
+/* A uint32 flag: 0 or 1. */
+static inline int get_flag(dem_reader *r, const char *what)
+{
+    uint32_t v = u32(r);
+    if (!r->st && v > 1) {
+        bad_int(r, what, v, 0, 1);
+        return 0;
+    }
+    return (int)v;
+}
+
+/* A double in [lo, hi] (so finite when both are). */
+static inline double get_num_in(dem_reader *r, const char *what, double lo, double hi)
+{
+    double v = f64(r);
+    if (!r->st && !(v >= lo && v <= hi)) {
+        char want[96];
+        snprintf(want, sizeof want, "a number in [%g, %g]", lo, hi);
+        bad_num(r, what, v, want);
+        return 0;
+    }
+    return v;
+}
+
+/* A finite double. */
+static inline double get_finite(dem_reader *r, const char *what)
+{
+    return get_num_in(r, what, -DBL_MAX, DBL_MAX);
 }
 
 /* n values into a new array of cap >= n entries. */

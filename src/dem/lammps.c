@@ -42,6 +42,9 @@ typedef struct reader {
     char *tok[MAX_TOKENS];
     int ntok;
     char *comment; /* text after '#' on the current line, or NULL */
+    int cut;       /* the current line is the file's last and has no newline */
+    int nul;       /* the current line holds a NUL byte: reading stopped there */
+    uint64_t size; /* of the file, in bytes */
 } reader;
 
 /* Reads the next line, strips its comment and splits it into tokens; 0 at end of file. */
@@ -51,6 +54,12 @@ static int next_line(reader *r)
     if (len < 0)
         return 0;
     r->line++;
+    r->cut = r->buf[len - 1] != '\n';
+    if ((size_t)len != strlen(r->buf)) { /* a NUL byte: not a text file; read as its end */
+        r->nul = 1;
+        r->ntok = 0;
+        return 0;
+    }
     char *hash = strchr(r->buf, '#');
     r->comment = NULL;
     if (hash) {
@@ -86,8 +95,19 @@ static int next_content(reader *r)
     return 0;
 }
 
+/* A line the parser refuses; when the file ends inside it (no newline), that is said first:
+ * a cut file is the likelier cause than a bad value. */
 static core_status bad_line(core_error *err, const reader *r, const char *what)
 {
+    if (r->nul)
+        return core_fail(err, CORE_ERR_ARG,
+                         "%s:%ld: the line holds a NUL byte (not a text file, or a damaged one)",
+                         r->path, r->line);
+    if (r->cut && r->ntok > 0)
+        return core_fail(err, CORE_ERR_ARG,
+                         "%s:%ld: the file ends inside this line, without a newline (cut "
+                         "short?): %s",
+                         r->path, r->line, what);
     return core_fail(err, CORE_ERR_ARG, "%s:%ld: %s", r->path, r->line, what);
 }
 
@@ -208,6 +228,7 @@ static core_status read_atoms(reader *r, dem_lammps_data *d, size_t *count, core
             return bad_line(err, r, msg);
         }
     }
+    int columns = 0; /* of the first line: image flags are on every line or on none */
     for (size_t k = 0; k < d->n; k++) {
         if (!next_content(r)) {
             snprintf(msg, sizeof msg,
@@ -227,6 +248,14 @@ static core_status read_atoms(reader *r, dem_lammps_data *d, size_t *count, core
                          r->ntok > MAX_TOKENS ? MAX_TOKENS : r->ntok);
             return bad_line(err, r, msg);
         }
+        if (columns && r->ntok != columns) {
+            snprintf(msg, sizeof msg,
+                     "an Atoms line has %d values where the lines before have %d (image flags "
+                     "ix iy iz on every line or on none)",
+                     r->ntok, columns);
+            return bad_line(err, r, msg);
+        }
+        columns = r->ntok;
         long long id, type, img[3] = {0, 0, 0};
         double diam, dens, x[3];
         if (!parse_ll(r->tok[0], 1, INT64_MAX, &id))
@@ -372,7 +401,8 @@ static core_status parse(reader *r, dem_lammps_data *d, core_error *err)
 {
     char msg[320], key[128];
     if (!next_line(r))
-        return core_fail(err, CORE_ERR_ARG, "%s: the file is empty", r->path);
+        return r->nul ? bad_line(err, r, "")
+                      : core_fail(err, CORE_ERR_ARG, "%s: the file is empty", r->path);
     /* The title line keeps its '#' text: it is free text. */
     rewind(r->fp);
     {
@@ -384,6 +414,7 @@ static core_status parse(reader *r, dem_lammps_data *d, core_error *err)
         }
     }
     long long natoms = -1, ntypes = -1;
+    long natoms_line = 0;
     int have_box[3] = {0, 0, 0};
     /* ---- header: counts and box, up to the first section ---- */
     int in_body = 0;
@@ -403,6 +434,11 @@ static core_status parse(reader *r, dem_lammps_data *d, core_error *err)
                        bad_line(err, r, msg);
             if (have_box[a])
                 return bad_line(err, r, "the box bounds of this axis are given twice");
+            if (fabs(lo) > 1e100 || fabs(hi) > 1e100) /* what dem.scene takes for a box */
+                return snprintf(msg, sizeof msg,
+                                "%clo %chi %g %g: box bounds of magnitude at most 1e100 expected",
+                                'x' + a, 'x' + a, lo, hi),
+                       bad_line(err, r, msg);
             d->lo[a] = lo, d->hi[a] = hi, have_box[a] = 1;
             continue;
         }
@@ -423,6 +459,7 @@ static core_status parse(reader *r, dem_lammps_data *d, core_error *err)
             join_tokens(r, 1, key, sizeof key);
             if (!strcmp(key, "atoms")) {
                 natoms = count;
+                natoms_line = r->line;
                 continue;
             }
             if (!strcmp(key, "atom types")) {
@@ -452,6 +489,8 @@ static core_status parse(reader *r, dem_lammps_data *d, core_error *err)
         return snprintf(msg, sizeof msg, "unknown header line '%s'", key), bad_line(err, r, msg);
     next:;
     }
+    if (r->nul)
+        return bad_line(err, r, "");
     if (natoms < 0)
         return core_fail(err, CORE_ERR_ARG, "%s: the header has no 'atoms' count", r->path);
     if (ntypes < 0)
@@ -461,8 +500,21 @@ static core_status parse(reader *r, dem_lammps_data *d, core_error *err)
             return core_fail(err, CORE_ERR_ARG, "%s: the header has no '%clo %chi' box bounds",
                              r->path, 'x' + a, 'x' + a);
     if ((unsigned long long)natoms > (unsigned long long)(UINT32_MAX - 2))
-        return core_fail(err, CORE_ERR_ARG, "%s: %lld atoms is more than a scene holds", r->path,
-                         natoms);
+        return core_fail(err, CORE_ERR_ARG, "%s:%ld: %lld atoms is more than a scene holds",
+                         r->path, natoms_line, natoms);
+    /* Each atom has an Atoms line of 14 bytes or more ("1 1 1 1 0 0 0" and its newline): a count
+     * the rest of the file cannot hold is refused before anything is sized by it. */
+    if (in_body) {
+        long here = ftell(r->fp);
+        uint64_t left = here >= 0 && (uint64_t)here <= r->size ? r->size - (uint64_t)here : 0;
+        if ((uint64_t)natoms > left / 14)
+            return core_fail(err, CORE_ERR_ARG,
+                             "%s:%ld: the header announces %lld atoms, but the %llu bytes after "
+                             "it hold at most %llu Atoms lines (14 bytes or more each): a wrong "
+                             "count, or a truncated file",
+                             r->path, natoms_line, natoms, (unsigned long long)left,
+                             (unsigned long long)(left / 14));
+    }
     d->n = (size_t)natoms;
     d->ntypes = (int)ntypes;
     core_status st = alloc_atoms(d, d->n, err);
@@ -532,6 +584,10 @@ static core_status parse(reader *r, dem_lammps_data *d, core_error *err)
     free(order);
     if (st != CORE_OK)
         return st;
+    if (r->nul || (r->cut && r->ntok > 0)) /* read whole, but its last line is cut */
+        return bad_line(err, r,
+                        "a whole data file ends its last line with a newline (LAMMPS's "
+                        "write_data does)");
     if (!have_atoms && d->n > 0)
         return core_fail(err, CORE_ERR_ARG,
                          "%s: the header announces %zu atoms but the file has no Atoms section "
@@ -551,9 +607,9 @@ core_status dem_lammps_read(const char *path, dem_lammps_data *out, core_error *
     if (!out->path)
         return core_fail(err, CORE_ERR_NOMEM, "cannot allocate a file name");
     reader r = {.path = out->path};
-    r.fp = fopen(path, "rb");
-    if (!r.fp)
-        return core_fail(err, CORE_ERR_IO, "cannot open '%s': %s", path, strerror(errno));
+    core_status opened = fileio_open_read(path, "LAMMPS data file", &r.fp, &r.size, err);
+    if (opened != CORE_OK)
+        return opened;
     core_status st = parse(&r, out, err);
     if (st == CORE_OK && ferror(r.fp))
         st = core_fail(err, CORE_ERR_IO, "cannot read '%s': %s", path, strerror(errno));
@@ -637,6 +693,11 @@ core_status dem_lammps_add(dem_scene *s, const dem_lammps_data *d, const dem_lam
                              "needs all four 0 (is this a 3D file?)",
                              d->path, d->line[k], d->id[k], d->x[2][k], d->v[2][k], d->w[0][k],
                              d->w[1][k]);
+        if (D == 2 && d->image[2][k] != 0)
+            return core_fail(err, CORE_ERR_ARG,
+                             "%s:%ld: atom %lld has image flag %d on axis z of a 2D scene (a 2D "
+                             "file's iz is 0)",
+                             d->path, d->line[k], d->id[k], d->image[2][k]);
         for (int a = 0; a < D; a++) {
             double x = d->x[a][k];
             if (!s->periodic[a] && d->image[a][k] != 0)
@@ -650,6 +711,26 @@ core_status dem_lammps_add(dem_scene *s, const dem_lammps_data *d, const dem_lam
                                  "%s:%ld: atom %lld: %c = %.17g is outside the scene's box [%g, "
                                  "%g] on an axis that is not periodic",
                                  d->path, d->line[k], d->id[k], 'x' + a, x, s->lo[a], s->hi[a]);
+            /* wrapped below; beyond LAMMPS's image range (512 box lengths) a coordinate is no
+             * image of an atom, and wrapping it would keep little of its digits */
+            double boxes = (x < s->lo[a] ? s->lo[a] - x : x - s->hi[a]) / s->len[a];
+            if (s->periodic[a] && boxes > 512)
+                return core_fail(err, CORE_ERR_ARG,
+                                 "%s:%ld: atom %lld: %c = %.17g is more than 512 box lengths "
+                                 "(LAMMPS's image range) outside the periodic box [%g, %g]",
+                                 d->path, d->line[k], d->id[k], 'x' + a, x, s->lo[a], s->hi[a]);
+        }
+        /* a speed whose kinetic energy overflows is no grain's (the energy measures sum v^2) */
+        for (int a = 0; a < 3; a++) {
+            const double v = d->v[a][k], w = d->w[a][k] * d->radius[k];
+            if (!isfinite(v * v) || !isfinite(w * w))
+                return core_fail(err, CORE_ERR_ARG,
+                                 "%s:%ld: atom %lld: %s = %g is too large (its square, in the "
+                                 "kinetic energy, overflows)",
+                                 d->path, d->line[k], d->id[k],
+                                 !isfinite(v * v) ? (const char *[]){"vx", "vy", "vz"}[a]
+                                                  : (const char *[]){"wx", "wy", "wz"}[a],
+                                 !isfinite(v * v) ? v : d->w[a][k]);
         }
     }
     /* Ids other than 1..n (a scene written after removals) become the particles' tags, so that

@@ -997,6 +997,24 @@ core_status dem_shapes_load(dem_scene *s, ckpt_section *sec, core_error *err)
                            ckpt_reader_path(sec->r));
             break;
         }
+        /* every value finite, the motion's times increasing (as dem_add_shape checks them) */
+        const double scalars[] = {sh->radius,  sh->axis[0], sh->axis[1],
+                                  sh->axis[2], sh->angle,   sh->moved};
+        int ok = finite_n(sh->v, 3 * sh->nv) && finite_n(scalars, 6) && finite_n(sh->center, 3) &&
+                 finite_n(sh->rot, 9) && finite_n(sh->vel, 3) && finite_n(sh->omega, 3) &&
+                 finite_n(sh->tab, 7 * sh->nt) && finite_n(sh->force, 3) &&
+                 finite_n(sh->torque, 3) && inside <= 1 && spins <= 1 && sh->half >= 0 &&
+                 sh->reach >= 0; /* infinite for an endless cylinder */
+        for (size_t k = 1; ok && k < sh->nt; k++)
+            ok = sh->tab[7 * k] > sh->tab[7 * (k - 1)];
+        if (!ok) {
+            st = core_fail(err, CORE_ERR_IO,
+                           "'%s' is corrupt (section '%s': wall %ld's geometry, pose or motion "
+                           "holds a value that is not finite, or motion times that do not "
+                           "increase)",
+                           ckpt_reader_path(sec->r), sec->tag, id + 1);
+            break;
+        }
         if ((st = ckpt_peek_count(sec, s->n, &n, err)))
             break;
         sh->cand = malloc((n ? n : 1) * sizeof *sh->cand);

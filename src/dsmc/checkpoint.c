@@ -16,6 +16,7 @@
  * identities existed) numbers the particles in file order. */
 #include <limits.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -87,7 +88,7 @@ core_status dsmc_save(const dsmc_scene *s, const char *path, const char *version
     ckpt_put_f64s(w, s->remainder, s->ncells);
     TRY(ckpt_section_end(w, err));
 
-    /* before the particles, which stay the last section (tests forge values at its end) */
+    /* before the particles, which stay the engine's last section (tests forge values at its end) */
     TRY(ckpt_section_begin(w, "dsmc.ids", CKPT_REQUIRED, err));
     ckpt_put_u64(w, s->next_id);
     ckpt_put_u32s(w, s->id, s->n);
@@ -120,6 +121,40 @@ static core_status corrupt(const reader *rd, const char *what)
 {
     return core_fail(rd->err, CORE_ERR_ARG, "'%s' is a corrupt dsmc checkpoint: %s", rd->path,
                      what);
+}
+
+/* A refusal of an engine call made for stored values (dsmc_create, dsmc_set_wall, ...), said as
+ * the file's: "'PATH' is a corrupt dsmc checkpoint: radius must be positive, got -1". */
+static core_status named(const reader *rd, core_status st)
+{
+    if (st == CORE_OK || st == CORE_ERR_NOMEM || !rd->err)
+        return st;
+    char why[sizeof rd->err->msg];
+    snprintf(why, sizeof why, "%s", rd->err->msg);
+    return corrupt(rd, why);
+}
+
+/* The grid against the file, before the grid is sized by the definition's cells: dsmc.cells
+ * holds one remainder per cell. */
+static core_status check_cells(ckpt_reader *r, reader *rd, const dsmc_scene_def *d)
+{
+    ckpt_section c;
+    core_status st = ckpt_find(r, "dsmc.cells", &c, rd->err);
+    uint64_t n = 0;
+    if (st || (st = ckpt_get_u64(&c, &n, rd->err)))
+        return st;
+    double cells = 1;
+    for (int k = 0; k < d->dim; k++)
+        cells *= d->cells[k];
+    if (cells != (double)n) {
+        char what[200];
+        snprintf(what, sizeof what,
+                 "cells %d x %d x %d make %.17g cells, but section 'dsmc.cells' holds %llu",
+                 d->cells[0], d->cells[1], d->dim == 3 ? d->cells[2] : 1, cells,
+                 (unsigned long long)n);
+        return corrupt(rd, what);
+    }
+    return CORE_OK;
 }
 
 static core_status get_int(reader *rd, long lo, long hi, const char *what, long *out)
@@ -179,7 +214,7 @@ static core_status read_walls(reader *rd, dsmc_scene *s)
         if (side < 2 * s->D && !s->def.periodic[side / 2]) {
             /* a wall of the box: the same checks as s:wall, which keeps it as given */
             const double vn = w.velocity[side / 2];
-            TRY(dsmc_set_wall(s, side, &w, rd->err));
+            TRY(named(rd, dsmc_set_wall(s, side, &w, rd->err)));
             if (vn != 0)
                 TRY(corrupt(rd, "a wall has a normal velocity"));
         } else {
@@ -196,11 +231,11 @@ static core_status read_clock(reader *rd, dsmc_scene *s)
     core_status st;
     long v;
     TRY(get_num(rd, "time", &s->t));
-    TRY(get_int(rd, 0, LONG_MAX, "steps", &v));
+    TRY(get_int(rd, 0, CKPT_COUNTER_MAX, "steps", &v));
     s->steps = v;
     TRY(get_num(rd, "collisions", &s->total_collisions));
     dsmc_stats *c = &s->stats;
-    TRY(get_int(rd, 0, LONG_MAX, "stats steps", &v));
+    TRY(get_int(rd, 0, CKPT_COUNTER_MAX, "stats steps", &v));
     c->steps = v;
     double *stats[9] = {&c->particle_moves, &c->attempts,    &c->collisions,
                         &c->wall_hits,      &c->vmax_raised, &c->cells_overpacked,
@@ -245,18 +280,23 @@ static core_status read_particles(reader *rd, dsmc_scene *s)
     /* between steps the particles are sorted by cell; re-adding them in that order keeps it */
     uint32_t prev = 0;
     for (size_t i = 0; i < n; i++) {
-        for (int k = 0; k < D; k++)
+        double v2 = 0;
+        for (int k = 0; k < D; k++) {
             if (!isfinite(a[k][i]) || !isfinite(a[D + k][i]) || a[k][i] < s->def.lo[k] ||
                 a[k][i] > s->def.hi[k])
                 TRY(corrupt(rd, "a particle is outside the box or not finite"));
+            v2 += a[D + k][i] * a[D + k][i];
+        }
+        if (!isfinite(v2 * s->mass))
+            TRY(corrupt(rd, "a particle's kinetic energy is not finite"));
         const uint32_t c = dsmc_cell_of(s, a[0][i], a[1][i], D == 3 ? a[2][i] : 0);
         if (c < prev)
             TRY(corrupt(rd, "the particles are not in cell order"));
         prev = c;
     }
     if (n)
-        TRY(dsmc_add(s, n, a[0], a[1], D == 3 ? a[2] : NULL, a[D], a[D + 1],
-                     D == 3 ? a[D + 2] : NULL, rd->err));
+        TRY(named(rd, dsmc_add(s, n, a[0], a[1], D == 3 ? a[2] : NULL, a[D], a[D + 1],
+                               D == 3 ? a[D + 2] : NULL, rd->err)));
 done:
     for (int k = 0; k < 6; k++)
         free(a[k]);
@@ -301,7 +341,8 @@ static core_status read_scene(ckpt_reader *r, reader *rd, dsmc_scene **out)
     dsmc_scene_def def;
     TRY(ckpt_find(r, "dsmc.scene", &rd->sec, rd->err));
     TRY(read_def(rd, &def));
-    TRY(dsmc_create(&def, &s, rd->err));
+    TRY(check_cells(r, rd, &def));
+    TRY(named(rd, dsmc_create(&def, &s, rd->err)));
     TRY(ckpt_find(r, "dsmc.walls", &rd->sec, rd->err));
     TRY(read_walls(rd, s));
     TRY(ckpt_find(r, "dsmc.particles", &rd->sec, rd->err));

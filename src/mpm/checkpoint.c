@@ -14,6 +14,7 @@
  * order, which is their global id (grain by grain, never reordered); nothing depends on threads. */
 #include <limits.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -191,6 +192,71 @@ static core_status corrupt(const reader *rd, const char *what)
     return core_fail(rd->err, CORE_ERR_ARG, "'%s' is a corrupt mpm checkpoint: %s", rd->path, what);
 }
 
+/* A refusal of an engine call made for stored values (mpm_create, mpm_add_material, ...), said
+ * as the file's: "'PATH' is a corrupt mpm checkpoint: density must be > 0, got -1". */
+static core_status named(const reader *rd, core_status st)
+{
+    if (st == CORE_OK || st == CORE_ERR_NOMEM || !rd->err)
+        return st;
+    char why[sizeof rd->err->msg];
+    snprintf(why, sizeof why, "%s", rd->err->msg);
+    return corrupt(rd, why);
+}
+
+/* The grid against the points, before the grid is sized by the definition's cells: a grain is
+ * seeded with points_per_cell^2 points per cell, each of reference volume (hx / ppc) (hy / ppc)
+ * (mpm_add_disk and the like), which no step changes. Reads the grains' ranges and points per
+ * cell and the points' volumes from the file without building anything. */
+static core_status check_cells(ckpt_reader *r, reader *rd, const mpm_scene_def *d)
+{
+    enum {
+        GRAIN = 152,
+        PPC = 88,
+        V0 = 5
+    }; /* bytes of a grain's record (write), offset of its
+        * points per cell; v0 is the 6th point array */
+    ckpt_section g, p;
+    core_status st;
+    if ((st = ckpt_find(r, "mpm.grains", &g, rd->err)) ||
+        (st = ckpt_find(r, "mpm.points", &p, rd->err)))
+        return st;
+    uint64_t ng, np;
+    if ((st = ckpt_get_u64(&g, &ng, rd->err)) || (st = ckpt_get_u64(&p, &np, rd->err)))
+        return st;
+    if (ng > (g.size - 8) / GRAIN || np > (p.size - 8) / (21 * sizeof(double)))
+        return CORE_OK; /* the readers below say what is wrong */
+    const double hx = d->size[0] / d->cells[0], hy = d->size[1] / d->cells[1];
+    for (uint64_t k = 0; k < ng; k++) {
+        uint64_t a, c;
+        int64_t ppc;
+        g.pos = 8 + k * GRAIN;
+        if ((st = ckpt_get_u64(&g, &a, rd->err)) || (st = ckpt_get_u64(&g, &c, rd->err)))
+            return st;
+        g.pos = 8 + k * GRAIN + PPC;
+        if ((st = ckpt_get_i64(&g, &ppc, rd->err)))
+            return st;
+        if (a >= np || c == 0 || c > np - a || ppc < 1 || ppc > 64)
+            return CORE_OK; /* read_grains refuses it, naming what */
+        const double v0 = (hx / (double)ppc) * (hy / (double)ppc);
+        for (uint64_t q = a; q < a + c; q++) {
+            double v;
+            p.pos = V0 * (8 + np * 8) + 8 + q * 8;
+            if ((st = ckpt_get_f64(&p, &v, rd->err)))
+                return st;
+            if (!(fabs(v - v0) <= 1e-9 * v0)) {
+                char what[256];
+                snprintf(what, sizeof what,
+                         "cells %d x %d (cell %g x %g) do not match point %llu's reference volume "
+                         "%g (%g with %lld points per cell along an axis)",
+                         d->cells[0], d->cells[1], hx, hy, (unsigned long long)q + 1, v, v0,
+                         (long long)ppc);
+                return corrupt(rd, what);
+            }
+        }
+    }
+    return CORE_OK;
+}
+
 static core_status read_def(reader *rd, mpm_scene_def *d)
 {
     core_status st;
@@ -241,7 +307,7 @@ static core_status read_materials(reader *rd, mpm_scene *s)
         TRY(get_num(rd, "yield", &m.yield));
         TRY(get_num(rd, "hardening", &m.hardening));
         if (mpm_add_material(s, &m, rd->err) < 0)
-            return CORE_ERR_ARG;
+            return named(rd, CORE_ERR_ARG);
     }
     st = ckpt_section_done(&rd->sec, rd->err);
 done:
@@ -262,11 +328,11 @@ static core_status read_contact(reader *rd, mpm_scene *s)
     TRY(get_int(rd, 0, 1, "conserve", &conserve));
     o.normals = (mpm_normals)normals;
     o.conserve = conserve != 0;
-    TRY(mpm_set_contact_options(s, &o, rd->err));
+    TRY(named(rd, mpm_set_contact_options(s, &o, rd->err)));
     if (model == MPM_CONTACT_FRICTION) {
-        TRY(mpm_set_friction(s, mu, rd->err));
+        TRY(named(rd, mpm_set_friction(s, mu, rd->err)));
     } else {
-        TRY(mpm_set_contact(s, MPM_CONTACT_NOSLIP, rd->err));
+        TRY(named(rd, mpm_set_contact(s, MPM_CONTACT_NOSLIP, rd->err)));
         s->mu = mu; /* kept as it was, though noslip ignores it */
     }
     st = ckpt_section_done(&rd->sec, rd->err);
@@ -296,7 +362,7 @@ static core_status read_planes(reader *rd, mpm_scene *s)
         TRY(get_num(rd, "plane point", &p.point[1]));
         if (p.kind == MPM_WALL_NONE || !(p.mu >= 0) || !(fabs(hypot(p.n[0], p.n[1]) - 1) < 1e-9))
             return corrupt(rd, "a plane is not a unit-normal noslip, slip or friction plane");
-        TRY(mpm_install_plane(s, &p, rd->err));
+        TRY(named(rd, mpm_install_plane(s, &p, rd->err)));
     }
     st = ckpt_section_done(&rd->sec, rd->err);
 done:
@@ -403,6 +469,8 @@ static core_status read_points(reader *rd, mpm_scene *s)
                 return corrupt(rd, "a point has a non-finite value");
         if (!(s->m[p] > 0) || !(s->v0[p] > 0))
             return corrupt(rd, "a point has no mass or volume");
+        if (!isfinite(s->m[p] * (s->vx[p] * s->vx[p] + s->vy[p] * s->vy[p])))
+            return corrupt(rd, "a point's kinetic energy is not finite");
         const double c[2] = {s->x[p], s->y[p]};
         for (int ax = 0; ax < 2; ax++) {
             const double o = d->origin[ax], L = d->size[ax];
@@ -426,7 +494,8 @@ static core_status read_scene(ckpt_reader *r, reader *rd, mpm_scene **out)
     mpm_scene_def def;
     TRY(ckpt_find(r, "mpm.scene", &rd->sec, rd->err));
     TRY(read_def(rd, &def));
-    TRY(mpm_create(&def, &s, rd->err));
+    TRY(check_cells(r, rd, &def));
+    TRY(named(rd, mpm_create(&def, &s, rd->err)));
     TRY(ckpt_find(r, "mpm.materials", &rd->sec, rd->err));
     TRY(read_materials(rd, s));
     TRY(ckpt_find(r, "mpm.contact", &rd->sec, rd->err));
@@ -442,12 +511,12 @@ static core_status read_scene(ckpt_reader *r, reader *rd, mpm_scene **out)
     for (size_t g = 0; g < s->ngrains; g++)
         if (pres[3 * g] != 0) {
             const double v[2] = {pres[3 * g + 1], pres[3 * g + 2]};
-            TRY(mpm_prescribe(s, g, v, rd->err));
+            TRY(named(rd, mpm_prescribe(s, g, v, rd->err)));
         }
     TRY(ckpt_find(r, "mpm.clock", &rd->sec, rd->err));
     TRY(get_num(rd, "time", &s->time));
     long steps;
-    TRY(get_int(rd, 0, LONG_MAX, "steps", &steps));
+    TRY(get_int(rd, 0, CKPT_COUNTER_MAX, "steps", &steps));
     s->steps = steps;
     TRY(get_num(rd, "m_min", &s->m_min));
     if (!(s->m_min >= 0))

@@ -1,6 +1,8 @@
 /* The checkpoint container: values come back exactly; a truncated, corrupt, foreign,
  * other-engine, other-byte-order or newer file is refused with a message naming the path and the
- * problem; every single flipped byte and every truncation of a small file is caught. */
+ * problem; every single flipped byte and every truncation of a small file is caught; a section
+ * deleted, duplicated or moved behind a recomputed checksum is caught by the contents list; a
+ * FIFO or a device is refused at once (under an alarm that ends the test if it is not). */
 #define _POSIX_C_SOURCE 200809L
 #include <dirent.h>
 #include <math.h>
@@ -11,6 +13,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 #include <cmocka.h>
 
@@ -360,6 +363,132 @@ static void test_newer_and_other_byte_order(void **state)
     free(b);
 }
 
+/* The sections of a file as (offset, length) of each whole section (header, payload, padding). */
+typedef struct piece {
+    size_t at, len;
+    char tag[17];
+} piece;
+
+static int pieces(const unsigned char *b, size_t n, piece *out, int max)
+{
+    int k = 0;
+    for (size_t at = 64; at < n - 24 && k < max; k++) {
+        uint64_t size;
+        memcpy(&size, b + at + 24, 8);
+        const size_t len = 32 + (size_t)size + (8 - (size_t)size % 8) % 8;
+        out[k].at = at;
+        out[k].len = len;
+        memcpy(out[k].tag, b + at, 16);
+        out[k].tag[16] = '\0';
+        at += len;
+    }
+    return k;
+}
+
+/* The file of header, the sections order[0..m) of b and a trailer with the right size and
+ * checksum, written to path. */
+static void rebuild(const unsigned char *b, const piece *p, const int *order, int m)
+{
+    size_t n = 64;
+    for (int k = 0; k < m; k++)
+        n += p[order[k]].len;
+    unsigned char *o = malloc(n + 24);
+    memcpy(o, b, 64);
+    size_t at = 64;
+    for (int k = 0; k < m; k++) {
+        memcpy(o + at, b + p[order[k]].at, p[order[k]].len);
+        at += p[order[k]].len;
+    }
+    const uint64_t size = n + 24;
+    memcpy(o + at, "GRAINEND", 8);
+    memcpy(o + at + 8, &size, 8);
+    reseal(o, n + 24);
+    spit(path, o, n + 24);
+    free(o);
+}
+
+static void test_contents(void **state)
+{
+    (void)state;
+    core_error err;
+    write_small(path, "dem", NULL);
+    size_t n;
+    unsigned char *b = slurp(path, &n);
+    piece p[8];
+    /* data, opt, empty, and the contents list last (its tag is the container's own) */
+    assert_int_equal(pieces(b, n, p, 8), 4);
+    assert_string_equal(p[3].tag, "contents");
+    ckpt_writer *w;
+    assert_int_equal(ckpt_writer_open(&w, path, "dem", "0.1.0", &err), CORE_OK);
+    assert_int_equal(ckpt_section_begin(w, "contents", 0, &err), CORE_ERR_ARG);
+    ckpt_writer_abort(w);
+    /* a section deleted, optional or not: the file is incomplete, the section named */
+    rebuild(b, p, (const int[]){0, 2, 3}, 3);
+    expect_refused("dem", "is incomplete: section 'opt' (number 2 of the 3 its writer listed) is "
+                          "missing");
+    rebuild(b, p, (const int[]){1, 2, 3}, 3);
+    expect_refused("dem", "is incomplete: section 'data' (number 1 of the 3");
+    /* duplicated, moved: not where the list has it */
+    rebuild(b, p, (const int[]){0, 1, 1, 2, 3}, 5);
+    expect_refused("dem", "section 'opt', number 3 of the file, is not where its writer listed it");
+    rebuild(b, p, (const int[]){2, 1, 0, 3}, 4);
+    expect_refused("dem", "section 'empty', number 1 of the file, is not where its writer listed");
+    /* the list not last */
+    rebuild(b, p, (const int[]){0, 3, 1, 2}, 4);
+    expect_refused("dem", "section 'contents' is section 2 of 4, not the last");
+    /* its count inflated */
+    unsigned char *c = malloc(n);
+    memcpy(c, b, n);
+    const uint64_t many = UINT64_C(1) << 40;
+    memcpy(c + p[3].at + 32, &many, 8);
+    reseal(c, n);
+    spit(path, c, n);
+    expect_refused("dem", "section 'contents' of 56 bytes does not hold a list of tags");
+    free(c);
+    /* without the list at all, the file of an older writer: read as it is */
+    rebuild(b, p, (const int[]){0, 1, 2}, 3);
+    assert_int_equal(read_small(path, &err), CORE_OK);
+    ckpt_reader *r;
+    spit(path, b, n);
+    assert_int_equal(ckpt_reader_open(&r, path, "dem", &err), CORE_OK);
+    assert_int_equal(ckpt_reader_nsections(r), 3);
+    assert_false(ckpt_has(r, "contents"));
+    ckpt_reader_close(r);
+    free(b);
+}
+
+/* A FIFO with no writer, and devices: refused at once, never read. The alarm ends the test if a
+ * read blocks (a FIFO) or never ends (/dev/zero). */
+static void test_not_regular(void **state)
+{
+    (void)state;
+    char fifo[300];
+    snprintf(fifo, sizeof fifo, "%s/fifo", dir);
+    assert_int_equal(mkfifo(fifo, 0600), 0);
+    alarm(20);
+    snprintf(path, sizeof path, "%s", fifo);
+    expect_refused("dem", "it is a FIFO (named pipe), not a regular file");
+    snprintf(path, sizeof path, "/dev/zero");
+    expect_refused("dem", "cannot read checkpoint '/dev/zero': it is a character device");
+    snprintf(path, sizeof path, "/dev/null");
+    expect_refused(NULL, "it is a character device, not a regular file");
+    FILE *fp = (FILE *)1;
+    core_error err;
+    assert_int_equal(fileio_open_read(fifo, "data file", &fp, NULL, &err), CORE_ERR_IO);
+    assert_null(fp);
+    assert_non_null(strstr(err.msg, "cannot read data file '"));
+    alarm(0);
+    snprintf(path, sizeof path, "%s/a.ckpt", dir);
+    /* a regular file: opened, its size given */
+    write_small(path, "dem", NULL);
+    uint64_t size = 0;
+    assert_int_equal(fileio_open_read(path, "checkpoint", &fp, &size, &err), CORE_OK);
+    struct stat st;
+    assert_int_equal(stat(path, &st), 0);
+    assert_true(size == (uint64_t)st.st_size);
+    fclose(fp);
+}
+
 static void test_write_failures(void **state)
 {
     (void)state;
@@ -406,6 +535,8 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_foreign_and_missing, setup, teardown),
         cmocka_unit_test_setup_teardown(test_other_engine, setup, teardown),
         cmocka_unit_test_setup_teardown(test_newer_and_other_byte_order, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_contents, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_not_regular, setup, teardown),
         cmocka_unit_test_setup_teardown(test_write_failures, setup, teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

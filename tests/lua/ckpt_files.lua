@@ -23,6 +23,19 @@ function M.reseal(s)
   return s:sub(1, #s - 8) .. string.pack("<i8", h)
 end
 
+-- The offset (0-based) just after the payload of s's section of that tag, before its padding:
+-- values at the end of a section are forged at F.section_end(s, tag) - 8 and below.
+function M.section_end(s, tag)
+  local at = 64
+  while at < #s - 24 do
+    local t = s:sub(at + 1, at + 16):gsub("%z+$", "")
+    local size = string.unpack("<I8", s, at + 25)
+    if t == tag then return at + 32 + size end
+    at = at + 32 + size + (8 - size % 8) % 8
+  end
+  error("no section '" .. tag .. "'")
+end
+
 -- s with bytes written over it after position at.
 function M.put(s, at, bytes) return s:sub(1, at) .. bytes .. s:sub(at + #bytes + 1) end
 

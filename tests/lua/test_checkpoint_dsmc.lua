@@ -144,16 +144,17 @@ check.errors(function() mpm.load(good) end, "is a dsmc checkpoint, not an mpm on
              "DSMC checkpoint to mpm.load")
 write(bad, reseal(put(s, 12, string.pack("=I4", 2))))
 check.errors(function() dsmc.load(bad) end, "format version 2", "newer format")
--- Behind a valid checksum: the last section holds the particles, the last value a velocity.
-write(bad, reseal(put(s, #s - 24 - 8, string.pack("=d", 1 / 0))))
+-- Behind a valid checksum: the particles' section ends with a velocity.
+local pend = F.section_end(s, "dsmc.particles")
+write(bad, reseal(put(s, pend - 8, string.pack("=d", 1 / 0))))
 check.errors(function() dsmc.load(bad) end,
              "corrupt dsmc checkpoint: a particle is outside the box",
              "infinite velocity")
 -- The first and the last particle's positions swapped: no longer in cell order. The section is
--- x, vx, y, vy as arrays of a count and n doubles, ending at the trailer.
+-- x, vx, y, vy as arrays of a count and n doubles.
 do
   local n = 50
-  local function at(array, i) return #s - 24 - (4 - array) * (8 + 8 * n) + 8 + 8 * (i - 1) end
+  local function at(array, i) return pend - (4 - array) * (8 + 8 * n) + 8 + 8 * (i - 1) end
   local t = s
   for _, array in ipairs({ 0, 2 }) do -- x, y
     local first = t:sub(at(array, 1) + 1, at(array, 1) + 8)

@@ -177,9 +177,8 @@ check.errors(function() mpm.load(bad) end, "is a dsmc checkpoint, not an mpm one
              "DSMC checkpoint")
 write(bad, reseal(put(s, 12, string.pack("=I4", 99))))
 check.errors(function() mpm.load(bad) end, "format version 99", "newer format")
--- Behind a valid checksum: the last section is mpm.clock (time, steps, m_min), then the 24-byte
--- trailer.
-local clock = #s - 24 - 24
+-- Behind a valid checksum: the section mpm.clock holds time, steps, m_min.
+local clock = F.section_end(s, "mpm.clock") - 24
 write(bad, reseal(put(s, clock, string.pack("=d", 0 / 0))))
 check.errors(function() mpm.load(bad) end, "corrupt mpm checkpoint: time is not finite", "NaN time")
 write(bad, reseal(put(s, clock + 16, string.pack("=d", -1))))

@@ -221,7 +221,8 @@ for _, case in ipairs(solved) do
 end
 
 -- a file whose law needs the coefficients but lacks the section (renamed and made optional: the
--- section header is a 16-byte tag, then its uint32 flags) is refused, naming what is missing
+-- section header is a 16-byte tag, then its uint32 flags) is refused by the writer's list of
+-- sections, naming what is missing
 do
   local s = pile(solved[1][2])
   run(s, 10)
@@ -232,8 +233,7 @@ do
   local forged = F.put(F.put(bytes, at - 1, "dampinx\0"), at - 1 + 16, string.pack("=I4", 0))
   F.write(path("forged.ckpt"), F.reseal(forged))
   check.errors(function() dem.load(path("forged.ckpt")) end,
-    "'" .. path("forged.ckpt") .. "' has no section 'damping', which its contact law (viscous damping from a " ..
-    "restitution) needs", "a file without the solved coefficients")
+    "'" .. path("forged.ckpt") .. "' is incomplete: section 'damping'", "a file without the solved coefficients")
   check.is_true(dem.load(path("good.ckpt")) ~= nil, "the unforged file loads")
   -- a law with a closed form (the unclipped linear spring) writes no section
   local u = pile{ normal = "linear", stiffness = 2e3, damping = "viscous", clip = false }

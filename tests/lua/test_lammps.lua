@@ -129,21 +129,26 @@ local good = head .. "1 1 0.1 1000 0.5 0.5 0.5\n2 1 0.1 1000 0.2 0.5 0.5\n3 1 0.
 local scene = dem.scene{ dim = 3, box = { { 0, 0, 0 }, { 1, 1, 1 } } }
 local ok = write("good.data", good)
 check.eq(scene:read_lammps_data(ok).count, 3, "the well-formed file loads")
+-- (one atom: a header counting 3 atoms before a single line is refused by its count first)
+local head1 = (head:gsub("\n3 atoms\n", "\n1 atoms\n"))
 local bad = {
-  { "short line", head .. "1 1 0.1 1000 0.5 0.5\n", ":12: an Atoms line has 6 values; atom_style sphere needs 7" },
-  { "zero diameter", head .. "1 1 0 1000 0.5 0.5 0.5\n", ":12: atom 1: diameter '0' must be a positive number" },
-  { "negative density", head .. "1 1 0.1 -5 0.5 0.5 0.5\n", ":12: atom 1: density '-5' must be a positive number" },
-  { "not a number", head .. "1 1 0.1 1000 0.5 abc 0.5\n", ":12: atom 1: coordinate y 'abc' is not a number" },
-  { "bad type", head .. "1 2 0.1 1000 0.5 0.5 0.5\n", ":12: atom 1: type '2' is not an integer in [1, 1]" },
+  { "short line", head1 .. "1 1 0.1 1000 0.5 0.5\n", ":12: an Atoms line has 6 values; atom_style sphere needs 7" },
+  { "zero diameter", head1 .. "1 1 0 1000 0.5 0.5 0.5\n", ":12: atom 1: diameter '0' must be a positive number" },
+  { "negative density", head1 .. "1 1 0.1 -5 0.5 0.5 0.5\n", ":12: atom 1: density '-5' must be a positive number" },
+  { "not a number", head1 .. "1 1 0.1 1000 0.5 abc 0.5\n", ":12: atom 1: coordinate y 'abc' is not a number" },
+  { "bad type", head1 .. "1 2 0.1 1000 0.5 0.5 0.5\n", ":12: atom 1: type '2' is not an integer in [1, 1]" },
   { "duplicate id", head .. "1 1 0.1 1000 0.5 0.5 0.5\n2 1 0.1 1000 0.2 0.5 0.5\n1 1 0.1 1000 0.8 0.5 0.5\n",
     ":14: atom id 1 appears twice (also line 12)" },
-  { "truncated", head .. "1 1 0.1 1000 0.5 0.5 0.5\n", "the file ends in the Atoms section after 1 of 3 atoms (truncated?)" },
+  { "truncated", head .. "1 1 0.1 1000 0.5 0.5 0.5\n2 1 0.1 1000 0.2 0.5 0.5\n",
+    "the file ends in the Atoms section after 2 of 3 atoms (truncated?)" },
+  { "count beyond the file", head .. "1 1 0.1 1000 0.5 0.5 0.5\n",
+    ":3: the header announces 3 atoms, but the 26 bytes after it hold at most 1 Atoms lines" },
   { "no Atoms", "title\n\n3 atoms\n1 atom types\n\n0 1 xlo xhi\n0 1 ylo yhi\n0 1 zlo zhi\n",
     "the header announces 3 atoms but the file has no Atoms section" },
   { "no box", "title\n\n0 atoms\n1 atom types\n\n0 1 xlo xhi\n0 1 ylo yhi\n", "the header has no 'zlo zhi' box bounds" },
   { "bonds", "title\n\n3 atoms\n2 bonds\n", ":4: 2 bonds: grainlab's DEM reads spheres only" },
   { "unknown header", "title\n\n3 atoms\n7 widgets\n", ":4: unknown header line '7 widgets'" },
-  { "other atom style", (head:gsub("# sphere", "# atomic")) .. "1 1 0.5 0.5 0.5\n",
+  { "other atom style", (head1:gsub("# sphere", "# atomic")) .. "1 1 0.5 0.5 0.5\n",
     ":10: the Atoms section is for atom_style atomic" },
   { "triclinic", "title\n\n0 atoms\n1 atom types\n0 1 xlo xhi\n0 1 ylo yhi\n0 1 zlo zhi\n0.1 0 0 xy xz yz\n", ":8: a triclinic box" },
   { "unknown section", good .. "\nBonds\n\n1 1 1 2\n", ":16: section 'Bonds' is not read by grainlab" },
@@ -161,7 +166,7 @@ for k, case in ipairs(bad) do
   check.contains(msg, "read_lammps_data: " .. p, case[1] .. ": names the call and the file")
   check.eq(scene:particles().count, 3, case[1] .. ": nothing half-loaded")
 end
-check.errors(function() dem.read_lammps_data(path("missing.data")) end, "cannot open", "missing file")
+check.errors(function() dem.read_lammps_data(path("missing.data")) end, "cannot read LAMMPS data file", "missing file")
 -- skipped sections: Masses and Pair Coeffs carry nothing grainlab takes from a file
 local skip = write("skip.data", "title\n\n1 atoms\n1 atom types\n0 1 xlo xhi\n0 1 ylo yhi\n0 1 zlo zhi\n\n" ..
   "Masses\n\n1 1.0\n\nPair Coeffs # granular\n\n1 1 1\n\nAtoms\n\n7 1 0.1 1000 0.5 0.5 0.5 0 0 0\n")
