@@ -19,10 +19,12 @@
 --     deleted; a flipped bit.
 -- Each case is loaded; what is loaded runs 3 steps. A case fails when the reader accepts a file
 -- that must be refused, refuses it without naming the file, hangs (the driver's watchdog), or
--- crashes (a sanitizer report ends the worker). FIFOs and devices are cases as well.
+-- crashes (a sanitizer report ends the worker). M.explicit_worker runs named cases instead (the
+-- test's, with the message each must give, FIFOs and devices among them).
 --
 -- Used by tests/lua/test_reader_fuzz.lua (a few hundred cases) and, for a campaign,
 --   grainlab tests/lua/reader_fuzz.lua role=campaign n=5000 seed=1 [exe=build-asan/grainlab]
+--            [limit=20 (s per case)] [log=cases.txt (every case's line)] [dir=... keep=1]
 -- (run from the repository; the workers are `exe`, the sanitizer build's grainlab for instance).
 local M = {}
 
@@ -639,22 +641,6 @@ function M.drive(p)
     end
   end
   return res
-end
-
--- A file that is not a regular file: each reader refuses it at once, naming it.
-function M.special_files(dir)
-  local fifo = dir .. "/fifo"
-  os.remove(fifo)
-  assert(os.execute("mkfifo " .. sh_quote(fifo)))
-  local cases = {}
-  for _, f in ipairs{ fifo, "/dev/zero", "/dev/null", dir } do
-    cases[#cases + 1] = { path = f, call = "dem.load", fn = function() return dem.load(f) end }
-    cases[#cases + 1] = { path = f, call = "mpm.load", fn = function() return mpm.load(f) end }
-    cases[#cases + 1] = { path = f, call = "dsmc.load", fn = function() return dsmc.load(f) end }
-    cases[#cases + 1] = { path = f, call = "dem.read_lammps_data",
-                          fn = function() return dem.read_lammps_data(f) end }
-  end
-  return cases
 end
 
 function M.main(p)
