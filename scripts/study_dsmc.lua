@@ -60,7 +60,8 @@ local function haff(nu, nc, wdt, seed)
     if not start and st.collisions_per_particle >= 2 then start = #ts end
     if st.t_over_m < T0 / drop then break end
     local w0 = grainlab.clock()
-    s:run{ steps = seg, dt = wdt / omega(st.t_over_m), warn = false }
+    -- the sweep crosses the mean collision time on purpose (omega dt up to 3): force = true
+    s:run{ steps = seg, dt = wdt / omega(st.t_over_m), force = true, warn = false }
     wall = wall + grainlab.clock() - w0
   end
   local tx, ty, cx, cy = {}, {}, {}, {}

@@ -13,6 +13,8 @@
 -- Checks: the temperature falls with height through the bulk: T at the layer 1-2 cm above the
 -- wall's top exceeds T at the height below which 80% of the particles lie; the DSMC conditions
 -- hold in the bulk (mean free path above the cell, collision time above dt).
+-- A more dissipative bed collapses: with e=0.85 a cell fills past close packing at t = 0.95 s
+-- and the run stops there with an error (docs/dsmc.md).
 --   grainlab scripts/vibrated_bed.lua [n=900] [e=0.9] [amplitude=1.5e-3] [frequency=60]
 --                                     [settle=2] [avg=4] [csv=out/vibrated_bed.csv]
 local N = params.n or 900

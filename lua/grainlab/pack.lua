@@ -151,6 +151,24 @@ local function common(call, s, opts, spec)
   return info, n, rng, sample, rmax_new, lo, hi
 end
 
+-- The packing fraction random sequential addition reaches when no particle fits any more (its
+-- saturation, equal radii): 0.547 for disks (Hinrichsen, Feder & Jossang 1986), 0.384 for
+-- spheres (Torquato, Uche & Stillinger 2006). With a range of radii the process stops sooner, as
+-- a large radius drawn late finds no room (measured: 0.46 for radii 1:2 and 1:4 in 2D after 300
+-- tries per particle, where equal radii reach 0.52), and a finite region loses a layer along its
+-- sides; what is asked beyond saturation can never be placed.
+local RSA_LIMIT = { [2] = 0.547, [3] = 0.384 }
+
+-- The mean area (2D) or volume (3D) of a particle of the radius spec (a number, or uniform in
+-- {a, b}): pi <r^2> = pi (a^2 + ab + b^2) / 3, 4/3 pi <r^3> = pi (a + b)(a^2 + b^2) / 3.
+local function mean_size(radius, dim)
+  if radius == nil then radius = { 0.5e-3, 1e-3 } end
+  local a, b = radius, radius
+  if type(radius) == "table" then a, b = radius[1], radius[2] end
+  if dim == 2 then return math.pi * (a * a + a * b + b * b) / 3 end
+  return math.pi * (a + b) * (a * a + b * b) / 3
+end
+
 function pack.random(s, opts)
   local call = "grainlab.pack.random"
   local info, n, rng, sample, rmax_new, lo, hi = common(call, s, opts, SPECS.random)
@@ -160,6 +178,23 @@ function pack.random(s, opts)
   if type(speed) ~= "number" or not (speed >= 0) then fail(call, "speed", "non-negative number", speed) end
   local placed, rmax = existing(s, dim)
   rmax = math.max(rmax, rmax_new)
+  -- Refused at entry what random addition cannot reach, rather than found out after max_tries.
+  local vol, there = 1, 0
+  for d = 1, dim do vol = vol * (hi[d] - lo[d]) end
+  for _, p in ipairs(placed) do
+    local inside = true
+    for d = 1, dim do inside = inside and p[d] >= lo[d] and p[d] <= hi[d] end
+    if inside then there = there + (dim == 2 and math.pi * p.r ^ 2 or 4 / 3 * math.pi * p.r ^ 3) end
+  end
+  local each, limit = mean_size(opts.radius, dim), RSA_LIMIT[dim]
+  local asked = (there + n * each) / vol
+  if asked > limit then
+    local fits = math.max(0, math.floor((limit * vol - there) / each))
+    fail(call, "n", string.format("at most %d particles (random addition saturates at a packing fraction of %.3g " ..
+                                  "of the region; %d of mean %s %.3g m^%d%s ask for %.3g; use pack.deposit, a larger region or fewer particles)",
+                                  fits, limit, n, dim == 2 and "area" or "volume", each, dim,
+                                  there > 0 and string.format(" with the %.3g already there", there / vol) or "", asked), n)
+  end
   local grid = new_grid(lo, hi, 2 * rmax, dim)
   for _, p in ipairs(placed) do grid.add(p) end
   local add = dim == 2 and s.add_disk or s.add_sphere
@@ -201,8 +236,6 @@ function pack.random(s, opts)
       end
     end
   end
-  local vol = 1
-  for d = 1, dim do vol = vol * (hi[d] - lo[d]) end
   return ids, { placed = #ids, tries = tries, fraction = area / vol }
 end
 
@@ -571,7 +604,10 @@ end
 
 grainlab.doc(pack, { name = "grainlab.pack", doc = [[Packing generators (reproducible from seed):
   pack.random(s, { n =, radius = r | {min, max}, region = {{lo},{hi}}, seed =, material =, speed = })
-    random sequential addition without overlaps; returns ids, {placed, tries, fraction}
+    random sequential addition without overlaps; returns ids, {placed, tries, fraction}. More
+    than it can ever place is refused at entry: a packing fraction of the region (with the
+    particles already in it) above its saturation, 0.547 in 2D and 0.384 in 3D; else it stops
+    after max_tries (default 1000 n) with the count it placed.
   pack.deposit(s, { n =, radius = {0.5e-3, 1e-3}, region =, seed =, material =, relax_steps = 20000, drag = 'auto' })
     gravity deposition: 2D drop-and-roll (Jodrey-Tory style) onto the floor of the region, then
     pack.settle at the scene's stiffness with at most relax_steps steps (0: none; set the contact
@@ -603,7 +639,9 @@ grainlab.doc(pack, { name = "grainlab.pack", doc = [[Packing generators (reprodu
     shear test of Bardenhagen et al., Fig. 5): random placement in a wider slab, compacted with
     the DEM module by a wall; with margin > 0 the disks overlapping [0, L] of a packing of
     [-margin, L + margin], cut by the edges. Returns {x, y, r, area_fraction, shrink,
-    mean_radius}.]] })
+    mean_radius}. Refused at entry: L below 4 d_min, disks covering more of the initial slab
+    than random placement reaches (0.547), less than 0.2 of the square, or an initial slab
+    they fill below 0.05 (the compaction's steps grow with its width).]] })
 -- pack.slab{ size = L, n = 369, diameter = {d_min, d_mean, d_max}, seed = 5, width = 1.8, margin = 0 }
 -- Diameters d_min + an exponential of mean 26/57 d_mean (the shape of the paper's HMX sizes),
 -- truncated at min(d_max, L / 4) (the DEM periodic axis needs 3 neighbour cut-offs) and
@@ -630,11 +668,19 @@ function pack.slab(opts)
   if type(margin) ~= "number" or not (margin >= 0) then fail("grainlab.pack.slab", "margin", "non-negative number", margin) end
   local Lp = L + 2 * margin -- packed width; the disks are shifted by -margin at the end
   W0 = W0 * Lp
+  if d_max <= d_min then -- no diameter to draw (the sampler below would never end)
+    fail("grainlab.pack.slab", "size", string.format("size above 4 d_min = %g (no disk is wider than size/4)", 4 * d_min), L)
+  end
   local rng = grainlab.rng{ seed = opts.seed or 5 }
   local d = {}
+  local scale, span = d_mean - d_min, d_max - d_min
   for i = 1, n do
-    local v
-    repeat v = d_min - (d_mean - d_min) * math.log(1 - rng:uniform()) until v <= d_max
+    local v, tries = nil, 0
+    repeat v = d_min - scale * math.log(1 - rng:uniform()); tries = tries + 1 until v <= d_max or tries == 64
+    if v > d_max then -- a truncation far in the head: the same law, by its inverse distribution
+      v = d_min - scale * math.log(1 - rng:uniform() * -math.expm1(-span / scale))
+      v = math.min(v, d_max)
+    end
     d[i] = v
   end
   local mean = 0
@@ -642,21 +688,72 @@ function pack.slab(opts)
   local k = (d_mean - d_min) / (mean - d_min)
   for i = 1, n do d[i] = math.min(d_min + k * (d[i] - d_min), d_max) end
   table.sort(d, function(a, b) return a > b end)
+  -- Refused at entry: more disk area than random placement can put in the initial slab, or a
+  -- slab too sparse to be a packing (the compaction's steps grow as size / diameter).
+  local area0 = 0
+  for i = 1, n do area0 = area0 + math.pi / 4 * d[i] ^ 2 end
+  local each, f0, f = area0 / n, area0 / (W0 * L), area0 / (Lp * L)
+  if f0 > RSA_LIMIT[2] then
+    fail("grainlab.pack.slab", "n", string.format("at most %d disks (their random placement in the initial slab, width x size wide, " ..
+         "saturates at a packing fraction of %.3g; %d disks of field 'diameter' (mean area %.3g m^2) ask for %.3g there, " ..
+         "%.3g of the size^2 square)",
+         math.floor(RSA_LIMIT[2] * W0 * L / each), RSA_LIMIT[2], n, each, f0, f), n)
+  end
+  if f < 0.2 then
+    fail("grainlab.pack.slab", "n", string.format("at least %d disks (a slab is a packing: the disks must cover 0.2 of the " ..
+         "size^2 square at least; %d disks of field 'diameter' (mean area %.3g m^2) cover %.3g)", math.ceil(0.2 * Lp * L / each), n, each, f), n)
+  end
+  if f0 < 0.05 then -- the wall travels (width - 1) size: the compaction's steps grow with it
+    fail("grainlab.pack.slab", "width", string.format("width at most %.3g (the initial slab must hold the disks at a packing " ..
+         "fraction of 0.05 at least; they cover %.3g of the size^2 square, %.3g of the slab)", f / 0.05, f, f0), opts.width)
+  end
   local function dy_min(a, b) local t = a - b; return t - L * math.floor(t / L + 0.5) end
+  -- Buckets of side >= the largest diameter, periodic in y: the disks a disk can overlap lie in
+  -- its bucket and the 8 around it, so a try costs the same for any n.
+  local cell = d[1]
+  local ny = math.max(1, math.floor(L / cell))
+  local function buckets()
+    local b = {}
+    local function key(cx, cy) return cx * ny + cy end
+    local function cy_of(yv) return math.min(ny - 1, math.max(0, math.floor(yv / L * ny))) end
+    function b.add(i, xv, yv)
+      local kk = key(math.floor(xv / cell), cy_of(yv))
+      local t = b[kk]
+      if not t then t = {}; b[kk] = t end
+      t[#t + 1] = i
+    end
+    -- fn(j) for every disk near (xv, yv); stops at the first true
+    function b.near(xv, yv, fn)
+      local cx, cy = math.floor(xv / cell), cy_of(yv)
+      local rows = ny >= 3 and { (cy - 1) % ny, cy, (cy + 1) % ny } or (ny == 2 and { 0, 1 } or { 0 })
+      for ix = cx - 1, cx + 1 do
+        for _, iy in ipairs(rows) do
+          local t = b[key(ix, iy)]
+          if t then for _, j in ipairs(t) do if fn(j) then return true end end end
+        end
+      end
+      return false
+    end
+    return b
+  end
   local x, y, r = {}, {}, {}
+  local grid, tries, max_tries = buckets(), 0, 1000 * n
   for i = 1, n do
     r[i] = 0.5 * d[i]
-    local ok, tries = false, 0
+    local ok
     repeat
       tries = tries + 1
       x[i], y[i] = r[i] + (W0 - 2 * r[i]) * rng:uniform(), L * rng:uniform()
-      ok = true
-      for j = 1, i - 1 do
+      ok = not grid.near(x[i], y[i], function(j)
         local ex, ey = x[i] - x[j], dy_min(y[i], y[j])
-        if ex * ex + ey * ey < (r[i] + r[j]) ^ 2 then ok = false; break end
-      end
-    until ok or tries > 100000
-    if not ok then error("grainlab.pack.slab: no room for the disks in the initial slab; use fewer or smaller disks", 2) end
+        return ex * ex + ey * ey < (r[i] + r[j]) ^ 2
+      end)
+    until ok or tries >= max_tries
+    if not ok then
+      error(string.format("grainlab.pack.slab: placed %d of %d disks in the initial slab in %d tries; use fewer or smaller disks, or a larger width",
+                          i - 1, n, max_tries), 2)
+    end
+    grid.add(i, x[i], y[i])
   end
   local soft = grainlab.material{ density = 1900, young = 2e8, poisson = 0.3, friction = 0, restitution = 0.3 }
   local ds = dem.scene{ box = { { -0.1 * Lp, 0 }, { W0 + 0.1 * Lp, L } }, gravity = { 0, 0 }, periodic = { false, true } }
@@ -673,12 +770,14 @@ function pack.slab(opts)
   local P = ds:particles()
   for i = 1, n do x[i], y[i] = P.x[i], P.y[i] - L * math.floor(P.y[i] / L) end
   local worst = 0
+  grid = buckets()
   for i = 1, n do
-    for j = i + 1, n do
+    grid.near(x[i], y[i], function(j)
       local ex, ey = x[i] - x[j], dy_min(y[i], y[j])
       local ov = (r[i] + r[j]) - math.sqrt(ex * ex + ey * ey)
       if ov > 0 then worst = math.max(worst, ov / (r[i] + r[j])) end
-    end
+    end)
+    grid.add(i, x[i], y[i])
   end
   -- stretch x so the outermost disks touch x = 0 and x = L (the soft wall contacts and the
   -- shrink leave a small gap; a stretch >= 1 only moves disks apart)

@@ -235,6 +235,22 @@ static core_status region_box(const dem_scene *s, const dem_inserter_def *d, dou
     return CORE_OK;
 }
 
+/* How many particles of the smallest radius the region's volume holds (N v <= V; a bound, not
+ * a packing). */
+static double region_capacity(const dem_scene *s, const dem_inserter_def *d)
+{
+    const int D = s->dim;
+    const double r = smallest_radius(d);
+    double vol = 1;
+    if (d->ball)
+        vol = D == 2 ? DEM_PI * d->extent * d->extent : 4.0 / 3.0 * DEM_PI * pow(d->extent, 3);
+    else
+        for (int a = 0; a < D; a++)
+            vol *= d->hi[a] - d->lo[a];
+    const double v = D == 2 ? DEM_PI * r * r : 4.0 / 3.0 * DEM_PI * r * r * r;
+    return fmin(floor(vol / v), 1e15);
+}
+
 int dem_add_inserter(dem_scene *s, const dem_inserter_def *d, core_error *err)
 {
     const int D = s->dim;
@@ -681,6 +697,15 @@ static core_status insert(dem_scene *s, int q, long step, int *changed, core_err
     long want = due - in->c.count - in->c.skipped;
     if (want <= 0)
         return CORE_OK;
+    /* No event places more particles than the region's volume holds at its smallest radius:
+     * the rest of what is due is skipped without a draw (a count of 1e15 in a small box once
+     * tried every one of them, `attempts` times each). */
+    const double cap = region_capacity(s, d);
+    if ((double)want > cap) {
+        if (d->rate > 0 || d->count >= 0) /* a mass alone stops at its first skip anyway */
+            in->c.skipped += want - (long)cap;
+        want = (long)cap;
+    }
     in->c.events++;
     /* The particles that can touch one placed in the region. */
     double lo[3], hi[3], reach = largest_radius(d) + s->r_max;

@@ -3,6 +3,7 @@
  * cells (collisions); every cell and every wall hit draws from its own random stream, and each
  * cell's particles are taken in identity order, so the result does not depend on the number of
  * threads, nor on the number of MPI ranks (domain.c). */
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -339,6 +340,8 @@ static void reflect(const dsmc_scene *s, int side, const wall_state *ws, double 
 typedef struct flight_totals {
     long wall_hits;
     int bad;
+    long stranded;  /* particles still beyond a wall after the bounce budget (put on it) */
+    long strand_id; /* the smallest identity among them (LONG_MAX: none) */
 } flight_totals;
 
 /* The constants of one flight step, read once: stores into the particle arrays could alias the
@@ -351,16 +354,33 @@ typedef struct flight_consts {
     uint64_t seed, step;
 } flight_consts;
 
-/* Walls for one particle that is outside the walls on a non-periodic axis (the slow path). */
+/* Whether the walls of axis k reflect like mirrors: both fixed, specular with restitution 1,
+ * and no gravity along the axis. Then any number of crossings in one step is a fold of the
+ * free flight about the two walls (the trajectory in a box of period 2L). */
+static bool mirror_axis(const dsmc_scene *s, const flight_consts *fc, int k)
+{
+    for (int side = 2 * k; side < 2 * k + 2; side++) {
+        const dsmc_wall_def *w = &s->walls[side];
+        if (w->kind != DSMC_WALL_SPECULAR || w->restitution != 1 || w->amplitude != 0)
+            return false;
+    }
+    return fc->g[k] == 0;
+}
+
+/* Walls for one particle that is outside the walls on a non-periodic axis (the slow path). A
+ * particle may cross both walls of a thin box: up to 4 reflections are followed one by one;
+ * beyond them, mirror walls fold the rest of the flight in closed form (O(1) for any dt), and
+ * other walls (moving, diffuse, inelastic, under gravity) put the particle on the wall it is
+ * behind and count it in *stranded: a step that long is refused by the run (dsmc_run). */
 static __attribute__((noinline)) long walls_one(const dsmc_scene *s, const flight_consts *fc, int D,
-                                                uint64_t id, double x[3], double v[3])
+                                                uint64_t id, double x[3], double v[3],
+                                                int *stranded)
 {
     long hits = 0;
     for (int k = 0; k < D; k++) {
         if (fc->per[k])
             continue;
         const wall_state *ws = fc->ws;
-        /* A fast particle may cross both walls of a thin box: a few reflections at most. */
         for (int bounce = 0; bounce < 4; bounce++) {
             int side = x[k] < ws[2 * k].pos ? 2 * k : x[k] > ws[2 * k + 1].pos ? 2 * k + 1 : -1;
             if (side < 0)
@@ -371,10 +391,23 @@ static __attribute__((noinline)) long walls_one(const dsmc_scene *s, const fligh
             reflect(s, side, &ws[side], fc->dt, x, v, &r);
             hits++;
         }
-        if (x[k] < ws[2 * k].pos)
-            x[k] = ws[2 * k].pos;
-        if (x[k] > ws[2 * k + 1].pos)
-            x[k] = ws[2 * k + 1].pos;
+        const double lo = ws[2 * k].pos, hi = ws[2 * k + 1].pos, L = hi - lo;
+        if (!(x[k] < lo || x[k] > hi))
+            continue;
+        const double u = x[k] - lo;
+        if (mirror_axis(s, fc, k) && fabs(u) < 1e12 * L) { /* beyond: digits of x left */
+            const double c = floor(u / L);                   /* walls crossed: |c| */
+            double m = u - 2 * L * floor(u / (2 * L));       /* in [0, 2L) */
+            if (m > L) {
+                m = 2 * L - m;
+                v[k] = -v[k];
+            }
+            x[k] = fmin(fmax(lo + m, lo), hi);
+            hits += (long)fabs(c);
+            continue;
+        }
+        *stranded = 1;
+        x[k] = x[k] < lo ? lo : hi;
     }
     return hits;
 }
@@ -407,12 +440,13 @@ flight_dim(dsmc_scene *s, const flight_consts *fc, size_t bcount[DSMC_SORT_BLOCK
         any_wall = any_wall || (k < D && !per[k]);
     }
     const int sh = fc->sh;
-    long hits = 0;
+    long hits = 0, stranded = 0, strand_id = LONG_MAX;
     int bad = 0;
     for (int b = 0; b < DSMC_SORT_BLOCKS; b++)
         bcount[b] = 0;
-#pragma omp parallel for schedule(dynamic, 8192) reduction(+ : hits, bcount[:DSMC_SORT_BLOCKS]) \
-    reduction(| : bad) if (n >= DSMC_PARALLEL_MIN)
+#pragma omp parallel for schedule(dynamic, 8192) \
+    reduction(+ : hits, stranded, bcount[:DSMC_SORT_BLOCKS]) reduction(| : bad) \
+    reduction(min : strand_id) if (n >= DSMC_PARALLEL_MIN)
     for (long i = 0; i < n; i++) {
         double x[3], v[3];
         int out = 0;
@@ -430,8 +464,14 @@ flight_dim(dsmc_scene *s, const flight_consts *fc, size_t bcount[DSMC_SORT_BLOCK
                 out |= x[k] < wlo[k] || x[k] > whi[k];
             }
         }
-        if (W && any_wall && out)
-            hits += walls_one(s, fc, D, s->id[i], x, v);
+        if (W && any_wall && out) {
+            int st = 0;
+            hits += walls_one(s, fc, D, s->id[i], x, v, &st);
+            if (st) {
+                stranded++;
+                strand_id = (long)s->id[i] < strand_id ? (long)s->id[i] : strand_id;
+            }
+        }
         size_t c = 0;
         double chk = 0;
         for (int k = D - 1; k >= 0; k--) {
@@ -446,7 +486,7 @@ flight_dim(dsmc_scene *s, const flight_consts *fc, size_t bcount[DSMC_SORT_BLOCK
         cell[i] = (uint32_t)c;
         bcount[c >> sh]++;
     }
-    return (flight_totals){hits, bad};
+    return (flight_totals){hits, bad, stranded, strand_id};
 }
 
 /* Moves every particle, finds its cell and counts the particles per sort range (bcount). */
@@ -495,6 +535,87 @@ typedef struct collide_totals {
     long attempts, collisions, raised, overpacked;
     long overflow; /* cells whose number of candidates was not a number (speeds overflowed) */
 } collide_totals;
+
+/* A cell may take at most this many candidate pairs per particle in one step (Eq. 1): about
+ * half as many collisions per particle, i.e. a step some 50 times the cell's collision time.
+ * Beyond it the cell is left alone and the run stops (dsmc_run): the work of a step stays in
+ * proportion to its particles, whatever dt is asked. */
+#define DSMC_CANDIDATES_PER_PARTICLE 100
+
+/* What stops a run after a step completes, reduced over threads and ranks to one culprit each
+ * (a total order: the result does not depend on the thread or rank count). */
+typedef struct dsmc_verdict {
+    int64_t packed_cells, packed_cell, packed_n; /* cells past close packing; the fullest */
+    int64_t capped_cells, capped_cell, capped_n; /* cells over the candidate cap; the worst */
+    double capped_m;                             /* its candidate pairs */
+    int64_t stranded, strand_id;                 /* particles put on a wall; the first id */
+} dsmc_verdict;
+
+static void verdict_clear(dsmc_verdict *v)
+{
+    memset(v, 0, sizeof *v);
+    v->packed_cell = v->capped_cell = v->strand_id = INT64_MAX;
+}
+
+static bool verdict_any(const dsmc_verdict *v)
+{
+    return v->packed_cells || v->capped_cells || v->stranded;
+}
+
+static void verdict_merge(dsmc_verdict *a, const dsmc_verdict *b)
+{
+    a->packed_cells += b->packed_cells;
+    if (b->packed_n > a->packed_n || (b->packed_n == a->packed_n && b->packed_cell < a->packed_cell))
+        a->packed_n = b->packed_n, a->packed_cell = b->packed_cell;
+    a->capped_cells += b->capped_cells;
+    if (b->capped_m > a->capped_m || (b->capped_m == a->capped_m && b->capped_cell < a->capped_cell))
+        a->capped_m = b->capped_m, a->capped_cell = b->capped_cell, a->capped_n = b->capped_n;
+    a->stranded += b->stranded;
+    if (b->strand_id < a->strand_id)
+        a->strand_id = b->strand_id;
+}
+
+/* The most particles whose centres can lie in one cell at the packing limit nu_rcp: their
+ * bodies fill the cell widened by a radius on every side, so N v_b <= nu_rcp prod(h_k + 2R). */
+static double fit_per_cell(const dsmc_scene *s)
+{
+    double vol = 1;
+    for (int k = 0; k < s->D; k++)
+        vol *= s->h[k] + 2 * s->def.radius;
+    return floor(s->def.packing_limit * vol / s->vpart);
+}
+
+/* ln P(N >= k) of a Poisson count of mean mu, bounded above (k > mu): the terms from k on fall
+ * at least by mu / (k + 1) each. */
+static double poisson_log_tail(double mu, double k)
+{
+    return -mu + k * log(mu) - lgamma(k + 1) - log(1 - mu / (k + 1));
+}
+
+/* The count from which a cell is past close packing for the run's check: more than fit in it
+ * (fit_per_cell), and beyond the reach of the cells' Poisson noise in a gas DSMC can describe:
+ * P(N >= threshold) < 1e-20 per cell and step at a mean occupancy mu of the larger of the gas's
+ * mean and that of the densest gas whose mean free path (chi = 1) still spans the cell
+ * (condition ii): V_c / (2 sqrt2 sigma h_max) in 2D, V_c / (sqrt2 sigma h_max) in 3D. In cells
+ * of one diameter (2D) that noise stays below 14, where 4 fit. */
+static double packed_threshold(const dsmc_scene *s)
+{
+    double hmax = 0;
+    for (int k = 0; k < s->D; k++)
+        hmax = fmax(hmax, s->h[k]);
+    double mu = s->cell_volume / ((s->D == 2 ? 2 * sqrt(2.0) : sqrt(2.0)) * s->sigma * hmax);
+    mu = fmax(mu, (double)dsmc_count(s) / (double)s->ncells);
+    const double lim = log(1e-20);
+    double lo = floor(mu) + 1, hi = lo + 20 * sqrt(mu) + 100; /* tail(hi) < 1e-20 */
+    while (hi - lo > 1) {
+        double mid = floor(0.5 * (lo + hi));
+        if (poisson_log_tail(mu, mid) < lim)
+            hi = mid;
+        else
+            lo = mid;
+    }
+    return fmax(fit_per_cell(s) + 1, hi);
+}
 
 /* Post-collision velocities: the normal component of g = v_i - v_j reversed and scaled by e, the
  * tangential one kept; n from the random impact parameter b (|b| < 2R): sin(theta) = b / 2R is
@@ -546,7 +667,7 @@ static inline void collide_3d(double *vi, double *vj, const double gv[3], double
     }
 }
 
-static collide_totals collide(dsmc_scene *s, double dt)
+static collide_totals collide(dsmc_scene *s, double dt, dsmc_verdict *verdict)
 {
     const int D = s->D;
     const long c_lo = (long)s->cell_lo, nc = (long)s->cell_hi;
@@ -558,13 +679,24 @@ static collide_totals collide(dsmc_scene *s, double dt)
     const double vb = s->vpart, rcp = s->def.packing_limit;
     const dsmc_excluded excl = s->def.excluded;
     const uint64_t seed = s->def.seed, step = (uint64_t)s->steps;
+    const size_t packed = (size_t)packed_threshold(s);
     long attempts = 0, collisions = 0, raised = 0, overpacked = 0, overflow = 0;
+    verdict_clear(verdict);
 #pragma omp parallel for schedule(dynamic, 64) \
     reduction(+ : attempts, collisions, raised, overpacked, overflow) if (s->n >= DSMC_PARALLEL_MIN)
     for (long c = c_lo; c < nc; c++) {
         size_t a = start[c], N = start[c + 1] - a;
         if (N < 2)
             continue;
+        if (N >= packed) { /* collided all the same: the step completes, the run stops after it */
+            dsmc_verdict mine;
+            verdict_clear(&mine);
+            mine.packed_cells = 1;
+            mine.packed_cell = c;
+            mine.packed_n = (int64_t)N;
+#pragma omp critical(dsmc_verdict)
+            verdict_merge(verdict, &mine);
+        }
         /* The cell's particles in identity order: P[k] is the k-th (offset from a). Out of
          * memory for a large cell: the arrays themselves are put in order, P = NULL. */
         uint64_t kbuf[64];
@@ -624,6 +756,22 @@ static collide_totals collide(dsmc_scene *s, double dt)
         double M = Nd * (Nd - 1) * base * vmax * chi / Veff + rem[c];
         if (!(M < 1e15)) { /* speeds near the overflow (or not finite): the step fails */
             overflow++;
+            free(heap);
+            continue;
+        }
+        /* dt far above the cell's collision time. The cap counts the candidates of the dilute
+         * limit: chi is bounded (the free volume at 1 % of the cell, Enskog's at 0.99 nu_rcp),
+         * and a few particles over the free volume of a small cell, a Poisson fluctuation of a
+         * valid gas, must not trip it. */
+        if (M * Veff > DSMC_CANDIDATES_PER_PARTICLE * Nd * Vc * chi) {
+            dsmc_verdict mine;
+            verdict_clear(&mine);
+            mine.capped_cells = 1;
+            mine.capped_cell = c;
+            mine.capped_n = (int64_t)N;
+            mine.capped_m = M;
+#pragma omp critical(dsmc_verdict)
+            verdict_merge(verdict, &mine);
             free(heap);
             continue;
         }
@@ -718,6 +866,95 @@ static core_status overflow_error(const dsmc_scene *s, double dt, core_error *er
                      s->steps - 1, s->t, cause);
 }
 
+/* "x 0.075-0.08 m, y 0-0.005 m": where cell c lies. */
+static void cell_where(const dsmc_scene *s, int64_t c, char *buf, size_t size)
+{
+    size_t len = 0;
+    for (int k = 0; k < s->D && len < size; k++) {
+        int64_t i = c % s->def.cells[k];
+        c /= s->def.cells[k];
+        double a = s->def.lo[k] + (double)i * s->h[k];
+        int w = snprintf(buf + len, size - len, "%s%c %.4g-%.4g m", k ? ", " : "", "xyz"[k], a,
+                         a + s->h[k]);
+        len += w > 0 ? (size_t)w : 0;
+    }
+}
+
+/* The verdict on the step just completed (agreed over ranks first: collective when multi) as
+ * the run's error, with the numbers and the likely cause. */
+static core_status verdict_error(const dsmc_scene *s, dsmc_verdict *v, bool multi, double dt,
+                                 core_error *err)
+{
+    if (multi) {
+        void *all = NULL;
+        size_t bytes = 0;
+        if (comm_allgatherv(v, sizeof *v, &all, &bytes, NULL))
+            return core_fail(err, CORE_ERR_NOMEM, "step %ld: out of memory gathering the "
+                             "verdict of the ranks", s->steps - 1);
+        dsmc_verdict m;
+        verdict_clear(&m);
+        for (size_t r = 0; r < bytes / sizeof *v; r++) {
+            dsmc_verdict one;
+            memcpy(&one, (char *)all + r * sizeof *v, sizeof one);
+            verdict_merge(&m, &one);
+        }
+        free(all);
+        *v = m;
+    }
+    const long step = s->steps - 1;
+    char where[160], more[64] = "";
+    if (v->packed_cells) {
+        cell_where(s, v->packed_cell, where, sizeof where);
+        if (v->packed_cells > 1)
+            snprintf(more, sizeof more, " (and %lld more cells)", (long long)v->packed_cells - 1);
+        bool grav = false;
+        for (int k = 0; k < s->D; k++)
+            grav = grav || s->def.gravity[k] != 0;
+        const double e = s->def.restitution, hd = s->h[0] / (2 * s->def.radius);
+        char cause[160];
+        const char *advice = "use a restitution nearer 1, a stronger drive or fewer particles";
+        if (e < 1)
+            snprintf(cause, sizeof cause, "inelastic collapse (restitution %g)%s", e,
+                     grav ? " under gravity" : "");
+        else if (grav)
+            snprintf(cause, sizeof cause, "gravity packing a bed its walls do not keep fluid");
+        else {
+            snprintf(cause, sizeof cause, "particles placed or moved there (an elastic gas "
+                                          "does not cluster)");
+            advice = "spread the particles over a larger region";
+        }
+        return core_fail(err, CORE_ERR_UNSTABLE,
+                         "step %ld (t = %.6g s): the cell at %s holds %lld particles, a "
+                         "packing fraction of %.3g where at most %.0f fit at the packing limit "
+                         "%g: a state past close packing%s (DSMC keeps no distance between "
+                         "particles). Likely cause: %s, in cells (%.3g diameters) wider than a "
+                         "cluster's mean free path; %s",
+                         step, s->t, where, (long long)v->packed_n,
+                         (double)v->packed_n * s->vpart / s->cell_volume, fit_per_cell(s),
+                         s->def.packing_limit, more, cause, hd, advice);
+    }
+    if (v->capped_cells) {
+        cell_where(s, v->capped_cell, where, sizeof where);
+        if (v->capped_cells > 1)
+            snprintf(more, sizeof more, " (and %lld more cells)", (long long)v->capped_cells - 1);
+        return core_fail(err, CORE_ERR_UNSTABLE,
+                         "step %ld (t = %.6g s): the cell at %s holds %lld particles and needs "
+                         "%.3g candidate pairs in one step, over the limit of %d per particle%s: "
+                         "dt = %g s is far above the collision time there, and those cells' "
+                         "collisions were not done; use a smaller dt (dt = 'auto' is a tenth "
+                         "of the mean collision time)",
+                         step, s->t, where, (long long)v->capped_n, v->capped_m,
+                         DSMC_CANDIDATES_PER_PARTICLE, more, dt);
+    }
+    if (v->stranded > 1)
+        snprintf(more, sizeof more, " (and %lld more)", (long long)v->stranded - 1);
+    return core_fail(err, CORE_ERR_UNSTABLE,
+                     "step %ld (t = %.6g s): particle %lld%s crossed the walls of the box more "
+                     "than 4 times in one step of dt = %g s and was put on a wall: dt is far "
+                     "above the flight time across the box; use a smaller dt",
+                     step, s->t, (long long)v->strand_id, more, dt);
+}
+
 core_status dsmc_run(dsmc_scene *s, const dsmc_run_def *run, long *done, core_error *err)
 {
     *done = 0;
@@ -740,6 +977,9 @@ core_status dsmc_run(dsmc_scene *s, const dsmc_run_def *run, long *done, core_er
     bool sorted = true;
     int64_t lost = 0;     /* particles this rank could not store at the last migration */
     int64_t overflow = 0; /* cells of the last step whose collision count overflowed */
+    dsmc_verdict verdict; /* this rank's verdict on the last step */
+    verdict_clear(&verdict);
+    double last_dt = run->dt;
     /* A step gives the same bits on any thread count: the tuner may choose it (core/threads.h)
      * when the step runs threaded. */
     threads_tune_begin(s, s->n >= DSMC_PARALLEL_MIN);
@@ -748,11 +988,16 @@ core_status dsmc_run(dsmc_scene *s, const dsmc_run_def *run, long *done, core_er
             break;
         int intr = interrupt_pending();
         if (multi) {
-            int64_t q[4] = {intr, (int64_t)s->n, lost, overflow};
-            comm_max_i64(q, 4);
+            int64_t q[5] = {intr, (int64_t)s->n, lost, overflow, verdict_any(&verdict)};
+            comm_max_i64(q, 5);
             intr = q[0] != 0;
             if (q[3]) {
                 st = overflow_error(s, run->dt, err);
+                break;
+            }
+            if (q[4]) {
+                st = verdict_error(s, &verdict, true, last_dt, err);
+                verdict_clear(&verdict);
                 break;
             }
             if (q[2]) {
@@ -795,7 +1040,10 @@ core_status dsmc_run(dsmc_scene *s, const dsmc_run_def *run, long *done, core_er
         }
         dsmc_sort_counted(s, bcount);
         sorted = true;
-        collide_totals ct = collide(s, dt);
+        collide_totals ct = collide(s, dt, &verdict);
+        verdict.stranded = ft.stranded;
+        verdict.strand_id = ft.strand_id == LONG_MAX ? INT64_MAX : ft.strand_id;
+        last_dt = dt;
         s->t += dt;
         s->steps++;
         ++*done;
@@ -813,6 +1061,10 @@ core_status dsmc_run(dsmc_scene *s, const dsmc_run_def *run, long *done, core_er
         cnt[4] += ct.raised;
         cnt[5] += ct.overpacked;
         threads_tune_step();
+        if (!multi && verdict_any(&verdict)) { /* several ranks: at the next reduction */
+            st = verdict_error(s, &verdict, false, dt, err);
+            break;
+        }
     }
     threads_tune_end();
     /* between runs the arrays are in cell then identity order, for everything that reads them
@@ -825,15 +1077,17 @@ core_status dsmc_run(dsmc_scene *s, const dsmc_run_def *run, long *done, core_er
     /* summed: CPU of all ranks, bytes and messages they sent; the slowest: wall time, time in
      * communication, particles held (the imbalance) */
     double sum[3] = {cpu, cs1.bytes - cs0.bytes, cs1.messages - cs0.messages};
-    double most[5] = {wall, cs1.seconds - cs0.seconds, (double)s->n, (double)lost,
-                      (double)overflow};
+    double most[6] = {wall, cs1.seconds - cs0.seconds, (double)s->n, (double)lost,
+                      (double)overflow, (double)(multi && verdict_any(&verdict))};
     if (s->distributed) {
         comm_sum_i64(cnt, 6);
         comm_sum_double(sum, 3);
-        comm_max_double(most, 5);
+        comm_max_double(most, 6);
     }
     if (s->distributed && st == CORE_OK && most[4] > 0) /* at the last step */
         st = overflow_error(s, run->dt, err);
+    if (s->distributed && st == CORE_OK && most[5] > 0)
+        st = verdict_error(s, &verdict, true, last_dt, err);
     if (most[3] > 0 && st == CORE_OK)
         st = core_fail(err, CORE_ERR_NOMEM,
                        "out of memory on a rank storing %.0f particles that migrated to it; "

@@ -437,7 +437,7 @@ static core_status advance(void *ctx, long n, struct progress *p, long *done, co
     return dsmc_run(c->s, c->run, done, err);
 }
 
-static const char *const RUN_FIELDS[] = {"steps",   "time",     "dt",   "every",
+static const char *const RUN_FIELDS[] = {"steps",   "time",     "dt",   "force", "every",
                                          "on_step", "progress", "warn", NULL};
 
 static int l_run(lua_State *L)
@@ -463,8 +463,21 @@ static int l_run(lua_State *L)
                                  "give dt");
     } else {
         run.dt = bind_field_number(L, 2, "run", "dt", 0, BIND_POSITIVE);
+        /* The paper's condition (iii) as a limit, as DEM's and MPM's stability limits: beyond
+         * the mean collision time the candidates of Eq. 1 grow with dt (work without physics:
+         * pairs meet several times in a step) and the result drifts (docs/dsmc.md). */
+        if (run.dt > v.collision_time && !bind_field_boolean(L, 2, "run", "force", 0)) {
+            char msg[400]; /* lua_pushfstring knows no %g */
+            snprintf(msg, sizeof msg,
+                     "run: dt = %g s exceeds the mean collision time 1/omega = %.3g s (the "
+                     "paper's condition iii, at the gas's density and temperature); use dt = "
+                     "\"auto\" (%.3g s), a smaller dt, or force = true",
+                     run.dt, v.collision_time, 0.1 * v.collision_time);
+            return luaL_error(L, "%s", msg);
+        }
     }
     lua_pop(L, 1);
+    (void)bind_field_boolean(L, 2, "run", "force", 0); /* checked whatever dt is */
     long steps;
     double time;
     int by_steps = bind_steps_or_time(L, 2, "run", &steps, &time);
@@ -833,15 +846,20 @@ void bind_open_dsmc(lua_State *L)
          "sin(2 pi f t + phase)), velocity 2 pi f A cos(2 pi f t + phase). velocity: a constant "
          "tangential wall velocity (the normal component is ignored)."},
         {"run", l_run,
-         "s:run{ steps = N | time = T, dt = 'auto', every =, on_step = function(s) end, progress "
-         "=, warn = true }",
+         "s:run{ steps = N | time = T, dt = 'auto', force = false, every =, on_step = "
+         "function(s) end, progress =, warn = true }",
          "Advances the gas: free flight with gravity and walls, sorting into cells, collisions "
          "of Eq. 1 with v_max = twice the largest speed about the cell's mean velocity (raised "
          "when a pair exceeds it), a random impact parameter and restitution e. dt = 'auto' is "
-         "a tenth of the mean collision time. Before running, the paper's validity conditions "
+         "a tenth of the mean collision time; a dt above the mean collision time is refused "
+         "unless force = true. Before running, the paper's validity conditions "
          "(i) collisional regime, (ii) mean free path larger than the cell, (iii) mean collision "
          "time larger than dt are checked and each violation is warned with its numbers on "
-         "stderr (warn = false: silent; s:measure('validity') returns them). on_step runs every "
+         "stderr (warn = false: silent; s:measure('validity') returns them). The run stops with "
+         "an error naming the step and the cell when a cell holds more than three times the "
+         "particles that fit in it at the packing limit (a state past close packing), when a "
+         "cell would need more than 100 candidate pairs per particle in one step, or when a "
+         "particle crosses the box's walls more than 4 times in one step. on_step runs every "
          "`every` steps; returning false stops. Returns {steps, time, dt, stopped}. Progress on stderr: "
          "nil shows it once the run has taken 2 s, true at once, false never (--quiet: never). "
          "From on_step, calls that would invalidate the run (a nested run, close, ...) are "

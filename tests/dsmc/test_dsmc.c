@@ -233,6 +233,134 @@ static void test_walls(void **state)
     dsmc_destroy(s);
 }
 
+/* A 2D unit box walled in x (periodic in y), 4 x 4 cells, R = 1 mm, e = 1, no gravity, with
+ * particles at (x[i], y[i]) moving at (vx[i], vy[i]). */
+static dsmc_scene *box_with(size_t n, const double *x, const double *y, const double *vx,
+                            const double *vy)
+{
+    dsmc_scene_def d = dsmc_default_scene_def();
+    d.periodic[0] = false;
+    d.cells[0] = d.cells[1] = 4;
+    dsmc_scene *s;
+    core_error err;
+    assert_int_equal(dsmc_create(&d, &s, &err), CORE_OK);
+    assert_int_equal(dsmc_add(s, n, x, y, NULL, vx, vy, NULL, &err), CORE_OK);
+    return s;
+}
+
+/* Steps far longer than a flight across the box: mirror walls (fixed, specular, e_w = 1) fold
+ * the flight in closed form, any number of crossings at the cost of one; other walls refuse the
+ * step, naming the particle. */
+static void test_long_flight(void **state)
+{
+    (void)state;
+    /* 0.3 + 10.25 = 10.55 unfolds to 0.55 after 10 crossings, moving on; 0.7 - 3.6 = -2.9 to
+     * 0.9 after 3, turned round. Rows 0 and 3: they never share a cell. */
+    const double x[2] = {0.3, 0.7}, y[2] = {0.1, 0.9}, vx[2] = {10.25, -3.6}, vy[2] = {0, 0};
+    dsmc_scene *s = box_with(2, x, y, vx, vy);
+    run(s, 1, 1.0);
+    dsmc_particles p;
+    dsmc_get_particles(s, &p);
+    for (size_t i = 0; i < 2; i++) {
+        const double want_x = p.id[i] == 0 ? 0.55 : 0.9, want_v = p.id[i] == 0 ? 10.25 : 3.6;
+        assert_true(fabs(p.x[0][i] - want_x) < 1e-12);
+        assert_true(fabs(p.v[0][i] - want_v) < 1e-12);
+    }
+    dsmc_stats st;
+    dsmc_get_stats(s, &st);
+    assert_true(st.wall_hits == 13);
+    /* a million crossings in one step: the same cost, still inside */
+    run(s, 1, 1e5);
+    dsmc_get_particles(s, &p);
+    for (size_t i = 0; i < 2; i++)
+        assert_true(p.x[0][i] >= 0 && p.x[0][i] <= 1);
+    dsmc_destroy(s);
+
+    /* an inelastic wall has no fold: the step stops the run, naming particle 0 (particle 1
+     * is back inside after 2 reflections) */
+    const double vx2[2] = {40.25, -3.6};
+    s = box_with(2, x, y, vx2, vy);
+    dsmc_wall_def w = dsmc_default_wall_def();
+    w.restitution = 0.5;
+    core_error err;
+    assert_int_equal(dsmc_set_wall(s, DSMC_XHI, &w, &err), CORE_OK);
+    dsmc_run_def r = dsmc_default_run_def();
+    r.steps = 3;
+    r.dt = 1.0;
+    long done;
+    assert_int_equal(dsmc_run(s, &r, &done, &err), CORE_ERR_UNSTABLE);
+    assert_int_equal(done, 1);
+    printf("  %s\n", err.msg);
+    assert_non_null(strstr(err.msg, "step 0 (t = 1 s): particle 0 crossed the walls of the box "
+                                    "more than 4 times in one step of dt = 1 s"));
+    dsmc_get_particles(s, &p);
+    for (size_t i = 0; i < 2; i++)
+        assert_true(p.x[0][i] >= 0 && p.x[0][i] <= 1);
+    dsmc_destroy(s);
+}
+
+/* A step far above the collision time is refused cell by cell before its candidates are drawn
+ * (at most 100 per particle): the run stops at once, the velocities of those cells untouched. */
+static void test_candidate_cap(void **state)
+{
+    (void)state;
+    dsmc_scene *s = gas(2, 2000, 0.05, 20, 1.0, -1.0);
+    dsmc_moments m0, m;
+    dsmc_measure_moments(s, &m0);
+    dsmc_run_def r = dsmc_default_run_def();
+    r.steps = 3;
+    r.dt = 1e6;
+    long done;
+    core_error err;
+    assert_int_equal(dsmc_run(s, &r, &done, &err), CORE_ERR_UNSTABLE);
+    assert_int_equal(done, 1);
+    printf("  %s\n", err.msg);
+    assert_non_null(strstr(err.msg, "over the limit of 100 per particle"));
+    assert_non_null(strstr(err.msg, "dt = 1e+06 s is far above the collision time there"));
+    dsmc_stats st;
+    dsmc_get_stats(s, &st);
+    assert_true(st.attempts == 0); /* every cell was over: nothing drawn */
+    dsmc_measure_moments(s, &m);
+    assert_true(fabs(m.kinetic_energy / m0.kinetic_energy - 1) < 1e-12); /* order of the sum */
+    dsmc_destroy(s);
+}
+
+/* A cell past close packing stops the run after the step: 60 particles at rest in one 1 cm cell
+ * of R = 1 mm disks, where 0.82 (1.2 cm)^2 / (pi R^2) = 37 fit. */
+static void test_past_close_packing(void **state)
+{
+    (void)state;
+    dsmc_scene_def d = dsmc_default_scene_def();
+    d.hi[0] = d.hi[1] = 0.1;
+    dsmc_scene *s;
+    core_error err;
+    assert_int_equal(dsmc_create(&d, &s, &err), CORE_OK);
+    double x[60], y[60], v[60] = {0};
+    for (int i = 0; i < 60; i++) {
+        x[i] = 0.0405 + 0.0001 * (i % 10);
+        y[i] = 0.0705 + 0.0001 * (i / 10);
+    }
+    assert_int_equal(dsmc_add(s, 60, x, y, NULL, v, v, NULL, &err), CORE_OK);
+    dsmc_run_def r = dsmc_default_run_def();
+    r.steps = 5;
+    r.dt = 1e-3;
+    long done;
+    assert_int_equal(dsmc_run(s, &r, &done, &err), CORE_ERR_UNSTABLE);
+    assert_int_equal(done, 1);
+    printf("  %s\n", err.msg);
+    assert_non_null(strstr(err.msg, "step 0 (t = 0.001 s): the cell at x 0.04-0.05 m, y 0.07-0.08 "
+                                    "m holds 60 particles, a packing fraction of 1.88 where at "
+                                    "most 37 fit at the packing limit 0.82: a state past close "
+                                    "packing"));
+    assert_non_null(strstr(err.msg, "particles placed or moved there"));
+    dsmc_destroy(s);
+    /* 37 (what fits) runs on */
+    assert_int_equal(dsmc_create(&d, &s, &err), CORE_OK);
+    assert_int_equal(dsmc_add(s, 37, x, y, NULL, v, v, NULL, &err), CORE_OK);
+    run(s, 5, 1e-3);
+    dsmc_destroy(s);
+}
+
 /* 3D: a closed box with specular walls on every side at e = 1 keeps the energy and the
  * particles. */
 static void test_walls_3d(void **state)
@@ -425,7 +553,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_elastic_2d), cmocka_unit_test(test_elastic_3d),
         cmocka_unit_test(test_haff_count), cmocka_unit_test(test_walls),
-        cmocka_unit_test(test_walls_3d), cmocka_unit_test(test_threads), cmocka_unit_test(test_layout),    cmocka_unit_test(test_bad_input),
+        cmocka_unit_test(test_walls_3d), cmocka_unit_test(test_long_flight),
+        cmocka_unit_test(test_candidate_cap), cmocka_unit_test(test_past_close_packing), cmocka_unit_test(test_threads), cmocka_unit_test(test_layout),    cmocka_unit_test(test_bad_input),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -26,8 +26,22 @@ check.eq(s2:particles().x[47], s1:particles().x[47], "random: reproducible from 
 check.is_true(rsa(5):particles().x[47] ~= s1:particles().x[47], "random: another seed, another packing")
 check.errors(function()
   local s = dem.scene{ dim = 2, box = { { 0, 0 }, { 0.005, 0.005 } } }
+  grainlab.pack.random(s, { n = 4, radius = 1e-3, max_tries = 4 })
+end, "grainlab.pack.random: placed 1 of 4 particles in 4 tries", "random: out of tries says how many it placed")
+-- more than random addition can ever place: refused at entry with the numbers (asked, limit, what fits)
+check.errors(function()
+  local s = dem.scene{ dim = 2, box = { { 0, 0 }, { 0.005, 0.005 } } }
   grainlab.pack.random(s, { n = 500, radius = 1e-3, max_tries = 2000 })
-end, "grainlab.pack.random: placed", "random: a region too full says how many it placed")
+end, "bad field 'n' in argument #2 to 'grainlab.pack.random' (at most 4 particles (random addition saturates at " ..
+     "a packing fraction of 0.547 of the region; 500 of mean area 3.14e-06 m^2 ask for 62.8;",
+  "random: a region too full is refused at entry")
+do -- the particles already in the region count
+  local s = dem.scene{ dim = 2, box = { { 0, 0 }, { 0.02, 0.02 } } }
+  grainlab.pack.random(s, { n = 30, radius = 1e-3, seed = 2 })
+  check.errors(function() grainlab.pack.random(s, { n = 50, radius = 1e-3, seed = 3 }) end,
+    "(at most 39 particles (random addition saturates at a packing fraction of 0.547 of the region; 50 of mean " ..
+    "area 3.14e-06 m^2 with the 0.236 already there ask for 0.628;", "random: counts what is there")
+end
 check.errors(function() grainlab.pack.random(dem.scene{ dim = 2, box = { { 0, 0 }, { 1, 1 } } }, { n = 0 }) end,
   "bad field 'n' in argument #2 to 'grainlab.pack.random' (integer in [1, 10000000] expected, got 0)", "random: n")
 check.errors(function() grainlab.pack.random(dem.scene{ dim = 2, box = { { 0, 0 }, { 1, 1 } } }, { n = 5, radus = 1 }) end,

@@ -65,19 +65,24 @@ local pc = 0
 for i = 1, 7 do pc = pc + p.count[i] end
 check.eq(pc, N, "profile counts add up")
 
--- A vibrating bottom wall keeps an inelastic gas under gravity hot; a fixed one lets it cool.
+-- A vibrating bottom wall keeps an inelastic gas under gravity hot; a fixed one lets it cool,
+-- and then collapse: DSMC keeps no distance between particles, and the run stops once a cell
+-- holds more than fit in it (here 38 where 37 fit: 5 mm cells, R = 0.5 mm, packing limit 0.82).
 local function bed(amplitude)
   local b = dsmc.scene{ dim = 2, size = { 0.05, 0.1 }, cells = { 10, 20 }, periodic = { true, false },
-                        gravity = { 0, -9.81 }, radius = 5e-4, restitution = 0.8, seed = 1 }
-  b:fill{ n = 300, temperature = b:info().mass * 0.05, region = { { 0, 0 }, { 0.05, 0.03 } } }
+                        gravity = { 0, -9.81 }, radius = 5e-4, restitution = 0.9, seed = 1 }
+  b:fill{ n = 100, temperature = b:info().mass * 0.05, region = { { 0, 0 }, { 0.05, 0.03 } } }
   if amplitude > 0 then b:wall{ side = "bottom", amplitude = amplitude, frequency = 50 } end
-  b:run{ time = 0.5, dt = 2e-4, warn = false }
-  return b:measure("temperature").t_over_m, b:measure("stats").wall_hits
+  b:run{ time = 0.3, dt = 2e-4, warn = false }
+  return b:measure("temperature").t_over_m, b:measure("stats").wall_hits, b
 end
 local hot, hits = bed(1e-3)
-local cold = bed(0)
+local cold, _, cb = bed(0)
 check.is_true(hits > 0, "particles hit the bottom wall")
 check.gt(hot, 10 * cold, "vibration feeds energy in")
+check.errors(function() cb:run{ time = 0.5, dt = 2e-4, force = true, warn = false } end,
+  "holds 38 particles, a packing fraction of 1.19 where at most 37 fit at the packing limit 0.82: " ..
+  "a state past close packing", "a collapsing bed stops the run past close packing")
 
 -- validity: cells larger than the mean free path are reported with their numbers
 local v = s:measure("validity", { dt = dt })
@@ -92,9 +97,9 @@ check.is_true(not vd.cells_ok and not vd.dt_ok, "a dense gas with coarse cells a
 local exe = arg[-1]
 for i = -2, -10, -1 do if arg[i] then exe = arg[i] else break end end
 local chunk = "local d = dsmc.scene{ dim = 2, size = { 0.1, 0.1 }, cells = { 5, 5 }, radius = 1e-3 }; " ..
-              "d:fill{ n = 500, temperature = 1e-6 }; d:run{ steps = 1, dt = 1 }; " ..
+              "d:fill{ n = 500, temperature = 1e-6 }; pcall(d.run, d, { steps = 1, dt = 1, force = true }); " ..
               "local q = dsmc.scene{ dim = 2, size = { 0.1, 0.1 }, cells = { 5, 5 }, radius = 1e-3 }; " ..
-              "q:fill{ n = 500, temperature = 1e-6 }; q:run{ steps = 1, dt = 1, warn = false }"
+              "q:fill{ n = 500, temperature = 1e-6 }; q:run{ steps = 1, dt = 1, force = true, warn = false }"
 local pipe = io.popen(exe .. " -e '" .. chunk .. "' 2>&1")
 local out = pipe:read("a")
 pipe:close()
@@ -102,4 +107,7 @@ check.contains(out, "dsmc run: warning: cells larger than the mean free path (co
 check.contains(out, "dsmc run: warning: time step above the mean collision time (condition iii): dt 1 s >= 1/omega = ", "warning iii")
 local _, count = out:gsub("%(condition ii%)", "")
 check.eq(count, 1, "warn = false silences the warnings")
+check.contains(out, "over the limit of 100 per particle", "the second run ran (and stopped at the cap)")
+local _, stops = out:gsub("over the limit of 100 per particle", "")
+check.eq(stops, 1, "only the second run's error reaches stderr")
 check.done()

@@ -76,9 +76,9 @@ local calls = {
   ["dsmc.scene:run"] = {
     setup = scene, self = self, opts = 1,
     args = function() return { { steps = 2, dt = 1e-4, every = 1, on_step = function() end,
-                                 progress = false, warn = false } } end,
+                                 progress = false, warn = false, force = false } } end,
     accept = { steps = { "zero" }, time = OPT, dt = OPT, every = OPT, on_step = { "nil", "function" },
-               progress = BOOL, warn = BOOL },
+               progress = BOOL, warn = BOOL, force = BOOL },
   },
   ["dsmc.scene:measure"] = {
     -- the modes without options: an empty table (or none), nothing else; the mode name fuzzed once

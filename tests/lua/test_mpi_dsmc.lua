@@ -127,7 +127,7 @@ do
                         restitution = 0.95, periodic = false, seed = 9 }
   s:fill{ n = 1500, temperature = s:info().mass * 1.0, velocity = { 1, 0.7 },
           region = { { 0, 0 }, { 0.005, 0.005 } }, seed = 8 }
-  s:run{ steps = 120, dt = 2e-4, warn = false }
+  s:run{ steps = 120, dt = 2e-4, force = true, warn = false } -- 10 collision times a step
   check_ids(s, 1500, "D")
   dump("D", s)
 end
@@ -142,11 +142,32 @@ do
                         periodic = false, gravity = { 0, -1e100 }, seed = 9 }
   s:fill{ n = 400, temperature = s:info().mass * 1.0, seed = 8 }
   s:add{ x = { 0.01, 0.011 }, y = { 0.001, 0.001 }, vx = { 0, 0 }, vy = { 1e100, -1e100 } }
-  local ok, msg = pcall(s.run, s, { steps = 3, dt = 1e100, warn = false })
+  local ok, msg = pcall(s.run, s, { steps = 3, dt = 1e100, force = true, warn = false })
   check.is_true(not ok and tostring(msg):find("overflowed", 1, true) ~= nil,
                 "E: the overflow is reported: " .. tostring(msg))
   put("E %s", tostring(msg))
   check_ids(s, 402, "E")
+end
+
+-- F: an inelastic bed on a fixed floor collapses: the run stops past close packing with the same
+-- cell, count and step on every rank count (the ranks' verdicts agreed at the next reduction),
+-- and so does a step far above the collision time (the candidate cap), here at the run's end
+do
+  local s = dsmc.scene{ dim = 2, size = { 0.05, 0.1 }, cells = { 10, 20 }, periodic = { true, false },
+                        gravity = { 0, -9.81 }, radius = 5e-4, restitution = 0.9, seed = 1 }
+  s:fill{ n = 100, temperature = s:info().mass * 0.05, region = { { 0, 0 }, { 0.05, 0.03 } } }
+  local ok, msg = pcall(s.run, s, { time = 1, dt = 2e-4, warn = false })
+  check.is_true(not ok and tostring(msg):find("past close packing", 1, true) ~= nil,
+                "F: the collapse is reported: " .. tostring(msg))
+  put("F %s", tostring(msg))
+  check_ids(s, 100, "F")
+  local g = dsmc.scene{ dim = 2, size = { 0.1, 0.1 }, cells = { 10, 10 }, radius = 1e-3, seed = 2 }
+  g:fill{ n = 500, temperature = g:info().mass * 1.0, seed = 5 }
+  ok, msg = pcall(g.run, g, { steps = 1, dt = 1e6, force = true, warn = false })
+  check.is_true(not ok and tostring(msg):find("over the limit of 100 per particle", 1, true) ~= nil,
+                "F: the candidate cap is reported: " .. tostring(msg))
+  put("F %s", tostring(msg))
+  check_ids(g, 500, "F cap")
 end
 
 local text = table.concat(out, "\n") .. "\n"
