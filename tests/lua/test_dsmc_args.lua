@@ -104,12 +104,12 @@ check.contains(grainlab.doc_of(dsmc.scene).usage, "dsmc.scene{", "help for dsmc.
 do
   local g = dsmc.scene{ dim = 2, size = { 1, 1 }, cells = { 4, 4 }, radius = 1e-3, gravity = { 0, -1e100 } }
   g:fill{ n = 10, temperature = g:info().mass, seed = 1 }
-  local msg = check.errors(function() g:run{ steps = 3, dt = 1e100, warn = false } end, "overflowed", "gravity x dt out of range")
+  local msg = check.errors(function() g:run{ steps = 3, dt = 1e100, warn = false, force = true } end, "overflowed", "gravity x dt out of range")
   check.contains(msg, "likely cause: the time step dt = 1e+100 s is out of range for the gravity: one step moves a particle |g| dt^2 / 2 = 5e+299 m against a box of 1 m",
                  "gravity x dt: the numbers")
   local h = dsmc.scene{ dim = 2, size = { 1, 1 }, cells = { 4, 4 }, radius = 1e-3 }
   h:fill{ n = 10, temperature = h:info().mass * 1e90, seed = 1 }
-  msg = check.errors(function() h:run{ steps = 3, dt = 1e100, warn = false } end, "overflowed", "speeds out of range")
+  msg = check.errors(function() h:run{ steps = 3, dt = 1e100, warn = false, force = true } end, "overflowed", "speeds out of range")
   check.contains(msg, "likely cause: the time step dt = 1e+100 s or the speeds given are out of range", "speeds: the cause")
 end
 check.done()
