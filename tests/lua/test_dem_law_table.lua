@@ -233,7 +233,8 @@ do
   local forged = F.put(F.put(bytes, at - 1, "dampinx\0"), at - 1 + 16, string.pack("=I4", 0))
   F.write(path("forged.ckpt"), F.reseal(forged))
   check.errors(function() dem.load(path("forged.ckpt")) end,
-    "'" .. path("forged.ckpt") .. "' is incomplete: section 'damping'", "a file without the solved coefficients")
+    "'" .. path("forged.ckpt") .. "' is corrupt (section 'dampinx', number 7 of the file, is not where its " ..
+    "writer listed it)", "a file without the solved coefficients")
   check.is_true(dem.load(path("good.ckpt")) ~= nil, "the unforged file loads")
   -- a law with a closed form (the unclipped linear spring) writes no section
   local u = pile{ normal = "linear", stiffness = 2e3, damping = "viscous", clip = false }
