@@ -748,3 +748,12 @@ core_status ckpt_peek_engine(const char *path, char out[CKPT_ENGINE_MAX + 1], co
     ckpt_reader_close(r);
     return CORE_OK;
 }
+
+core_status ckpt_blame_file(core_error *err, core_status st, const char *path, const char *kind)
+{
+    if (st == CORE_OK || st == CORE_ERR_NOMEM || !err)
+        return st;
+    char why[sizeof err->msg];
+    snprintf(why, sizeof why, "%s", err->msg);
+    return core_fail(err, CORE_ERR_ARG, "'%s' is a corrupt %s checkpoint: %s", path, kind, why);
+}

@@ -95,6 +95,10 @@ typedef struct ckpt_section {
 /* Reads the whole file and verifies magic, byte order, trailer, size, checksum, format version,
  * the engine (when engine is not NULL) and every section's bounds. Every refusal names the path
  * and the problem: "'f.ckpt' is an mpm checkpoint, not a dem one". */
+/* An engine's refusal of values read from PATH (its create or add call made for them), said as
+ * the file's: "'PATH' is a corrupt KIND checkpoint: <the engine's message>". CORE_OK and
+ * out-of-memory pass through unchanged. */
+core_status ckpt_blame_file(core_error *err, core_status st, const char *path, const char *kind);
 core_status ckpt_reader_open(ckpt_reader **r, const char *path, const char *engine,
                              core_error *err);
 const char *ckpt_reader_path(const ckpt_reader *r);

@@ -127,11 +127,7 @@ static core_status corrupt(const reader *rd, const char *what)
  * the file's: "'PATH' is a corrupt dsmc checkpoint: radius must be positive, got -1". */
 static core_status named(const reader *rd, core_status st)
 {
-    if (st == CORE_OK || st == CORE_ERR_NOMEM || !rd->err)
-        return st;
-    char why[sizeof rd->err->msg];
-    snprintf(why, sizeof why, "%s", rd->err->msg);
-    return corrupt(rd, why);
+    return ckpt_blame_file(rd->err, st, rd->path, "dsmc");
 }
 
 /* The grid against the file, before the grid is sized by the definition's cells: dsmc.cells
