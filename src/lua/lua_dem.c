@@ -965,6 +965,40 @@ static const char *const RUN_FIELDS[] = {"steps",      "time",     "dt", "force"
                                          "integrator", "m",        "n",  "q",     "every",
                                          "on_step",    "progress", NULL};
 
+/* Once per scene, a run whose contacts take no damping (damping = "none", the default) while a
+ * material asks a restitution below 1 says so: the contacts are elastic, and the material's e
+ * would take effect only with damping = "viscous" or "brilliantov". --quiet silences it. */
+static void undamped_restitution_notice(lua_State *L, const dem_scene *s, int scene)
+{
+    if (dem_contact(s)->damping != DEM_DAMPING_NONE)
+        return;
+    int worst = -1, nmat = dem_material_count(s);
+    for (int k = 0; k < nmat; k++) {
+        const dem_material *m = dem_material_get(s, k);
+        if (m->restitution < 1 && (worst < 0 || m->restitution < dem_material_get(s, worst)->restitution))
+            worst = k;
+    }
+    if (worst < 0)
+        return;
+    lua_getiuservalue(L, scene, 1);
+    int said = lua_getfield(L, -1, "undamped_noticed") != LUA_TNIL;
+    lua_pop(L, 1);
+    if (!said) {
+        lua_pushboolean(L, 1);
+        lua_setfield(L, -2, "undamped_noticed");
+    }
+    lua_pop(L, 1);
+    if (said || progress_default_style() == PROGRESS_QUIET)
+        return;
+    fprintf(stderr,
+            "grainlab: warning: run: the contacts have no damping (damping = \"none\"), so every "
+            "collision is elastic (e = 1), but material %d asks restitution %g; call "
+            "s:contact{ damping = \"viscous\" } (or \"brilliantov\" with hertz) for it to take "
+            "effect\n",
+            worst + 1, dem_material_get(s, worst)->restitution);
+    fflush(stderr);
+}
+
 static int l_run(lua_State *L)
 {
     dem_scene *s = check_scene_local(L, 1); /* a run continues a decomposed scene as it is */
@@ -1007,6 +1041,7 @@ static int l_run(lua_State *L)
         }
     }
     lua_pop(L, 1);
+    undamped_restitution_notice(L, s, 1);
     run.dt_limit = ts.limit;
     run.dt_speed = ts.impact_velocity;
     long steps;

@@ -9,7 +9,7 @@ end
 if engine == "dem" then
   local s = dem.scene{ box = { { 0, 0 }, { 0.01, 0.01 } }, gravity = { 0, -9.81 } }
   s:add_wall{ point = { 0, 0 }, normal = { 0, 1 } }
-  local quartz = grainlab.material{ density = 2650, young = 30e9, friction = 0.45, restitution = 0.5 }
+  local quartz = grainlab.material{ density = 2650, young = 30e9, friction = 0.45 }
   for i = 1, 4 do s:add_disk{ pos = { 0.002 * i, 0.002 }, radius = 4e-4, material = quartz } end
   s:run(opts)
 elseif engine == "mpm" then

@@ -129,6 +129,14 @@ lines "$err" 2 default-material
 run "$G" --quiet default_material.lua </dev/null
 expect_rc 0 default-material-quiet; [ -z "$err" ] && ok || bad "default-material-quiet: printed"
 
+# --- a material's restitution under contacts without damping is named once, as elastic ---
+run "$G" undamped.lua </dev/null
+expect_rc 0 undamped; has "$out" "e	1.0000" undamped
+has "$err" "grainlab: warning: run: the contacts have no damping (damping = \"none\"), so every collision is elastic (e = 1), but material 1 asks restitution 0.5" undamped
+lines "$err" 1 undamped
+run "$G" --quiet undamped.lua </dev/null
+expect_rc 0 undamped-quiet; [ -z "$err" ] && ok || bad "undamped-quiet: printed"
+
 # --- Ctrl-C (SIGINT) stops a running script with an error naming it ---
 # The signals are sent once the script says it runs: a background job of this non-interactive
 # shell starts with SIGINT ignored until grainlab's handler is in place, so a signal sent at a
