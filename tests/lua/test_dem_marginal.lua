@@ -1,5 +1,5 @@
 -- Angle of marginal stability (Herrmann Sec. 3), small and fast: the procedure of
--- scripts/marginal_stability.lua (scripts/heap_box.lua) with 200 disks. The closed box is tilted
+-- scripts/marginal_stability.lua (scripts/lib/heap_box.lua) with 200 disks. The closed box is tilted
 -- in steps until at least a tenth of the grains move by more than a diameter in one hold; the
 -- search then restarts from the last stable state, loaded from a checkpoint, in finer steps.
 -- Checks: mu = 0.5 holds its surface above the angle of repose of the same packing (the wall
@@ -8,7 +8,7 @@
 -- steps.
 local check = grainlab.check
 grainlab.threads(1) -- 200 particles: threads only add synchronisation
-local heap_box = dofile((arg[0]:match("^(.*)/tests/lua/") or ".") .. "/scripts/heap_box.lua")
+local heap_box = dofile((arg[0]:match("^(.*)/tests/lua/") or ".") .. "/scripts/lib/heap_box.lua")
 local ckpt = os.tmpname()
 
 local function marginal(mu)

@@ -1,5 +1,5 @@
 -- Angle of repose (Herrmann Sec. 3), small and fast: the procedure of scripts/repose.lua (its
--- pile in a box, scripts/heap_box.lua; see the script's header for the reasoning) with 250 disks
+-- pile in a box, scripts/lib/heap_box.lua; see the script's header for the reasoning) with 250 disks
 -- and mu = 0.1 and 0.8. Disks of radius 0.5..1 mm are
 -- deposited in a box [0, W] on a rough floor of fixed disks, with a catch basin below and beside
 -- it; the gate wall at x = W is removed, the grains that fall out land in the basin, and the
@@ -13,7 +13,7 @@
 local check = grainlab.check
 grainlab.threads(1) -- 250 particles: threads only add synchronisation
 
-local heap_box = dofile((arg[0]:match("^(.*)/tests/lua/") or ".") .. "/scripts/heap_box.lua")
+local heap_box = dofile((arg[0]:match("^(.*)/tests/lua/") or ".") .. "/scripts/lib/heap_box.lua")
 local n, seed = 250, 1
 
 local function repose(mu)

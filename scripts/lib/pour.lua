@@ -3,7 +3,7 @@
 -- up on `n` grains (at most 2 s), an error if more than 1 % found no place, then 0.3 s with a
 -- background drag of 20 /s and 0.2 s without. Returns s:flow() after the filling.
 -- Shared by silo.lua and brazil_nut.lua:
---   local pour = dofile((arg[0]:match("^(.*)/") or ".") .. "/pour.lua")
+--   local pour = dofile((arg[0]:match("^(.*)/") or ".") .. "/lib/pour.lua")
 --   pour(s, n, advance, "silo")
 return function(s, n, advance, who)
   local poured = 0

@@ -1,7 +1,7 @@
 -- The pile in a box of Herrmann & Mueller Sec. 3, shared by scripts/repose.lua (the angle of
 -- repose: the gate removed) and scripts/marginal_stability.lua (the angle of marginal stability:
 -- the box tilted), and their tests. Not a scenario; load it with
---   local heap_box = dofile((arg[0]:match("^(.*)/") or ".") .. "/heap_box.lua")
+--   local heap_box = dofile((arg[0]:match("^(.*)/") or ".") .. "/lib/heap_box.lua")
 --
 -- heap_box.new{ n, mu, seed, young, aspect, ... } builds and settles the packing (the procedure
 -- and its reasons are in scripts/repose.lua's header; geometry_only = true: the sizes only):
