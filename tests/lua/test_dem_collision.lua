@@ -2,101 +2,27 @@
 -- derivations): the linear spring-dashpot against its closed form in 2D and 3D, the elastic Hertz
 -- contact time, Brilliantov restitution falling with speed and matching an RK4 integration of
 -- m_eff d'' = -max(0, K d^{3/2} + T K d^{1/2} d'), and the automatic dt resolving the contact.
--- Contact start/end: first and last steps with a contact, interpolated to zero overlap.
+-- The grains, the measured collision and the RK4 reference are the script's own
+-- (scripts/lib/collision.lua).
 local check = grainlab.check
 grainlab.threads(1) -- two grains: threads would only add synchronisation
 
+local collision = dofile("../../scripts/lib/collision.lua")
 local pi = math.pi
-local r1, r2 = 0.5e-3, 0.7e-3
-local quartz = { density = 2650, young = 30e9, poisson = 0.3 }
-local glass = { density = 2500, young = 63e9, poisson = 0.22 }
+local quartz, glass, m_eff_of = collision.quartz, collision.glass, collision.m_eff_of
 local function with(m, extra)
   local t = {}
-  for key, v in pairs(m) do t[key] = v end
-  for key, v in pairs(extra or {}) do t[key] = v end
+  for _, src in ipairs{ m, extra } do for key, v in pairs(src) do t[key] = v end end
   return t
 end
-local function mass(m, r) return m.density * 4 / 3 * pi * r ^ 3 end
-local function m_eff_of(a, b) local m1, m2 = mass(a, r1), mass(b, r2); return m1 * m2 / (m1 + m2) end
-local function hertz_K(a, b)
-  local es = 1 / ((1 - a.poisson ^ 2) / a.young + (1 - b.poisson ^ 2) / b.young)
-  return 4 / 3 * es * math.sqrt(r1 * r2 / (r1 + r2))
-end
-local DIRS = { [2] = { 0.6, 0.8 }, [3] = { 1 / 3, 2 / 3, 2 / 3 } }
 
--- One collision along DIRS[dim], centre of mass at rest (or grain 1 at rest with o.target),
--- touching 0.3 into the third step. Returns t_c, e, steps in contact, dt.
-local function build(o, gap)
-  local D, n = o.dim, DIRS[o.dim]
-  local m1, m2 = mass(o.mat1, r1), mass(o.mat2, r2)
-  local f1 = o.target and 0 or m2 / (m1 + m2)
-  local lo, hi, p1, p2, v1, v2 = {}, {}, {}, {}, {}, {}
-  for d = 1, D do
-    lo[d], hi[d] = -0.01, 0.01
-    p1[d], p2[d] = -n[d] * (r1 + gap / 2), n[d] * (r2 + gap / 2)
-    v1[d], v2[d] = n[d] * o.v * f1, -n[d] * o.v * (1 - f1)
-  end
-  local s = dem.scene{ dim = D, box = { lo, hi } }
-  local add = D == 2 and s.add_disk or s.add_sphere
-  add(s, { pos = p1, radius = r1, material = grainlab.material(o.mat1), vel = v1 })
-  add(s, { pos = p2, radius = r2, material = grainlab.material(o.mat2), vel = v2 })
-  s:contact(o.contact)
-  return s
-end
-
+-- One collision (scripts/lib/collision.lua: centre of mass at rest, or grain 1 at rest with
+-- o.target), touching 0.3 into the third step, at o.dt or (without) the automatic dt. Returns
+-- t_c, e, steps in contact, dt.
 local function collide(o)
-  local D, n = o.dim, DIRS[o.dim]
-  local dt = o.dt or build(o, 1e-4):timestep().dt_auto
-  local s = build(o, o.v * dt * 2.3)
-  local X, V = { "x", "y", "z" }, { "vx", "vy", "vz" }
-  local function overlap(p)
-    local d2 = 0
-    for d = 1, D do d2 = d2 + (p[X[d]][2] - p[X[d]][1]) ^ 2 end
-    return r1 + r2 - math.sqrt(d2)
-  end
-  local prev_delta, prev_t = overlap(s:particles()), 0
-  local t_start, t_end, in_contact, after, disagree = nil, nil, nil, nil, 0
-  local r = s:run{ steps = math.ceil(20 * o.t_est / dt), dt = o.dt or "auto", every = 1, on_step = function(sc)
-    local p, t = sc:particles(), sc:info().time
-    local delta = overlap(p)
-    local listed = sc:measure("contacts").count > 0
-    if listed ~= (delta > 0) then disagree = disagree + 1 end
-    if listed then
-      in_contact = (in_contact or 0) + 1
-      t_start = t_start or prev_t + (t - prev_t) * (-prev_delta) / (delta - prev_delta)
-    elseif t_start then
-      t_end = prev_t + (t - prev_t) * prev_delta / (prev_delta - delta)
-      after = p
-      return false
-    end
-    prev_delta, prev_t = delta, t
-  end }
-  check.is_true(t_end, "the collision ended")
-  check.eq(disagree, 0, "steps where the contact list disagrees with the overlap")
-  check.eq(r.dt, dt, "run used the expected dt")
-  local vn = 0
-  for d = 1, D do vn = vn + (after[V[d]][2] - after[V[d]][1]) * n[d] end
-  return t_end - t_start, vn / o.v, in_contact, dt
-end
-
--- RK4 of d'' = accel(d, d'), d(0) = 0, d'(0) = v, n steps per t_est; crossing interpolated.
-local function rk4(accel, v, t_est, n)
-  local h, d, u, t = t_est / n, 0.0, v, 0.0
-  local function a(dd, uu) return accel(dd > 0 and dd or 0, uu) end
-  for _ = 1, 10 * n do
-    local k1d, k1u = u, a(d, u)
-    local k2d, k2u = u + 0.5 * h * k1u, a(d + 0.5 * h * k1d, u + 0.5 * h * k1u)
-    local k3d, k3u = u + 0.5 * h * k2u, a(d + 0.5 * h * k2d, u + 0.5 * h * k2u)
-    local k4d, k4u = u + h * k3u, a(d + h * k3d, u + h * k3u)
-    local dn = d + h / 6 * (k1d + 2 * k2d + 2 * k3d + k4d)
-    local un = u + h / 6 * (k1u + 2 * k2u + 2 * k3u + k4u)
-    if dn <= 0 then
-      local frac = d / (d - dn)
-      return t + h * frac, -(u + frac * (un - u)) / v
-    end
-    d, u, t = dn, un, t + h
-  end
-  error("rk4: the contact did not end")
+  o.phase, o.auto = 0.3, not o.dt
+  local r = collision.collide(o)
+  return r.tc, r.e, r.steps, r.dt
 end
 
 -- Linear law, clip = false: t_c = pi/w, e = exp(-b t_c), w = sqrt(w0^2 - b^2), w0 = sqrt(k/m_eff),
@@ -119,7 +45,7 @@ for _, c in ipairs{ { 0.9, 2000 }, { 0.5, 2000 }, { 0.1, 10000 } } do
 end
 
 -- Hertz, elastic: t_c = 2.94328 d_max/v0, d_max = (5 m_eff v0^2/(4K))^{2/5}, e = 1.
-local hz_K, hz_m = hertz_K(quartz, glass), m_eff_of(quartz, glass)
+local hz_K, hz_m = collision.hertz_K(quartz, glass), m_eff_of(quartz, glass)
 local function hertz_tc(v) return 2.94328 * (5 * hz_m * v ^ 2 / (4 * hz_K)) ^ 0.4 / v end
 for D = 2, 3 do
   for _, v in ipairs{ 0.1, 10 } do
@@ -134,11 +60,6 @@ end
 -- Hertz + Brilliantov (T = 1e-7 s): e falls with v0, and matches RK4 (1e5 steps) at 1 m/s.
 local T = 1e-7
 local bri = { normal = "hertz", damping = "brilliantov", damping_time = T }
-local function bri_accel(d, u)
-  local sd = math.sqrt(d)
-  local f = hz_K * d * sd + T * hz_K * sd * u
-  return f > 0 and -f / hz_m or 0
-end
 local prev = math.huge
 for i, v in ipairs{ 0.01, 0.1, 1, 10 } do
   local tc = hertz_tc(v)
@@ -148,7 +69,7 @@ for i, v in ipairs{ 0.01, 0.1, 1, 10 } do
   prev = e
 end
 do
-  local rtc, re = rk4(bri_accel, 1, hertz_tc(1), 100000)
+  local rtc, re = collision.rk4(collision.hertz_accel(hz_K, hz_m, T), 1, hertz_tc(1), 100000)
   local t, e = collide{ dim = 3, mat1 = quartz, mat2 = glass, v = 1, dt = rtc / 2000, t_est = rtc, contact = bri }
   check.near(t, rtc, 1e-3, "brilliantov 3D v0=1: contact time vs RK4")
   check.near(e, re, 1e-3, "brilliantov 3D v0=1: restitution vs RK4")
