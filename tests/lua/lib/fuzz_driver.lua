@@ -13,8 +13,8 @@
 -- records what each test covers and runs no case) and fails when a function of the registry
 -- that takes options is covered by none.
 --
--- Used by tests/lua/test_fuzz_*.lua:
---   local fuzz = dofile("fuzz_driver.lua")
+-- Used by tests/*/test_fuzz_*.lua:
+--   local fuzz = dofile("../lua/lib/fuzz_driver.lua")
 --   fuzz.run{ modules = { dem = dem }, types = { ["dem.scene"] = scene }, calls = { ... } }
 -- A call entry, keyed "module.fn" or "type:method" (type = the metatable's __name):
 --   { setup = function() return ctx end,          -- fresh state for every case (optional)

@@ -12,7 +12,7 @@ grainlab.threads(1)
 local mat = grainlab.material{ density = 2650, young = 1e8, poisson = 0.3, friction = 0.1,
                                restitution = 0.6 }
 
-local new_cluster = dofile("dem_cluster.lua")
+local new_cluster = dofile("../lua/lib/dem_cluster.lua")
 local function cluster(dim, periodic, contact)
   return new_cluster{ dim = dim, side = dim == 2 and 16 or 7, spacing = 2.1e-3, inward = 300,
                       periodic = periodic, contact = contact, material = mat }

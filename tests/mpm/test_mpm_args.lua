@@ -103,7 +103,7 @@ check.errors(function() m:run{ steps = 1 } end, "run: the scene has no material 
 check.eq(m:add_disk{ center = { 0.5, 0.5 }, radius = 0.2, material = mat }, 1, "first grain id")
 
 -- contact
-m:contact{ model = "friction", mu = 0.3 } -- accepted (tests/lua/test_mpm_friction.lua checks it)
+m:contact{ model = "friction", mu = 0.3 } -- accepted (tests/mpm/test_mpm_friction.lua checks it)
 check.eq(m:info().mu, 0.3, "friction accepted with its mu")
 m:contact{ model = "noslip" }
 check.errors(function() m:contact{ model = "glue" } end,

@@ -2,7 +2,7 @@
 -- render function and image method gets every bad-value class; only the classes declared below
 -- are accepted, everything else must end in an error naming the call and the field. Files go to
 -- a temporary path, removed at the end.
-local fuzz = dofile("fuzz_driver.lua")
+local fuzz = dofile("../lua/lib/fuzz_driver.lua")
 local tmp = os.tmpname()
 local png = tmp .. ".png"
 

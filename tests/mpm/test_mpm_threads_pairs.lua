@@ -5,7 +5,7 @@
 -- skips a thread); a prescribed grain (the nodes it forces, the last in grain order); the
 -- momentum-conserving correction (three grains at a node); MUSL (the remap's sums) and USF (the
 -- force scatter's).
-local same_points = dofile("mpm_same_points.lua")
+local same_points = dofile("../lua/lib/mpm_same_points.lua")
 local check = grainlab.check
 local mat = mpm.material{ model = "vonmises", density = 3000, shear = 2.5e6, bulk = 10e6, yield = 2e4 }
 

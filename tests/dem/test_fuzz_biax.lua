@@ -1,7 +1,7 @@
 -- Generated bad-input test of grainlab.biax (see fuzz_driver.lua): every configuration field of
 -- every biax function taking one, and every positional argument, gets every bad-value class;
 -- only the classes declared below are accepted.
-local fuzz = dofile("fuzz_driver.lua")
+local fuzz = dofile("../lua/lib/fuzz_driver.lua")
 local OPT = { "nil" }
 local calls = {}
 

@@ -6,7 +6,7 @@
 -- threads to work; saved from on_step; s:info() survives; bad files and failed writes give
 -- clear errors and leave nothing behind. The same in separate processes: tests/cli.
 local check = grainlab.check
-local C = dofile("ckpt_dem_case.lua")
+local C = dofile("../lua/lib/ckpt_dem_case.lua")
 
 local dir = os.tmpname()
 os.remove(dir)
@@ -247,7 +247,7 @@ do
 end
 
 -- ---- bad input ----------------------------------------------------------------------------
-local F = dofile("ckpt_files.lua")
+local F = dofile("../lua/lib/ckpt_files.lua")
 local slurp, spit, reseal = F.read, F.write, F.reseal
 
 local good = path("good.ckpt")

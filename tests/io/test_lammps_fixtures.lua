@@ -37,7 +37,7 @@ local function read_dump(path)
 end
 
 local function compare(name, s, info, dim)
-  local dump = read_dump("../io/" .. name .. ".dump")
+  local dump = read_dump(name .. ".dump")
   local p = s:particles()
   check.eq(p.count, dump.count, name .. ": atom count")
   check.eq(info.count, dump.count, name .. ": info.count")
@@ -74,24 +74,24 @@ local function compare(name, s, info, dim)
 end
 
 -- 3D, periodic in x (boundary p f f): some atoms carry image flags -1; positions are in the box.
-local s3, info3 = dem.read_lammps_data("../io/pour3d.data", { periodic = { true, false, false } })
+local s3, info3 = dem.read_lammps_data("pour3d.data", { periodic = { true, false, false } })
 check.eq(s3:info().dim, 3, "pour3d is 3D (z varies)")
 check.contains(info3.title, "LAMMPS data file via write_data", "title line")
 check.is_true(info3.velocities, "pour3d has velocities")
 compare("pour3d", s3, info3, 3)
 -- without periodic x the image flags are refused, naming the atom and the line
-check.errors(function() dem.read_lammps_data("../io/pour3d.data") end,
+check.errors(function() dem.read_lammps_data("pour3d.data") end,
   "which is not periodic in this scene", "image flags need a periodic axis")
 
 -- 2D (dimension 2: z = 0, zlo < 0 < zhi): recognised as 2D without being told.
-local s2, info2 = dem.read_lammps_data("../io/pour2d.data")
+local s2, info2 = dem.read_lammps_data("pour2d.data")
 check.eq(s2:info().dim, 2, "pour2d is read as 2D")
 compare("pour2d", s2, info2, 2)
 -- two densities in the file, no materials given: one default material per type
 check.eq(#info2.ids, 143, "pour2d atoms")
 
 -- LIGGGHTS 3.8 (atom_style granular): "Atoms" without a style hint, numbers in %.16e
-local sl, infol = dem.read_lammps_data("../io/liggghts.data", { periodic = { true, true, false } })
+local sl, infol = dem.read_lammps_data("liggghts.data", { periodic = { true, true, false } })
 check.contains(infol.title, "LIGGGHTS-PUBLIC 3.8.0", "LIGGGHTS title")
 compare("liggghts", sl, infol, 3)
 
@@ -99,11 +99,11 @@ compare("liggghts", sl, infol, 3)
 -- density = "file" (a copy with 1200) or "material" (masses from 2500)
 local q = grainlab.material{ density = 2650, young = 1e8, friction = 0.4 }
 local g = grainlab.material{ density = 2500, young = 1e8, friction = 0.4 }
-check.errors(function() dem.read_lammps_data("../io/pour2d.data", { types = { [1] = q, [2] = g } }) end,
+check.errors(function() dem.read_lammps_data("pour2d.data", { types = { [1] = q, [2] = g } }) end,
   "has density 1200 but type 2's material has density 2500", "strict density")
-local sf = dem.read_lammps_data("../io/pour2d.data", { types = { [1] = q, [2] = g }, density = "file" })
-compare("pour2d", sf, select(2, dem.read_lammps_data("../io/pour2d.data")), 2)
-local sm, im = dem.read_lammps_data("../io/pour2d.data", { types = { [1] = q, [2] = g }, density = "material" })
+local sf = dem.read_lammps_data("pour2d.data", { types = { [1] = q, [2] = g }, density = "file" })
+compare("pour2d", sf, select(2, dem.read_lammps_data("pour2d.data")), 2)
+local sm, im = dem.read_lammps_data("pour2d.data", { types = { [1] = q, [2] = g }, density = "material" })
 local pm = sm:particles()
 for i = 1, pm.count do
   if im.types[i] == 2 then

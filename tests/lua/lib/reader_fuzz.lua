@@ -22,8 +22,8 @@
 -- crashes (a sanitizer report ends the worker). M.explicit_worker runs named cases instead (the
 -- test's, with the message each must give, FIFOs and devices among them).
 --
--- Used by tests/lua/test_reader_fuzz.lua (a few hundred cases) and, for a campaign,
---   grainlab tests/lua/reader_fuzz.lua role=campaign n=5000 seed=1 [exe=build-asan/grainlab]
+-- Used by tests/io/test_reader_fuzz.lua (a few hundred cases) and, for a campaign,
+--   grainlab tests/lua/lib/reader_fuzz.lua role=campaign n=5000 seed=1 [exe=build-asan/grainlab]
 --            [limit=20 (s per case)] [log=cases.txt (every case's line)] [dir=... keep=1]
 -- (run from the repository; the workers are `exe`, the sanitizer build's grainlab for instance).
 local M = {}

@@ -20,7 +20,7 @@ local function dump(name, cols)
 end
 
 -- MPM (the scene of test_mpm_contact_paths.lua)
-local contact_scene = dofile("mpm_contact_scene.lua")
+local contact_scene = dofile("../lua/lib/mpm_contact_scene.lua")
 local cases = {}
 for _, case in ipairs(contact_scene.cases) do cases[#cases + 1] = case end
 cases[#cases + 1] = { name = "musl, noslip", update = "musl", contact = { model = "noslip" } }
@@ -30,7 +30,7 @@ for _, case in ipairs(cases) do
 end
 
 -- DEM: imploding clusters (dem_cluster.lua), touching from the start
-local cluster = dofile("dem_cluster.lua")
+local cluster = dofile("../lua/lib/dem_cluster.lua")
 local dmat = grainlab.material{ density = 2650, young = 1e8, poisson = 0.3, friction = 0.3,
                                 restitution = 0.6 }
 for _, dim in ipairs{ 2, 3 } do

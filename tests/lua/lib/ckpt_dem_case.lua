@@ -1,4 +1,4 @@
--- The scenes of the DEM checkpoint tests (tests/lua/test_checkpoint_dem.lua and
+-- The scenes of the DEM checkpoint tests (tests/dem/test_checkpoint_dem.lua and
 -- tests/cli/test_checkpoint.sh): a small box of disks (2D) or spheres (3D) falling under gravity
 -- onto a floor, with Hertz contacts, Brilliantov damping from a restitution, Cundall-Strack
 -- spring friction (contact history), two materials, a wall moving sideways, a servo lid, one

@@ -168,7 +168,7 @@ do
 end
 
 -- ---- checkpoints: the solved coefficients are saved; a file without them is refused -----------
-local F = dofile("ckpt_files.lua")
+local F = dofile("../lua/lib/ckpt_files.lua")
 local dir = os.tmpname()
 os.remove(dir)
 assert(os.execute("mkdir -p '" .. dir .. "'"))

@@ -1,7 +1,7 @@
 -- Generated bad-input test (fuzz_driver.lua) of the LAMMPS calls: dem.read_lammps_data and the
 -- dem.scene methods read_lammps_data, write_lammps_data and write_lammps_dump. Every field and the
 -- file name get every bad-value class; only the classes declared below are accepted.
-local fuzz = dofile("fuzz_driver.lua")
+local fuzz = dofile("../lua/lib/fuzz_driver.lua")
 local check = grainlab.check
 local mat = grainlab.material{ density = 1000, young = 1e7, poisson = 0.3, friction = 0.3 }
 

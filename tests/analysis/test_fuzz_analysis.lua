@@ -1,7 +1,7 @@
 -- Generated bad-input test of the analysis module and the boundary-condition methods it adds to
 -- dem.scene (see fuzz_driver.lua), with the nested tables (s:boundary's mbc, mesh:raster's state)
 -- fuzzed field by field.
-local fuzz = dofile("fuzz_driver.lua")
+local fuzz = dofile("../lua/lib/fuzz_driver.lua")
 local OPT = { "nil" }
 
 local function scene()

@@ -1,7 +1,7 @@
 -- Generated bad-input test of the dsmc module (see fuzz_driver.lua): every field of every dsmc
 -- function and dsmc.scene method gets every bad-value class; only the classes declared below are
 -- accepted, everything else must end in an error naming the call and the field.
-local fuzz = dofile("fuzz_driver.lua")
+local fuzz = dofile("../lua/lib/fuzz_driver.lua")
 local check = grainlab.check
 
 local function scene()

@@ -13,10 +13,10 @@
 --      boundaries and inside numbers, sections shortened, grown, deleted, duplicated and moved,
 --      counts, indices and counters inflated, doubles made NaN, inf or 1e308; a case fails when a
 --      file that must be refused loads, or a refusal does not name the file.
--- scripts: `grainlab tests/lua/reader_fuzz.lua role=campaign n=5000` is the large campaign.
+-- scripts: `grainlab tests/lua/lib/reader_fuzz.lua role=campaign n=5000` is the large campaign.
 local check = grainlab.check
-local R = dofile("reader_fuzz.lua")
-local F = dofile("ckpt_files.lua")
+local R = dofile("../lua/lib/reader_fuzz.lua")
+local F = dofile("../lua/lib/ckpt_files.lua")
 
 local exe = arg[-1]
 for i = -2, -10, -1 do if arg[i] then exe = arg[i] else break end end

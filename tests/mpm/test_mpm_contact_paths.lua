@@ -7,9 +7,9 @@
 -- moving friction wall on the right; per case one option set: B-spline shapes with the strain
 -- cap, separation and conserve (MUSL); a friction plane with the gap test and the grains' own
 -- normals (USF: the force sums); linear normals with a PIC blend (USL, no remap).
-local same_points = dofile("mpm_same_points.lua")
+local same_points = dofile("../lua/lib/mpm_same_points.lua")
 local check = grainlab.check
-local contact_scene = dofile("mpm_contact_scene.lua")
+local contact_scene = dofile("../lua/lib/mpm_contact_scene.lua")
 local cases = contact_scene.cases
 local function run(case, threads)
   grainlab.threads(threads)

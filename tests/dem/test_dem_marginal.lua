@@ -8,7 +8,7 @@
 -- steps.
 local check = grainlab.check
 grainlab.threads(1) -- 200 particles: threads only add synchronisation
-local heap_box = dofile((arg[0]:match("^(.*)/tests/lua/") or ".") .. "/scripts/lib/heap_box.lua")
+local heap_box = dofile("../../scripts/lib/heap_box.lua")
 local ckpt = os.tmpname()
 
 local function marginal(mu)

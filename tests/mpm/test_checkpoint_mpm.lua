@@ -145,7 +145,7 @@ do
 end
 
 -- ---- bad files ------------------------------------------------------------------------------
-local F = dofile("ckpt_files.lua")
+local F = dofile("../lua/lib/ckpt_files.lua")
 local read, write, reseal, put = F.read, F.write, F.reseal, F.put
 
 local good = base .. "_good.ckpt"

@@ -1,7 +1,7 @@
 -- Generated bad-input test of the dem module (see fuzz_driver.lua): every field of every dem
 -- function and dem.scene method gets every bad-value class; only the classes declared below are
 -- accepted, everything else must end in an error naming the call and the field.
-local fuzz = dofile("fuzz_driver.lua")
+local fuzz = dofile("../lua/lib/fuzz_driver.lua")
 local check = grainlab.check
 local mat = grainlab.material{ density = 2650, young = 1e7, poisson = 0.3, friction = 0.3 }
 

@@ -13,7 +13,7 @@
 local check = grainlab.check
 grainlab.threads(1) -- 250 particles: threads only add synchronisation
 
-local heap_box = dofile((arg[0]:match("^(.*)/tests/lua/") or ".") .. "/scripts/lib/heap_box.lua")
+local heap_box = dofile("../../scripts/lib/heap_box.lua")
 local n, seed = 250, 1
 
 local function repose(mu)
