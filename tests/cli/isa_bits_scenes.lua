@@ -6,7 +6,8 @@
 -- B-splines, strain cap, separation and conserve; USF with a friction plane and own normals; USL
 -- with linear normals and PIC) and one no-slip MUSL scene. DEM: an imploding cluster of 5,184
 -- disks (Hertz, Brilliantov, Cundall-Strack spring, rolling resistance, gravity in a closed box:
--- the parallel, vectorised pair kernel) and of 343 spheres. DSMC: 20,000 inelastic disks.
+-- the parallel, vectorised pair kernel) and of 343 spheres. DSMC: 20,000 inelastic disks at volume
+-- fraction 0.1.
 grainlab.threads(math.tointeger(params.threads) or 1)
 local out = assert(io.open(assert(params.out, "out= is required"), "w"))
 
@@ -46,11 +47,8 @@ for _, dim in ipairs{ 2, 3 } do
   dump("dem " .. dim .. "D", cols)
 end
 
--- DSMC
-local n, R = 20000, 1e-3
-local L = math.sqrt(n * math.pi * R * R / 0.003)
-local gas = dsmc.scene{ dim = 2, size = { L, L }, cells = { 30, 30 }, radius = R, restitution = 0.9, seed = 3 }
-gas:fill{ n = n, temperature = gas:info().mass * 1.0, seed = 5 }
+-- DSMC: the gas of the DSMC benchmarks (scripts/bench/fig2_gas.lua), 20,000 disks
+local gas = dofile("../../scripts/bench/fig2_gas.lua")(20000)
 gas:run{ steps = 10, dt = 0.1 / gas:measure("temperature").collision_frequency, progress = false }
 local q = gas:particles()
 dump("dsmc", { q.x, q.y, q.vx, q.vy })

@@ -3,8 +3,7 @@ local check = grainlab.check
 local ok = { dim = 2, size = { 0.1, 0.1 }, cells = { 10, 10 }, radius = 1e-3 }
 local function with(t)
   local c = {}
-  for k, v in pairs(ok) do c[k] = v end
-  for k, v in pairs(t) do c[k] = v end
+  for _, src in ipairs{ ok, t } do for k, v in pairs(src) do c[k] = v end end
   return c
 end
 
