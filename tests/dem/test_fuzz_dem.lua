@@ -219,15 +219,6 @@ local calls = {
         s:contact{ damping = "brilliantov", damping_time = 1e-5 }; return s end,
       self = self, args = function() return { 1, 2 } end, no_opts = true, pos = { ID, ID } },
   },
-  ["dem.scene:save"] = {
-    setup = scene2, self = self, args = function() return { tmp .. "/save.ckpt" } end,
-    pos = { { "string" } }, strings = { [1] = tmp .. "/save.ckpt" },
-  },
-  ["dem.load"] = {
-    setup = function() scene2():save(tmp .. "/load.ckpt") end,
-    args = function() return { tmp .. "/load.ckpt" } end,
-    pos = { { "string" } }, strings = { [1] = tmp .. "/load.ckpt" },
-  },
   ["dem.scene:inserter"] = {
     { setup = scene2, self = self, opts = 1,
       args = function() return { { box = { { 0, 0.5 }, { 1, 1 } }, rate = 100, count = 10, mass = 1,
@@ -258,6 +249,7 @@ local calls = {
     accept = { pressure = {}, strain_rate = {} },
   },
 }
+fuzz.checkpoint_calls(calls, "dem", scene2, tmp .. "/state.ckpt")
 
 -- Registered on dem.scene by lua_analysis.c, whose validation fixes come with the delaunay
 -- helper's branch: fuzzed once that is merged.

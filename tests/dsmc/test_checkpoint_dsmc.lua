@@ -48,13 +48,8 @@ local function dump(s)
   return out
 end
 
-local function same(a, b, what)
-  check.eq(#a, #b, what .. ": line count")
-  for i = 1, #a do
-    if a[i] ~= b[i] then check.eq(b[i], a[i], string.format("%s: line %d", what, i)) end
-  end
-  check.eq(table.concat(a, "\n"), table.concat(b, "\n"), what)
-end
+local F = dofile("../lua/lib/ckpt_files.lua")
+local same = F.same_lines
 
 local function continuation(make, dt, n1, n2, what)
   grainlab.threads(1)
@@ -113,7 +108,6 @@ do
 end
 
 -- ---- bad files ------------------------------------------------------------------------------
-local F = dofile("../lua/lib/ckpt_files.lua")
 local read, write, reseal, put = F.read, F.write, F.reseal, F.put
 
 local good, bad = base .. "_good.ckpt", base .. "_bad.ckpt"

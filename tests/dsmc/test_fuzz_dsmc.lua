@@ -22,14 +22,6 @@ local BOOL = { "nil", "boolean" }
 local ckpt = os.tmpname()
 
 local calls = {
-  ["dsmc.scene:save"] = {
-    setup = scene, self = self, args = function() return { ckpt } end,
-    pos = { { "string" } }, strings = { ckpt },
-  },
-  ["dsmc.load"] = {
-    setup = function() scene():save(ckpt) end, args = function() return { ckpt } end,
-    pos = { { "string" } }, strings = { ckpt },
-  },
   ["dsmc.scene"] = {
     { args = function() return { { dim = 2, box = { { 0, 0 }, { 1, 1 } }, cells = { 4, 4 },
                                    periodic = { true, false }, gravity = { 0, -1 }, restitution = 0.9,
@@ -104,6 +96,7 @@ local calls = {
   ["dsmc.scene:reset_stats"] = { setup = scene, self = self },
   ["dsmc.scene:info"] = { setup = scene, self = self },
 }
+fuzz.checkpoint_calls(calls, "dsmc", scene, ckpt)
 
 -- VTK output (lua_vtk.c): the files go to a scratch directory.
 local vtkdir = os.tmpname()

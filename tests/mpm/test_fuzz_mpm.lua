@@ -18,14 +18,6 @@ local BOOL = { "nil", "boolean" }
 local ckpt = os.tmpname()
 
 local calls = {
-  ["mpm.scene:save"] = {
-    setup = scene, self = self, args = function() return { ckpt } end,
-    pos = { { "string" } }, strings = { ckpt },
-  },
-  ["mpm.load"] = {
-    setup = function() scene():save(ckpt) end, args = function() return { ckpt } end,
-    pos = { { "string" } }, strings = { ckpt },
-  },
   ["mpm.scene"] = {
     args = function() return { { cells = { 8, 8 }, size = { 1, 1 }, origin = { 0, 0 },
                                  periodic = { false, false }, gravity = { 0, -9.81 }, walls = "slip",
@@ -124,6 +116,7 @@ local calls = {
     accept = { vx = {}, vy = {} },
   },
 }
+fuzz.checkpoint_calls(calls, "mpm", scene, ckpt)
 
 -- VTK output (lua_vtk.c): the files go to a scratch directory.
 local vtkdir = os.tmpname()

@@ -1,6 +1,6 @@
--- Byte-level helpers the checkpoint tests share: read and write a file whole, and forge files a
--- real writer could have produced (the container's FNV-1a 64 checksum recomputed over a changed
--- body, so that a changed field reaches the checks behind the checksum).
+-- Helpers the checkpoint tests share: read and write a file whole, forge files a real writer
+-- could have produced (the container's FNV-1a 64 checksum recomputed over a changed body, so that
+-- a changed field reaches the checks behind the checksum), and compare two states dumped as text.
 local M = {}
 
 function M.read(path)
@@ -38,5 +38,16 @@ end
 
 -- s with bytes written over it after position at.
 function M.put(s, at, bytes) return s:sub(1, at) .. bytes .. s:sub(at + #bytes + 1) end
+
+-- Two states dumped as lists of lines (values as %a) are the same: the line count, the first line
+-- that differs (by its number), then the whole.
+function M.same_lines(a, b, what)
+  local check = grainlab.check
+  check.eq(#a, #b, what .. ": line count")
+  for i = 1, #a do
+    if a[i] ~= b[i] then check.eq(b[i], a[i], string.format("%s: line %d", what, i)) end
+  end
+  check.eq(table.concat(a, "\n"), table.concat(b, "\n"), what)
+end
 
 return M

@@ -377,4 +377,18 @@ function M.run(spec)
   print(string.format("%d binding cases passed", cases))
 end
 
+-- The base calls of an engine's checkpoint pair, added to calls: name.scene:save(path) on a fresh
+-- scene(), and name.load(path) of the file a fresh scene() saved there (path is the "string"
+-- class of both).
+function M.checkpoint_calls(calls, name, scene, path)
+  calls[name .. ".scene:save"] = {
+    setup = scene, self = function(ctx) return ctx end, args = function() return { path } end,
+    pos = { { "string" } }, strings = { path },
+  }
+  calls[name .. ".load"] = {
+    setup = function() scene():save(path) end, args = function() return { path } end,
+    pos = { { "string" } }, strings = { path },
+  }
+end
+
 return M
