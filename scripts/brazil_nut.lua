@@ -52,8 +52,8 @@
 --       [frequency=20] [ratio=4] [width=24] [depth=4] [t_max=200] [rise_from=2]
 --       [csv=out/brazil_nut.csv] [verbose=false]
 local figures = require("grainlab.figures")
-local pour = dofile((arg[0]:match("^(.*)/") or ".") .. "/pour.lua")
-local heap_box = dofile((arg[0]:match("^(.*)/") or ".") .. "/heap_box.lua") -- its least-squares line
+local pour = dofile((arg[0]:match("^(.*)/") or ".") .. "/lib/pour.lua")
+local heap_box = dofile((arg[0]:match("^(.*)/") or ".") .. "/lib/heap_box.lua") -- its least-squares line
 
 local function int(v) return type(v) == "number" and math.tointeger(v) or nil end
 local packings = int(params.packings or 3)

@@ -64,15 +64,14 @@ assert(type(T) == "number" and T > 0, "T must be a positive number")
 assert(math.type(nphases) == "integer" and nphases >= 1, "phases must be a positive integer")
 grainlab.threads(params.threads or 1)
 
+-- The grains, the reference (RK4 of the contact ODE) and the kernel's collision measured step by
+-- step: scripts/lib/collision.lua, shared with the test.
+local collision = dofile((arg[0]:match("^(.*)/") or ".") .. "/lib/collision.lua")
 local pi = math.pi
-local r1, r2 = 0.5e-3, 0.7e-3
-local quartz = { density = 2650, young = 30e9, poisson = 0.3 }
-local glass = { density = 2500, young = 63e9, poisson = 0.22 }
-local function mass(m, r) return m.density * 4 / 3 * pi * r ^ 3 end
-local function e_star(a, b) return 1 / ((1 - a.poisson ^ 2) / a.young + (1 - b.poisson ^ 2) / b.young) end
-local function hertz_K(a, b) return 4 / 3 * e_star(a, b) * math.sqrt(r1 * r2 / (r1 + r2)) end
-local function m_eff_of(a, b) local m1, m2 = mass(a, r1), mass(b, r2); return m1 * m2 / (m1 + m2) end
-local DIRS = { [2] = { 0.6, 0.8 }, [3] = { 1 / 3, 2 / 3, 2 / 3 } }
+local r1, r2, quartz, glass = collision.r1, collision.r2, collision.quartz, collision.glass
+local mass, e_star, hertz_K, m_eff_of = collision.mass, collision.e_star, collision.hertz_K, collision.m_eff_of
+local rk4, linear_accel, hertz_accel = collision.rk4, collision.linear_accel, collision.hertz_accel
+local collide = collision.collide
 
 -- ---- quadratures for the constants ----------------------------------------------------------
 -- int_0^1 (1 - x^{5/2})^{-1/2} dx with x = 1 - u^2 (removes the endpoint singularity), midpoint.
@@ -102,111 +101,6 @@ local function damping_integral(n)
 end
 local C_HERTZ = 2 * hertz_integral(200000)
 local I_DAMP = damping_integral(200000)
-
--- ---- reference: RK4 of m_eff d'' = -max(0, f(d, d')) ----------------------------------------
--- accel(d, u) is -f/m_eff (d >= 0). Starts at d = 0, d' = v; h = t_est/n. Returns t_c, e.
--- The crossing of d = 0 inside the last step is interpolated linearly in d and d' (exact in free
--- flight, which is how clipped contacts end; O(h^2) for the unclipped linear law).
-local function rk4(accel, v, t_est, n)
-  local h = t_est / n
-  local d, u, t = 0.0, v, 0.0
-  local function a(dd, uu) return accel(dd > 0 and dd or 0, uu) end
-  for _ = 1, 10 * n do
-    local k1d, k1u = u, a(d, u)
-    local k2d, k2u = u + 0.5 * h * k1u, a(d + 0.5 * h * k1d, u + 0.5 * h * k1u)
-    local k3d, k3u = u + 0.5 * h * k2u, a(d + 0.5 * h * k2d, u + 0.5 * h * k2u)
-    local k4d, k4u = u + h * k3u, a(d + h * k3d, u + h * k3u)
-    local dn = d + h / 6 * (k1d + 2 * k2d + 2 * k3d + k4d)
-    local un = u + h / 6 * (k1u + 2 * k2u + 2 * k3u + k4u)
-    if dn <= 0 then
-      local frac = d / (d - dn)
-      return t + h * frac, -(u + frac * (un - u)) / v
-    end
-    d, u, t = dn, un, t + h
-  end
-  error("rk4: the contact did not end")
-end
-
-local function linear_accel(w0sq, b, clip)
-  return function(d, u)
-    local f = w0sq * d + 2 * b * u
-    if clip and f < 0 then f = 0 end
-    return -f
-  end
-end
-local function hertz_accel(K, m_eff, Tb)
-  return function(d, u)
-    local sd = math.sqrt(d)
-    local f = K * d * sd + Tb * K * sd * u
-    if f < 0 then f = 0 end
-    return -f / m_eff
-  end
-end
-
--- ---- the kernel's collision ---------------------------------------------------------------
--- o: dim, contact (table for s:contact), mat1, mat2 (tables for grainlab.material), v (approach
--- speed), dt, t_est (expected contact time). The grains start gap apart, centre of mass at rest.
-local function build(o, gap)
-  local D, n = o.dim, DIRS[o.dim]
-  local m1, m2 = mass(o.mat1, r1), mass(o.mat2, r2)
-  local lo, hi = {}, {}
-  for d = 1, D do lo[d], hi[d] = -0.01, 0.01 end
-  local s = dem.scene{ dim = D, box = { lo, hi } }
-  local p1, p2, v1, v2 = {}, {}, {}, {}
-  for d = 1, D do
-    p1[d] = -n[d] * (r1 + gap / 2)
-    p2[d] = n[d] * (r2 + gap / 2)
-    v1[d] = n[d] * o.v * m2 / (m1 + m2)
-    v2[d] = -n[d] * o.v * m1 / (m1 + m2)
-  end
-  local add = D == 2 and s.add_disk or s.add_sphere
-  add(s, { pos = p1, radius = r1, material = grainlab.material(o.mat1), vel = v1 })
-  add(s, { pos = p2, radius = r2, material = grainlab.material(o.mat2), vel = v2 })
-  return s, s:contact(o.contact)
-end
-
--- Returns contact time, restitution, steps with a contact, transverse velocity left, dt.
--- o.auto: run with the default dt = "auto" (o.dt ignored).
-local function collide(o)
-  local D, n = o.dim, DIRS[o.dim]
-  local dt = o.auto and build(o, 1e-4):timestep().dt_auto or o.dt
-  local gap = o.v * dt * (2 + o.phase) -- touch inside the third step, at fraction phase of it
-  local s, T_out = build(o, gap)
-  local X = { "x", "y", "z" }
-  local function overlap(p)
-    local d2 = 0
-    for d = 1, D do d2 = d2 + (p[X[d]][2] - p[X[d]][1]) ^ 2 end
-    return r1 + r2 - math.sqrt(d2)
-  end
-  local prev_delta, prev_t = overlap(s:particles()), 0
-  local t_start, t_end, in_contact, after = nil, nil, 0, nil
-  local run = s:run{ steps = math.ceil(20 * o.t_est / dt) + 10, dt = o.auto and "auto" or dt, every = 1, on_step = function(sc)
-    local p, t = sc:particles(), sc:info().time
-    local delta = overlap(p)
-    local nc = sc:measure("contacts").count
-    assert((nc > 0) == (delta > 0), "contact list disagrees with the overlap")
-    if nc > 0 then
-      in_contact = in_contact + 1
-      if not t_start then t_start = prev_t + (t - prev_t) * (-prev_delta) / (delta - prev_delta) end
-    elseif t_start and not t_end then
-      t_end = prev_t + (t - prev_t) * prev_delta / (prev_delta - delta)
-      after = p
-      return false
-    end
-    prev_delta, prev_t = delta, t
-  end }
-  assert(t_end, "the collision did not end")
-  assert(run.dt == dt, "run used another dt")
-  local vn, vt = 0, 0
-  local V = { "vx", "vy", "vz" }
-  for d = 1, D do vn = vn + (after[V[d]][2] - after[V[d]][1]) * n[d] end
-  for d = 1, D do
-    local rel = after[V[d]][2] - after[V[d]][1]
-    vt = math.max(vt, math.abs(rel - vn * n[d]))
-  end
-  return { tc = t_end - t_start, e = vn / o.v, steps = in_contact, transverse = vt / o.v,
-           damping_time = T_out, dt = dt }
-end
 
 local function rel(a, b) return math.abs(a - b) / math.abs(b) end
 

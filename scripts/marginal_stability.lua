@@ -3,7 +3,7 @@
 -- angle of maximal stability theta_m, grains can arrange in a statically stable way. The angle of
 -- a heap of granular material can fluctuate between theta_m and a dynamic angle theta_r").
 --
--- Procedure, for every mu in `mus` and `seeds` packings each (scripts/heap_box.lua):
+-- Procedure, for every mu in `mus` and `seeds` packings each (scripts/lib/heap_box.lua):
 --  * The packing of scripts/repose.lua: N polydisperse disks (radii 0.5-1 mm) deposited in a box
 --    of width W on a rough floor, settled; Hertz + Brilliantov damping + Cundall-Strack spring,
 --    E = 1e6 Pa, mu also against the walls.
@@ -36,7 +36,7 @@
 --
 --   grainlab scripts/marginal_stability.lua [n=1000] [seed=1] [seeds=2] [mus=0.05,0.1,0.2,0.3,0.5,0.8]
 --       [hold=0.2] [T_max=4] [csv=out/marginal_stability.csv] [verbose=false]
-local heap_box = dofile((arg[0]:match("^(.*)/") or ".") .. "/heap_box.lua")
+local heap_box = dofile((arg[0]:match("^(.*)/") or ".") .. "/lib/heap_box.lua")
 local figures = require("grainlab.figures")
 
 local function int(v) return type(v) == "number" and math.tointeger(v) or nil end

@@ -98,7 +98,7 @@ for name, v in pairs { young = young, dt_factor = dt_factor, aspect = aspect, v_
 end
 assert(dt_factor <= 1, "dt_factor must be <= 1 (dt above the stability limit)")
 assert(type(csv) == "string", "csv must be a path")
-local heap_box = dofile((arg[0]:match("^(.*)/") or ".") .. "/heap_box.lua")
+local heap_box = dofile((arg[0]:match("^(.*)/") or ".") .. "/lib/heap_box.lua")
 local mus = heap_box.mus(params.mus, { 0.1, 0.2, 0.3, 0.5, 0.8 })
 -- images/ only from the default run (docs/dem.md shows it); any other run writes to out/.
 local figures = require("grainlab.figures")
@@ -109,7 +109,7 @@ local published = figures.published({ n = n, seed = seed, seeds = seeds, young =
                                       v_rest = 5e-3, T_max = 4, mus = "0.1,0.2,0.3,0.5,0.8" })
 local png = params.png or figures.path("repose.png", { published = published })
 
--- One friction coefficient and packing: prepare, collapse, fit (scripts/heap_box.lua).
+-- One friction coefficient and packing: prepare, collapse, fit (scripts/lib/heap_box.lua).
 local function run_one(mu, sd)
   local c0 = grainlab.clock()
   local b = heap_box.new{ n = n, mu = mu, seed = sd, young = young, aspect = aspect,

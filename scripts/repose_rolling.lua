@@ -4,7 +4,7 @@
 -- Without rolling resistance a pile of disks levels off near 20 deg however large mu is (the
 -- disks roll once friction stops them sliding: scripts/repose.lua), where sand stands at 30-35
 -- deg. Rolling resistance stands for the shape and contact width of real grains. Here mu = 0.8
--- and mu_r runs through `mus_r`; for each, on the same packings (scripts/heap_box.lua):
+-- and mu_r runs through `mus_r`; for each, on the same packings (scripts/lib/heap_box.lua):
 --  * theta_r: the wall of the box removed, the pile left at rest fitted (scripts/repose.lua);
 --  * theta_m: the closed box tilted in steps until the surface gives way
 --    (scripts/marginal_stability.lua).
@@ -25,7 +25,7 @@
 -- near atan 0.5 = 26.6 deg (17.8, 25.0, 25.3, 27.7; 2 packings).
 --   grainlab scripts/repose_rolling.lua [n=1000] [mu=0.8] [mus_r=0,0.1,0.2,0.3,0.5] [seed=1]
 --       [seeds=1] [aspect=1] [csv=out/repose_rolling.csv] [verbose=false]
-local heap_box = dofile((arg[0]:match("^(.*)/") or ".") .. "/heap_box.lua")
+local heap_box = dofile((arg[0]:match("^(.*)/") or ".") .. "/lib/heap_box.lua")
 local figures = require("grainlab.figures")
 
 local n = math.tointeger(params.n or 1000)

@@ -36,7 +36,7 @@
 -- (a silo only as tall as it is wide drains at a rate that falls with the fill: reduced runs
 -- loosen `steady`)
 local figures = require("grainlab.figures")
-local pour = dofile((arg[0]:match("^(.*)/") or ".") .. "/pour.lua")
+local pour = dofile((arg[0]:match("^(.*)/") or ".") .. "/lib/pour.lua")
 
 local function int(v) return type(v) == "number" and math.tointeger(v) or nil end
 local n = int(params.n or 3000)

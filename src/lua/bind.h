@@ -163,8 +163,8 @@ typedef struct bind_fn {
 
 /* The keys a function's options table accepts: the same NULL-terminated array the function
  * passes to bind_check_fields, so that help() and the generated binding tests
- * (tests/lua/test_fuzz_*.lua) enumerate exactly what the function checks. `mode` is NULL, or the
- * first argument the list goes with (s:measure('stress', { volume = })). */
+ * (tests/<module>/test_fuzz_*.lua) enumerate exactly what the function checks. `mode` is NULL,
+ * or the first argument the list goes with (s:measure('stress', { volume = })). */
 typedef struct bind_fields {
     const char *name;          /* the registered function or method */
     const char *mode;          /* NULL or the mode argument */

@@ -6,7 +6,7 @@
 -- dim=2|3, integ=velocity_verlet|position_verlet|gear|two_timescales, bnd=true: the 2D scene with
 -- boundary conditions; delaunay=K: the 2D scene with Delaunay boundary variant K of
 -- ckpt_dem_case.lua (its integrator, N and M unless given), the edges printed too
-local C = dofile("../lua/ckpt_dem_case.lua")
+local C = dofile("../lua/lib/ckpt_dem_case.lua")
 local p = params
 local v = p.delaunay and assert(C.delaunay[p.delaunay], "no such Delaunay variant") or {}
 local dim, integ = p.dim or 2, p.integ or v.integ or "velocity_verlet"

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The AVX2 clones of the hot kernels (src/core/clones.h) give the baseline's bits: the scenes of
-# tests/lua/isa_bits_scenes.lua (MPM with frictional and no-slip contact, DEM in 2D and 3D, DSMC)
+# tests/cli/isa_bits_scenes.lua (MPM with frictional and no-slip contact, DEM in 2D and 3D, DSMC)
 # run by two grainlab binaries on 1 and 2 threads, their final states compared byte for byte,
 # thread count by thread count (no-slip MPM's sums follow the fixed thread count: docs/mpm.md).
 #   isa_same_bits.sh REFERENCE THIS
@@ -11,7 +11,7 @@
 set -u
 [ $# -eq 2 ] || { sed -n '2,9p' "$0" >&2; exit 2; }
 ref=$(realpath "$1") this=$(realpath "$2")
-scenes=$(cd "$(dirname "$0")/../lua" && pwd)/isa_bits_scenes.lua
+scenes=$(cd "$(dirname "$0")" && pwd)/isa_bits_scenes.lua
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 for exe in "$ref" "$this"; do

@@ -4,7 +4,7 @@
  * unloads one edge of the loop, chosen by a counter kept in its ctx, so a ctx not restored
  * changes the forces); without a restorer, with another kind's, or with one that
  * fails, the load is refused and returns no scene; an update without a kind is refused at save.
- * The Lua tests (tests/lua/test_checkpoint_dem.lua, tests/cli/test_checkpoint.sh) cover the
+ * The Lua tests (tests/dem/test_checkpoint_dem.lua, tests/cli/test_checkpoint.sh) cover the
  * Delaunay update of s:boundary. */
 #include <math.h>
 #include <setjmp.h>

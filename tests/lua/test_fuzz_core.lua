@@ -2,7 +2,7 @@
 -- fuzz_driver.lua): every field and argument gets every bad-value class; only the classes
 -- declared below are accepted, everything else must end in an error naming the call and the
 -- field. Files go to a temporary path, removed at the end.
-local fuzz = dofile("fuzz_driver.lua")
+local fuzz = dofile("../lua/lib/fuzz_driver.lua")
 local check = grainlab.check
 local tmp = os.tmpname()
 

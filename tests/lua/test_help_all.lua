@@ -3,14 +3,7 @@
 -- A new function without a doc record fails here.
 local check = grainlab.check
 
-local function captured(fn, ...)
-  local lines, real = {}, print
-  print = function(...) lines[#lines + 1] = table.concat({ ... }, "\t") end
-  local ok, err = pcall(fn, ...)
-  print = real
-  if not ok then error(err, 0) end
-  return table.concat(lines, "\n")
-end
+local captured = dofile("../lua/lib/captured.lua")
 
 local missing, checked, seen = {}, 0, {}
 local function own_help(path, fn)

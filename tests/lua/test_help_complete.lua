@@ -1,14 +1,7 @@
 -- help() and the REPL's completion candidates, read as text.
 local check = grainlab.check
 
-local function captured(fn, ...)
-  local lines, real = {}, print
-  print = function(...) lines[#lines + 1] = table.concat({ ... }, "\t") end
-  local ok, err = pcall(fn, ...)
-  print = real
-  if not ok then error(err, 0) end
-  return table.concat(lines, "\n")
-end
+local captured = dofile("../lua/lib/captured.lua")
 
 local text = captured(help)
 check.contains(text, "grainlab " .. grainlab.version, "overview")

@@ -1,6 +1,7 @@
 /* MPM and DSMC checkpoints without Lua: a saved and reloaded scene continues with the same bits
  * as the original (memcmp of every point or particle array), and a load that fails returns no
- * scene. The Lua tests (tests/lua/test_checkpoint_*.lua) cover bad files and the bindings. */
+ * scene. The Lua tests (tests/mpm/test_checkpoint_mpm.lua, tests/dsmc/test_checkpoint_dsmc.lua)
+ * cover bad files and the bindings. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
