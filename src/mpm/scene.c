@@ -261,20 +261,7 @@ void mpm_destroy(mpm_scene *s)
     free(s->gstart);
     free(s->gcount);
     free(s->gdef);
-    free(s->tp);
-    free(s->tg);
-    free(s->tq);
-    free(s->tc);
-    free(s->tmark);
-    free(s->trec);
-    free(s->tfin);
-    free(s->gps);
-    free(s->gpc);
-    free(s->tfac);
-    free(s->tnear);
-    free(s->tbuf);
-    free(s->nrec);
-    free(s->cp);
+    mpm_step_free(s->step);
     free(s);
 }
 
