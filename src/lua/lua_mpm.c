@@ -7,6 +7,7 @@
 #include "core/comm.h"
 #include "core/progress.h"
 #include "lua/bind.h"
+#include "lua/lua_mpm.h"
 #include "mpm/mpm.h"
 
 static const char *SCENE = "mpm.scene";
@@ -16,7 +17,7 @@ typedef struct lscene {
     mpm_scene *s;
 } lscene;
 
-static mpm_scene *check_scene(lua_State *L, int idx)
+mpm_scene *bind_mpm_check(lua_State *L, int idx)
 {
     lscene *u = luaL_checkudata(L, idx, SCENE);
     if (!u->s)
@@ -24,13 +25,13 @@ static mpm_scene *check_scene(lua_State *L, int idx)
     return u->s;
 }
 
-static void set_number(lua_State *L, const char *k, double v)
+void bind_mpm_set_number(lua_State *L, const char *k, double v)
 {
     lua_pushnumber(L, v);
     lua_setfield(L, -2, k);
 }
 
-static void push_pair(lua_State *L, const double v[2])
+void bind_mpm_push_pair(lua_State *L, const double v[2])
 {
     lua_createtable(L, 2, 0);
     for (int d = 0; d < 2; d++) {
@@ -342,7 +343,7 @@ static int l_scene(lua_State *L)
  * the scene on first use). */
 static int material_of(lua_State *L, int scene, int arg, const char *call)
 {
-    mpm_scene *s = check_scene(L, scene);
+    mpm_scene *s = bind_mpm_check(L, scene);
     lua_getfield(L, arg, "material");
     const mpm_material *m = luaL_testudata(L, -1, MATERIAL);
     if (!m)
@@ -377,7 +378,7 @@ static const char *const POLYGON_FIELDS[] = {"vertices", "material", "points_per
 
 static int add_grain(lua_State *L, const char *call, mpm_shape shape)
 {
-    mpm_scene *s = check_scene(L, 1);
+    mpm_scene *s = bind_mpm_check(L, 1);
     const bind_run *r = bind_running(L, 1);
     if (r && r->dt > 0 && !r->forced) /* with dt = 'auto' the CFL condition holds every step */
         bind_refuse_running(L, 1, call, "a new grain can raise the wave speed the run's fixed dt "
@@ -456,7 +457,7 @@ static const char *const CONTACT_FIELDS[] = {"model",      "mu",       "normals"
 static int l_contact(lua_State *L)
 {
     static const char *const names[] = {"noslip", "friction", NULL};
-    mpm_scene *s = check_scene(L, 1);
+    mpm_scene *s = bind_mpm_check(L, 1);
     bind_check_table(L, 2, "contact");
     bind_check_fields(L, 2, "contact", CONTACT_FIELDS);
     int model = bind_field_option(L, 2, "contact", "model", names, 0, BIND_REQUIRED);
@@ -487,7 +488,7 @@ static int l_contact(lua_State *L)
 }
 
 /* A grain id in [1, count] at arg, as a 0-based index. */
-static size_t grain_arg(lua_State *L, mpm_scene *s, int arg, const char *call)
+size_t bind_mpm_grain_arg(lua_State *L, mpm_scene *s, int arg, const char *call)
 {
     int isint;
     lua_Integer id = lua_tointegerx(L, arg, &isint);
@@ -502,8 +503,8 @@ static size_t grain_arg(lua_State *L, mpm_scene *s, int arg, const char *call)
 /* m:prescribe(grain, {vx, vy}) */
 static int l_prescribe(lua_State *L)
 {
-    mpm_scene *s = check_scene(L, 1);
-    size_t id = grain_arg(L, s, 2, "prescribe");
+    mpm_scene *s = bind_mpm_check(L, 1);
+    size_t id = bind_mpm_grain_arg(L, s, 2, "prescribe");
     double v[2];
     bind_arg_vector(L, 3, "prescribe", 2, v);
     core_error err;
@@ -519,7 +520,7 @@ static int l_plane(lua_State *L)
 {
     static const char *const kinds[] = {"noslip", "slip", "friction", NULL};
     static const mpm_wall kind_of[] = {MPM_WALL_NOSLIP, MPM_WALL_SLIP, MPM_WALL_FRICTION};
-    mpm_scene *s = check_scene(L, 1);
+    mpm_scene *s = bind_mpm_check(L, 1);
     bind_check_table(L, 2, "plane");
     bind_check_fields(L, 2, "plane", PLANE_FIELDS);
     mpm_plane_def d = {{0, 0}, {0, 1}, MPM_WALL_FRICTION, 0, {0, 0}};
@@ -537,31 +538,6 @@ static int l_plane(lua_State *L)
     if (mpm_add_plane(s, &d, &err))
         return bind_raise(L, "plane", &err);
     return 0;
-}
-
-/* m:field(name) -> {nx =, ny =, values = {...} (row-major, nan in empty cells), ...} */
-static int l_field(lua_State *L)
-{
-    static const char *const names[] = {"vx",           "vy",    "speed", "ux",   "uy",
-                                        "displacement", "sxx",   "syy",   "sxy",  "pressure",
-                                        "psd",          "eps_p", "grain", "mass", NULL};
-    mpm_scene *s = check_scene(L, 1);
-    int kind = bind_check_option(L, 2, NULL, names);
-    const mpm_scene_def *d = mpm_def(s);
-    size_t n = (size_t)d->cells[0] * (size_t)d->cells[1];
-    double *v = lua_newuserdatauv(L, n * sizeof *v, 0);
-    mpm_field(s, (mpm_field_kind)kind, v);
-    lua_createtable(L, 0, 5);
-    bind_push_array(L, v, n, "values");
-    lua_pushinteger(L, d->cells[0]);
-    lua_setfield(L, -2, "nx");
-    lua_pushinteger(L, d->cells[1]);
-    lua_setfield(L, -2, "ny");
-    push_pair(L, d->origin);
-    lua_setfield(L, -2, "origin");
-    push_pair(L, d->size);
-    lua_setfield(L, -2, "size");
-    return 1;
 }
 
 /* ---- time stepping ------------------------------------------------------------------------- */
@@ -582,7 +558,7 @@ static const char *const TIMESTEP_FIELDS[] = {"cfl", NULL};
 
 static int l_timestep(lua_State *L)
 {
-    mpm_scene *s = check_scene(L, 1);
+    mpm_scene *s = bind_mpm_check(L, 1);
     double cfl = MPM_DEFAULT_CFL;
     if (!lua_isnoneornil(L, 2)) {
         bind_check_table(L, 2, "timestep");
@@ -616,7 +592,7 @@ static const char *const RUN_FIELDS[] = {"steps", "time",    "dt",       "cfl", 
 
 static int l_run(lua_State *L)
 {
-    mpm_scene *s = check_scene(L, 1);
+    mpm_scene *s = bind_mpm_check(L, 1);
     bind_refuse_running(L, 1, "run", "return false from on_step to stop it");
     bind_check_table(L, 2, "run");
     bind_check_fields(L, 2, "run", RUN_FIELDS);
@@ -676,123 +652,12 @@ static int l_run(lua_State *L)
     return 1;
 }
 
-/* ---- measurements ---------------------------------------------------------------------------- */
-/* No mode of m:measure takes options: a table given to it may hold no key. */
-static const char *const NO_FIELDS[] = {NULL};
-
-static int l_measure(lua_State *L)
-{
-    static const char *const what_names[] = {"energy", "momentum", "columns", "shear", NULL};
-    mpm_scene *s = check_scene(L, 1);
-    int what = bind_check_option(L, 2, NULL, what_names);
-    bind_mode_options(L, 3, "measure", what_names[what], NO_FIELDS);
-    if (what == 2) {
-        const int nx = mpm_def(s)->cells[0];
-        double *c = lua_newuserdatauv(L, (size_t)nx * sizeof *c, 0);
-        mpm_column_uy(s, c);
-        lua_createtable(L, 0, 2);
-        bind_push_array(L, c, (size_t)nx, "uy");
-        double h[2];
-        mpm_cell_size(s, h);
-        lua_createtable(L, nx, 0);
-        for (int i = 0; i < nx; i++) {
-            lua_pushnumber(L, mpm_def(s)->origin[0] + (i + 0.5) * h[0]);
-            lua_rawseti(L, -2, i + 1);
-        }
-        lua_setfield(L, -2, "x");
-        return 1;
-    }
-    if (what == 3) {
-        lua_pushnumber(L, mpm_shear_strain(s));
-        return 1;
-    }
-    if (what == 0) {
-        mpm_energy e;
-        mpm_measure_energy(s, &e);
-        lua_createtable(L, 0, 5);
-        set_number(L, "kinetic", e.kinetic);
-        set_number(L, "elastic", e.elastic);
-        set_number(L, "plastic", e.plastic);
-        set_number(L, "potential", e.potential);
-        set_number(L, "total", e.total);
-        return 1;
-    }
-    double p[2], lz;
-    mpm_measure_momentum(s, p, &lz);
-    lua_createtable(L, 0, 2);
-    push_pair(L, p);
-    lua_setfield(L, -2, "linear");
-    set_number(L, "angular", lz);
-    return 1;
-}
-
-static int l_grain(lua_State *L)
-{
-    mpm_scene *s = check_scene(L, 1);
-    size_t id = grain_arg(L, s, 2, "grain");
-    mpm_grain_info g;
-    core_error err;
-    if (mpm_grain(s, id, &g, &err))
-        return bind_raise(L, "grain", &err);
-    lua_createtable(L, 0, 7);
-    set_number(L, "mass", g.mass);
-    push_pair(L, g.center);
-    lua_setfield(L, -2, "center");
-    push_pair(L, g.velocity);
-    lua_setfield(L, -2, "velocity");
-    set_number(L, "angular_momentum", g.angular_momentum);
-    set_number(L, "inertia", g.inertia);
-    set_number(L, "omega", g.omega);
-    lua_pushinteger(L, (lua_Integer)g.points);
-    lua_setfield(L, -2, "points");
-    return 1;
-}
-
-static int l_points(lua_State *L)
-{
-    mpm_scene *s = check_scene(L, 1);
-    size_t n = mpm_point_count(s);
-    mpm_points p;
-    mpm_get_points(s, &p);
-    lua_createtable(L, 0, 16);
-    bind_push_array(L, p.x, n, "x");
-    bind_push_array(L, p.y, n, "y");
-    bind_push_array(L, p.vx, n, "vx");
-    bind_push_array(L, p.vy, n, "vy");
-    bind_push_array(L, p.mass, n, "mass");
-    static const char *const sig[4] = {"sxx", "syy", "sxy", "szz"};
-    static const char *const F[4] = {"Fxx", "Fxy", "Fyx", "Fyy"};
-    for (int k = 0; k < 4; k++) {
-        bind_push_array(L, p.sigma[k], n, sig[k]);
-        bind_push_array(L, p.F[k], n, F[k]);
-    }
-    bind_push_array(L, p.eps_p, n, "eps_p");
-    bind_push_array(L, p.ux, n, "ux");
-    bind_push_array(L, p.uy, n, "uy");
-    lua_createtable(L, (int)n, 0);
-    for (size_t i = 0; i < n; i++) {
-        lua_pushinteger(L, p.grain[i] + 1);
-        lua_rawseti(L, -2, (lua_Integer)i + 1);
-    }
-    lua_setfield(L, -2, "grain");
-    lua_createtable(L, (int)n, 0);
-    for (size_t i = 0; i < n; i++) {
-        double J = p.F[0][i] * p.F[3][i] - p.F[1][i] * p.F[2][i];
-        lua_pushnumber(L, p.volume0[i] * J);
-        lua_rawseti(L, -2, (lua_Integer)i + 1);
-    }
-    lua_setfield(L, -2, "volume");
-    lua_pushinteger(L, (lua_Integer)n);
-    lua_setfield(L, -2, "count");
-    return 1;
-}
-
 /* m:set_velocities{ vx = {...}, vy = {...} }: one entry per point. */
 static const char *const VELOCITIES_FIELDS[] = {"vx", "vy", NULL};
 
 static int l_set_velocities(lua_State *L)
 {
-    mpm_scene *s = check_scene(L, 1);
+    mpm_scene *s = bind_mpm_check(L, 1);
     bind_check_table(L, 2, "set_velocities");
     bind_check_fields(L, 2, "set_velocities", VELOCITIES_FIELDS);
     size_t n = mpm_point_count(s);
@@ -824,7 +689,7 @@ static int l_set_velocities(lua_State *L)
 
 static int l_info(lua_State *L)
 {
-    mpm_scene *s = check_scene(L, 1);
+    mpm_scene *s = bind_mpm_check(L, 1);
     const mpm_scene_def *d = mpm_def(s);
     lua_createtable(L, 0, 12);
     lua_createtable(L, 2, 0);
@@ -833,55 +698,38 @@ static int l_info(lua_State *L)
         lua_rawseti(L, -2, k + 1);
     }
     lua_setfield(L, -2, "cells");
-    push_pair(L, d->size);
+    bind_mpm_push_pair(L, d->size);
     lua_setfield(L, -2, "size");
-    push_pair(L, d->origin);
+    bind_mpm_push_pair(L, d->origin);
     lua_setfield(L, -2, "origin");
-    push_pair(L, d->gravity);
+    bind_mpm_push_pair(L, d->gravity);
     lua_setfield(L, -2, "gravity");
     double h[2];
     mpm_cell_size(s, h);
-    push_pair(L, h);
+    bind_mpm_push_pair(L, h);
     lua_setfield(L, -2, "cell_size");
     lua_pushinteger(L, (lua_Integer)mpm_point_count(s));
     lua_setfield(L, -2, "points");
     lua_pushinteger(L, (lua_Integer)mpm_grain_count(s));
     lua_setfield(L, -2, "grains");
-    set_number(L, "time", mpm_time(s));
+    bind_mpm_set_number(L, "time", mpm_time(s));
     lua_pushinteger(L, mpm_steps_done(s));
     lua_setfield(L, -2, "steps");
     lua_pushstring(L, UPDATE_NAMES[d->update]);
     lua_setfield(L, -2, "update");
-    set_number(L, "pic", d->pic);
+    bind_mpm_set_number(L, "pic", d->pic);
     lua_pushstring(L, mpm_contact(s) == MPM_CONTACT_NOSLIP ? "noslip" : "friction");
     lua_setfield(L, -2, "contact");
-    set_number(L, "mu", mpm_friction(s));
+    bind_mpm_set_number(L, "mu", mpm_friction(s));
     lua_pushstring(L, SHAPE_NAMES[d->shape]);
     lua_setfield(L, -2, "shape");
     mpm_contact_options o = mpm_get_contact_options(s);
     lua_pushstring(L, NORMAL_NAMES[o.normals]);
     lua_setfield(L, -2, "normals");
-    set_number(L, "separation", o.separation);
-    set_number(L, "strain_cap", o.strain_cap);
+    bind_mpm_set_number(L, "separation", o.separation);
+    bind_mpm_set_number(L, "strain_cap", o.strain_cap);
     lua_pushboolean(L, o.conserve);
     lua_setfield(L, -2, "conserve");
-    return 1;
-}
-
-static int l_timings(lua_State *L)
-{
-    mpm_scene *s = check_scene(L, 1);
-    double sec[MPM_NSTAGES], total = 0;
-    long steps;
-    mpm_timings(s, sec, &steps);
-    lua_createtable(L, 0, MPM_NSTAGES + 2);
-    for (int k = 0; k < MPM_NSTAGES; k++) {
-        set_number(L, mpm_stage_names[k], sec[k]);
-        total += sec[k];
-    }
-    set_number(L, "total", total);
-    lua_pushinteger(L, steps);
-    lua_setfield(L, -2, "steps");
     return 1;
 }
 
@@ -941,13 +789,6 @@ void bind_open_mpm(lua_State *L)
          "A rigid half-space not aligned with the grid (at most 4): the nodes behind the plane "
          "(normal points out of the body, into the material) take the wall rule with the "
          "plane's exact normal; the nodes form a staircase along it."},
-        {"field", l_field,
-         "m:field('vx'|'vy'|'speed'|'ux'|'uy'|'displacement'|'sxx'|'syy'|'sxy'|'pressure'|'psd'|"
-         "'eps_p'|'grain'|'mass')",
-         "A cell field: the mass-weighted mean over the points in each cell (nan in empty "
-         "cells; 'mass' sums). psd is the principal stress difference sigma_1 - sigma_2. "
-         "Returns {nx, ny, origin, size, values} (row-major, x fastest), ready for "
-         "render.field."},
         {"contact", l_contact,
          "m:contact{ model = 'noslip' | 'friction', mu = 0.3, normals = 'averaged'|'own'|'linear', "
          "separation = 0, strain_cap = 0, conserve = true }",
@@ -986,32 +827,11 @@ void bind_open_mpm(lua_State *L)
          "nil shows it once the run has taken 2 s, true at once, false never (--quiet: never). "
          "From on_step, calls that would invalidate the run (a nested run, close, ...) are "
          "refused."},
-        {"measure", l_measure, "m:measure('energy'|'momentum'|'columns'|'shear')",
-         "energy: kinetic, elastic (Hencky stored energy), plastic (plastic work), potential "
-         "(gravity), total; per unit depth (J/m). momentum: linear = {px, py}, angular (about "
-         "the origin). columns: {x, uy}, the mass-weighted mean vertical displacement per "
-         "column of cells (the paper's Fig. 8). shear: the material's average shear strain, "
-         "the mass-weighted least-squares slope d u_y / d x of the displacements."},
-        {"grain", l_grain, "m:grain(id)",
-         "mass, center (centre of mass), velocity, angular_momentum (about the centre of mass), "
-         "inertia, omega (= angular_momentum / inertia) and points of grain id."},
-        {"points", l_points, "m:points()",
-         "Arrays over the material points: x, y, vx, vy, ux, uy (displacement), mass, volume, "
-         "grain, sxx, syy, sxy, szz (Cauchy stress, tension positive), Fxx, Fxy, Fyx, Fyy, "
-         "eps_p; and count."},
         {"set_velocities", l_set_velocities, "m:set_velocities{ vx = {...}, vy = {...} }",
          "Sets every point's velocity from arrays in point order (as m:points() lists them)."},
         {"info", l_info, "m:info()",
          "cells, size, origin, cell_size, gravity, points, grains, time, steps, update, pic, "
          "contact, mu (0 for noslip), shape, normals, separation, strain_cap, conserve."},
-        {"timings", l_timings, "m:timings()",
-         "Wall seconds spent in each stage of the step, summed over the steps run since the "
-         "scene was created or loaded: stencil (0 with friction: p2g takes it), p2g (particle to "
-         "grid, with the grain fields), "
-         "normals (contact normals), grid (momentum update and walls), contact (the contact "
-         "rule), g2p (grid to particle), remap (MUSL), material (stress update), check (the "
-         "end-of-step checks); total, and steps. Read on thread 0 once per stage per step "
-         "(scripts/bench/mpm_shear.lua prints them)."},
         {NULL, NULL, NULL, NULL}};
     static const luaL_Reg meta[] = {
         {"__gc", l_gc}, {"__close", l_gc}, {"__tostring", l_tostring}, {NULL, NULL}};
@@ -1024,12 +844,9 @@ void bind_open_mpm(lua_State *L)
                                                 {"timestep", NULL, TIMESTEP_FIELDS},
                                                 {"run", NULL, RUN_FIELDS},
                                                 {"set_velocities", NULL, VELOCITIES_FIELDS},
-                                                {"measure", "energy", NO_FIELDS},
-                                                {"measure", "momentum", NO_FIELDS},
-                                                {"measure", "columns", NO_FIELDS},
-                                                {"measure", "shear", NO_FIELDS},
                                                 {NULL, NULL, NULL}};
     bind_type_fields(L, SCENE, method_fields);
+    bind_open_mpm_measure(L);
 
     luaL_newmetatable(L, MATERIAL);
     bind_doc(L, -1, MATERIAL, MATERIAL,

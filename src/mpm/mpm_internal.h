@@ -67,7 +67,7 @@ struct mpm_scene {
     double *lzz;
     bool lzz_ok;
     /* the stress update and G2P one point at a time, for the tests: the reference of their
-     * lanes (constitutive and to_points in step.c); false (calloc) otherwise */
+     * lanes (constitutive in stress.c, to_points in transfer.c); false (calloc) otherwise */
     bool no_lanes;
     int *grain, *mat;
     /* stencil, MPM_STENCIL per point */
@@ -89,7 +89,7 @@ struct mpm_scene {
     mpm_contact_options opt;
     double *pnx, *pny;      /* sum_p m_p G_pi over the grain: its outward normal direction */
     int *ngr;               /* grains touching node i (nnodes) */
-    /* Each node's pairs in pair order, rebuilt every step (step.c, pair_chains): nhead, the
+    /* Each node's pairs in pair order, rebuilt every step (contact.c, pair_chains): nhead, the
      * node's first pair or -1 (nnodes); pnext, the next pair at the same node or -1; pshared:
      * pair q is at a node of two or more grains. The threads add up a node's pairs along its
      * chain, each over its own range of nodes, so that no pass over all pairs is serial. */
@@ -103,40 +103,15 @@ struct mpm_scene {
     size_t *gstart, *gcount;
     mpm_grain_def *gdef;    /* each grain's shape, for the overlap warning */
 
-    /* threads: nt contiguous point ranges [tp[t], tp[t+1]) aligned to grains (tg[t] the first
-     * grain of range t), so that a grain's points, its per-grain field entries and the nodes
-     * only it touches belong to one thread; thread t's pairs (friction) are [tq[t], tq[t] +
-     * tc[t]) with tq[t] = ns tp[t], in grain order, gaps between the threads' ranges;
-     * per-thread scratch: marks (nt x nnodes) */
-    int nt, ntcap;
-    size_t *tp, *tg, *tq, *tc;
-    int *tmark;             /* nt x (nnodes + 1), the last of each -1 */
-    unsigned char *tnear;   /* nt x nnodes, zero outside grain_finish */
-    /* per-thread scratch of the frictional scatter: one record per (grain, node) pair of the
-     * grain being scattered (its sums, see grain_scatter), reccap records per thread */
-    struct mpm_pair_rec *trec;
-    int *tfin;              /* and reccap ints: a grain's pairs' final stencil entries */
-    size_t reccap;
-    struct mpm_point_fac *tfac; /* and the factors of a grain's points, faccap per thread */
-    size_t faccap;
-    size_t *gps, *gpc, gpcap; /* grain g's pairs: gpc[g] from tq[its thread] + gps[g] */
-    /* The noslip transfers' chunks: nc grain-aligned point ranges [cp[c], cp[c+1]); thread t
-     * scatters chunks t, t + nt, ... each into its own node records (to_grid: nrec, nnodes per
-     * chunk; the remap and USF: tbuf, x and y per node, 2 nnodes doubles per chunk), added up in
-     * chunk order into the nodal arrays. nc is the processor count in auto mode whatever the
-     * thread count of the moment (so the tuner may run a noslip step on one thread: the same
-     * bits), else the thread count. */
-    int nc, nccap;
-    size_t *cp;
-    double *tbuf;
-    struct mpm_node_rec *nrec;
-
     mpm_contact_model contact;
     double time;
     long steps;
-    double tstage[MPM_NSTAGES]; /* mpm_timings */
-    long tsteps;
+    /* the step's threads, scratch and timings (step_internal.h), made by the first run */
+    struct mpm_step *step;
 };
+
+/* Frees the step context of mpm_scene.step (step.c); NULL is a no-op. */
+void mpm_step_free(struct mpm_step *c);
 
 /* Sizes the per-grain field arrays for the current points (called before a run with contact
  * "friction"; no allocation happens inside the step loop). */

@@ -87,9 +87,9 @@ static core_status plane_reference(mpm_scene *s, int k, core_error *err)
     return CORE_OK;
 }
 
-core_status mpm_create(const mpm_scene_def *def, mpm_scene **out, core_error *err)
+/* The scene definition's values, and a grid whose creation fields fit in memory. */
+static core_status check_scene_def(const mpm_scene_def *def, core_error *err)
 {
-    *out = NULL;
     for (int d = 0; d < 2; d++) {
         if (def->cells[d] < 1 || def->cells[d] > 1 << 20)
             return core_fail(err, CORE_ERR_ARG, "cells[%d] must be in [1, 1048576], got %d", d + 1,
@@ -130,12 +130,56 @@ core_status mpm_create(const mpm_scene_def *def, mpm_scene **out, core_error *er
         double nodes = (def->cells[0] + 3.0) * (def->cells[1] + 3.0);
         double bytes = nodes * (9 * sizeof(double) + 2);
         if (bytes > budget)
-            return core_fail(err, CORE_ERR_ARG,
-                             "cells %d x %d need %.3g bytes of grid fields, above the limit of "
-                             "%.3g bytes (the machine's memory, or GRAINLAB_MEMORY_LIMIT); use fewer cells "
-                             "(field 'cells')",
-                             def->cells[0], def->cells[1], bytes, budget);
+            return core_fail(
+                err, CORE_ERR_ARG,
+                "cells %d x %d need %.3g bytes of grid fields, above the limit of "
+                "%.3g bytes (the machine's memory, or GRAINLAB_MEMORY_LIMIT); use fewer cells "
+                "(field 'cells')",
+                def->cells[0], def->cells[1], bytes, budget);
     }
+    return CORE_OK;
+}
+
+/* The grid's edges as planes 0-3 (n into the wall); their nodes are the boundary rows and
+ * columns and the ghost layers beyond them, on axes that are not periodic. */
+static void edge_planes(mpm_scene *s)
+{
+    const mpm_scene_def *def = &s->def;
+    static const double normals[4][2] = {{-1, 0}, {1, 0}, {0, -1}, {0, 1}};
+    for (int k = 0; k < 4; k++) {
+        mpm_plane *pl = &s->planes[k];
+        pl->kind = def->periodic[k / 2] ? MPM_WALL_NONE : def->walls[k];
+        pl->n[0] = normals[k][0];
+        pl->n[1] = normals[k][1];
+        pl->v[0] = def->wall_velocity[k][0];
+        pl->v[1] = def->wall_velocity[k][1];
+        pl->mu = def->wall_mu[k];
+    }
+    s->nplanes = 4;
+    for (int j = 0; j < s->nny; j++)
+        for (int i = 0; i < s->nnx; i++) {
+            unsigned char w = 0;
+            int gi = i - s->gl[0], gj = j - s->gl[1];
+            if (!def->periodic[0] && gi <= 0 && s->planes[MPM_LEFT].kind != MPM_WALL_NONE)
+                w |= 1u << MPM_LEFT;
+            if (!def->periodic[0] && gi >= def->cells[0] &&
+                s->planes[MPM_RIGHT].kind != MPM_WALL_NONE)
+                w |= 1u << MPM_RIGHT;
+            if (!def->periodic[1] && gj <= 0 && s->planes[MPM_BOTTOM].kind != MPM_WALL_NONE)
+                w |= 1u << MPM_BOTTOM;
+            if (!def->periodic[1] && gj >= def->cells[1] &&
+                s->planes[MPM_TOP].kind != MPM_WALL_NONE)
+                w |= 1u << MPM_TOP;
+            s->nwall[(size_t)j * s->nnx + i] = w;
+        }
+}
+
+core_status mpm_create(const mpm_scene_def *def, mpm_scene **out, core_error *err)
+{
+    *out = NULL;
+    core_status st = check_scene_def(def, err);
+    if (st)
+        return st;
     mpm_scene *s = calloc(1, sizeof *s);
     if (!s)
         return core_fail(err, CORE_ERR_NOMEM, "out of memory for the scene");
@@ -164,35 +208,7 @@ core_status mpm_create(const mpm_scene_def *def, mpm_scene **out, core_error *er
         mpm_destroy(s);
         return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu grid nodes", s->nnodes);
     }
-    /* The grid's edges as planes 0-3 (n into the wall); their nodes are the boundary rows and
-     * columns and the ghost layers beyond them, on axes that are not periodic. */
-    static const double normals[4][2] = {{-1, 0}, {1, 0}, {0, -1}, {0, 1}};
-    for (int k = 0; k < 4; k++) {
-        mpm_plane *pl = &s->planes[k];
-        pl->kind = def->periodic[k / 2] ? MPM_WALL_NONE : def->walls[k];
-        pl->n[0] = normals[k][0];
-        pl->n[1] = normals[k][1];
-        pl->v[0] = def->wall_velocity[k][0];
-        pl->v[1] = def->wall_velocity[k][1];
-        pl->mu = def->wall_mu[k];
-    }
-    s->nplanes = 4;
-    for (int j = 0; j < s->nny; j++)
-        for (int i = 0; i < s->nnx; i++) {
-            unsigned char w = 0;
-            int gi = i - s->gl[0], gj = j - s->gl[1];
-            if (!def->periodic[0] && gi <= 0 && s->planes[MPM_LEFT].kind != MPM_WALL_NONE)
-                w |= 1u << MPM_LEFT;
-            if (!def->periodic[0] && gi >= def->cells[0] &&
-                s->planes[MPM_RIGHT].kind != MPM_WALL_NONE)
-                w |= 1u << MPM_RIGHT;
-            if (!def->periodic[1] && gj <= 0 && s->planes[MPM_BOTTOM].kind != MPM_WALL_NONE)
-                w |= 1u << MPM_BOTTOM;
-            if (!def->periodic[1] && gj >= def->cells[1] &&
-                s->planes[MPM_TOP].kind != MPM_WALL_NONE)
-                w |= 1u << MPM_TOP;
-            s->nwall[(size_t)j * s->nnx + i] = w;
-        }
+    edge_planes(s);
     s->opt = mpm_default_contact_options();
     for (int k = 0; k < 4; k++)
         s->slack[k / 2][k % 2] =
@@ -201,8 +217,7 @@ core_status mpm_create(const mpm_scene_def *def, mpm_scene **out, core_error *er
         /* the grid edge's plane passes through the edge */
         s->planes[k].point[0] = def->origin[0] + (k == MPM_RIGHT ? def->size[0] : 0);
         s->planes[k].point[1] = def->origin[1] + (k == MPM_TOP ? def->size[1] : 0);
-        core_status st = plane_reference(s, k, err);
-        if (st) {
+        if ((st = plane_reference(s, k, err))) {
             mpm_destroy(s);
             return st;
         }
@@ -261,20 +276,7 @@ void mpm_destroy(mpm_scene *s)
     free(s->gstart);
     free(s->gcount);
     free(s->gdef);
-    free(s->tp);
-    free(s->tg);
-    free(s->tq);
-    free(s->tc);
-    free(s->tmark);
-    free(s->trec);
-    free(s->tfin);
-    free(s->gps);
-    free(s->gpc);
-    free(s->tfac);
-    free(s->tnear);
-    free(s->tbuf);
-    free(s->nrec);
-    free(s->cp);
+    mpm_step_free(s->step);
     free(s);
 }
 
@@ -368,61 +370,50 @@ static bool inside(const mpm_grain_def *g, double x, double y)
     return x >= g->lo[0] && x <= g->hi[0] && y >= g->lo[1] && y <= g->hi[1];
 }
 
-long mpm_add_grain(mpm_scene *s, const mpm_grain_def *g, core_error *err)
+/* The grain's material, points per cell and shape, and its bounding box [lo, hi]: inside the
+ * grid on an axis that is not periodic (unless clipped), shorter than a periodic axis. */
+static core_status grain_bounds(const mpm_scene *s, const mpm_grain_def *g, double lo[2],
+                                double hi[2], core_error *err)
 {
     const mpm_scene_def *d = &s->def;
-    if (g->material < 0 || g->material >= s->nmat) {
-        core_fail(err, CORE_ERR_ARG, "material index %d is not in the scene", g->material);
-        return -1;
-    }
-    if (g->points_per_cell < 1 || g->points_per_cell > 64) {
-        core_fail(err, CORE_ERR_ARG, "points per cell must be in [1, 64], got %d",
-                  g->points_per_cell);
-        return -1;
-    }
-    double lo[2], hi[2];
+    if (g->material < 0 || g->material >= s->nmat)
+        return core_fail(err, CORE_ERR_ARG, "material index %d is not in the scene", g->material);
+    if (g->points_per_cell < 1 || g->points_per_cell > 64)
+        return core_fail(err, CORE_ERR_ARG, "points per cell must be in [1, 64], got %d",
+                         g->points_per_cell);
     if (g->shape == MPM_POLYGON) {
-        if (g->nvertices < 3 || !g->vertices) {
-            core_fail(err, CORE_ERR_ARG, "a polygon needs at least 3 vertices, got %d",
-                      g->nvertices);
-            return -1;
-        }
+        if (g->nvertices < 3 || !g->vertices)
+            return core_fail(err, CORE_ERR_ARG, "a polygon needs at least 3 vertices, got %d",
+                             g->nvertices);
         double area = 0;
         lo[0] = lo[1] = INFINITY;
         hi[0] = hi[1] = -INFINITY;
         for (int i = 0, j = g->nvertices - 1; i < g->nvertices; j = i++) {
             const double *v = g->vertices;
-            if (!isfinite(v[2 * i]) || !isfinite(v[2 * i + 1])) {
-                core_fail(err, CORE_ERR_ARG, "vertex %d of the polygon is not finite", i + 1);
-                return -1;
-            }
+            if (!isfinite(v[2 * i]) || !isfinite(v[2 * i + 1]))
+                return core_fail(err, CORE_ERR_ARG, "vertex %d of the polygon is not finite",
+                                 i + 1);
             area += v[2 * j] * v[2 * i + 1] - v[2 * i] * v[2 * j + 1];
             for (int a = 0; a < 2; a++) {
                 lo[a] = fmin(lo[a], v[2 * i + a]);
                 hi[a] = fmax(hi[a], v[2 * i + a]);
             }
         }
-        if (!(fabs(area) > 0)) {
-            core_fail(err, CORE_ERR_ARG, "the polygon has zero area (collinear vertices)");
-            return -1;
-        }
+        if (!(fabs(area) > 0))
+            return core_fail(err, CORE_ERR_ARG, "the polygon has zero area (collinear vertices)");
     } else if (g->shape == MPM_DISK) {
-        if (!(g->radius > 0) || !isfinite(g->radius)) {
-            core_fail(err, CORE_ERR_ARG, "radius must be > 0, got %g", g->radius);
-            return -1;
-        }
+        if (!(g->radius > 0) || !isfinite(g->radius))
+            return core_fail(err, CORE_ERR_ARG, "radius must be > 0, got %g", g->radius);
         for (int a = 0; a < 2; a++) {
             lo[a] = g->center[a] - g->radius;
             hi[a] = g->center[a] + g->radius;
         }
     } else {
         for (int a = 0; a < 2; a++) {
-            if (!(g->hi[a] > g->lo[a])) {
-                core_fail(err, CORE_ERR_ARG,
-                          "the rectangle's upper corner must be above the "
-                          "lower one on every axis");
-                return -1;
-            }
+            if (!(g->hi[a] > g->lo[a]))
+                return core_fail(err, CORE_ERR_ARG,
+                                 "the rectangle's upper corner must be above the "
+                                 "lower one on every axis");
             lo[a] = g->lo[a];
             hi[a] = g->hi[a];
         }
@@ -430,20 +421,30 @@ long mpm_add_grain(mpm_scene *s, const mpm_grain_def *g, core_error *err)
     static const char *const axis[2] = {"x", "y"};
     for (int a = 0; a < 2; a++) {
         double glo = d->origin[a], ghi = d->origin[a] + d->size[a];
-        if (d->periodic[a] && hi[a] - lo[a] >= d->size[a]) {
-            core_fail(err, CORE_ERR_ARG,
-                      "the shape spans %g in %s, not less than the periodic "
-                      "length %g",
-                      hi[a] - lo[a], axis[a], d->size[a]);
-            return -1;
-        }
-        if (!d->periodic[a] && !g->clip && (lo[a] < glo || hi[a] > ghi)) {
-            core_fail(err, CORE_ERR_ARG,
-                      "the shape spans [%g, %g] in %s, outside the grid [%g, %g]", lo[a], hi[a],
-                      axis[a], glo, ghi);
-            return -1;
-        }
+        if (d->periodic[a] && hi[a] - lo[a] >= d->size[a])
+            return core_fail(err, CORE_ERR_ARG,
+                             "the shape spans %g in %s, not less than the periodic "
+                             "length %g",
+                             hi[a] - lo[a], axis[a], d->size[a]);
+        if (!d->periodic[a] && !g->clip && (lo[a] < glo || hi[a] > ghi))
+            return core_fail(err, CORE_ERR_ARG,
+                             "the shape spans [%g, %g] in %s, outside the grid [%g, %g]", lo[a],
+                             hi[a], axis[a], glo, ghi);
     }
+    return CORE_OK;
+}
+
+/* The sub-cells of size dx x dy whose centres may hold the grain's points: [i0, i1] x [j0, j1]
+ * over the bounding box [lo, hi], within the grid if clipped. */
+typedef struct {
+    double dx, dy;
+    long i0, i1, j0, j1;
+} grain_cells;
+
+static grain_cells cells_of(const mpm_scene *s, const mpm_grain_def *g, const double lo[2],
+                            const double hi[2])
+{
+    const mpm_scene_def *d = &s->def;
     /* Points at the centres of n x n sub-cells of every grid cell, kept when inside the shape. */
     const int n = g->points_per_cell;
     const double dx = s->hx / n, dy = s->hy / n;
@@ -462,65 +463,50 @@ long mpm_add_grain(mpm_scene *s, const mpm_grain_def *g, core_error *err)
             j1 = j1 > n0[1] ? n0[1] : j1;
         }
     }
-    size_t count = 0;
-    double cx = 0, cy = 0;
-    for (long j = j0; j <= j1; j++)
-        for (long i = i0; i <= i1; i++) {
-            double x = d->origin[0] + (i + 0.5) * dx, y = d->origin[1] + (j + 0.5) * dy;
-            if (inside(g, x, y)) {
-                count++;
-                cx += x;
-                cy += y;
-            }
-        }
-    if (count == 0) {
-        core_fail(err, CORE_ERR_ARG,
-                  "the shape holds no point at %d points per cell (cell %g x %g): "
-                  "make it larger or use more points per cell",
-                  n, s->hx, s->hy);
-        return -1;
+    return (grain_cells){dx, dy, i0, i1, j0, j1};
+}
+
+/* Room for one more grain. */
+static core_status grow_grains(mpm_scene *s, core_error *err)
+{
+    if (s->ngrains < s->gcap)
+        return CORE_OK;
+    size_t cap = s->gcap ? 2 * s->gcap : 16;
+    size_t *a = realloc(s->gstart, cap * sizeof *a);
+    if (!a)
+        return core_fail(err, CORE_ERR_NOMEM, "out of memory for grains");
+    s->gstart = a;
+    size_t *b = realloc(s->gcount, cap * sizeof *b);
+    if (!b)
+        return core_fail(err, CORE_ERR_NOMEM, "out of memory for grains");
+    s->gcount = b;
+    mpm_grain_def *gd = realloc(s->gdef, cap * sizeof *gd);
+    if (!gd)
+        return core_fail(err, CORE_ERR_NOMEM, "out of memory for grains");
+    s->gdef = gd;
+    if (s->gpres) {
+        int *c = realloc(s->gpres, cap * sizeof *c);
+        if (!c)
+            return core_fail(err, CORE_ERR_NOMEM, "out of memory for grains");
+        s->gpres = c;
     }
-    cx /= (double)count;
-    cy /= (double)count;
-    if (reserve_points(s, s->np + count, err))
-        return -1;
-    if (s->ngrains == s->gcap) {
-        size_t cap = s->gcap ? 2 * s->gcap : 16;
-        size_t *a = realloc(s->gstart, cap * sizeof *a);
-        if (!a) {
-            core_fail(err, CORE_ERR_NOMEM, "out of memory for grains");
-            return -1;
-        }
-        s->gstart = a;
-        size_t *b = realloc(s->gcount, cap * sizeof *b);
-        if (!b) {
-            core_fail(err, CORE_ERR_NOMEM, "out of memory for grains");
-            return -1;
-        }
-        s->gcount = b;
-        mpm_grain_def *gd = realloc(s->gdef, cap * sizeof *gd);
-        if (!gd) {
-            core_fail(err, CORE_ERR_NOMEM, "out of memory for grains");
-            return -1;
-        }
-        s->gdef = gd;
-        if (s->gpres) {
-            int *c = realloc(s->gpres, cap * sizeof *c);
-            if (!c) {
-                core_fail(err, CORE_ERR_NOMEM, "out of memory for grains");
-                return -1;
-            }
-            s->gpres = c;
-        }
-        s->gcap = cap;
-    }
-    if (s->gpres)
-        s->gpres[s->ngrains] = -1;
+    s->gcap = cap;
+    return CORE_OK;
+}
+
+/* The grain's points at the centres of its sub-cells inside the shape, from point np on, at
+ * rest in their reference state but for a rigid motion about their centroid (cx, cy); returns
+ * a point's mass. */
+static double fill_grain(mpm_scene *s, const mpm_grain_def *g, const grain_cells *b, double cx,
+                         double cy)
+{
+    const mpm_scene_def *d = &s->def;
+    const double dx = b->dx, dy = b->dy;
     const mpm_material *mat = &s->mats[g->material];
     const double vol = dx * dy, mass = mat->density * vol;
     size_t p = s->np;
-    for (long j = j0; j <= j1; j++)
-        for (long i = i0; i <= i1; i++) {
+    for (long j = b->j0; j <= b->j1; j++)
+        for (long i = b->i0; i <= b->i1; i++) {
             double x = d->origin[0] + (i + 0.5) * dx, y = d->origin[1] + (j + 0.5) * dy;
             if (!inside(g, x, y))
                 continue;
@@ -549,6 +535,45 @@ long mpm_add_grain(mpm_scene *s, const mpm_grain_def *g, core_error *err)
             s->mat[p] = g->material;
             p++;
         }
+    return mass;
+}
+
+long mpm_add_grain(mpm_scene *s, const mpm_grain_def *g, core_error *err)
+{
+    const mpm_scene_def *d = &s->def;
+    double lo[2], hi[2];
+    if (grain_bounds(s, g, lo, hi, err))
+        return -1;
+    const grain_cells b = cells_of(s, g, lo, hi);
+    const double dx = b.dx, dy = b.dy;
+    const int n = g->points_per_cell;
+    size_t count = 0;
+    double cx = 0, cy = 0;
+    for (long j = b.j0; j <= b.j1; j++)
+        for (long i = b.i0; i <= b.i1; i++) {
+            double x = d->origin[0] + (i + 0.5) * dx, y = d->origin[1] + (j + 0.5) * dy;
+            if (inside(g, x, y)) {
+                count++;
+                cx += x;
+                cy += y;
+            }
+        }
+    if (count == 0) {
+        core_fail(err, CORE_ERR_ARG,
+                  "the shape holds no point at %d points per cell (cell %g x %g): "
+                  "make it larger or use more points per cell",
+                  n, s->hx, s->hy);
+        return -1;
+    }
+    cx /= (double)count;
+    cy /= (double)count;
+    if (reserve_points(s, s->np + count, err))
+        return -1;
+    if (grow_grains(s, err))
+        return -1;
+    if (s->gpres)
+        s->gpres[s->ngrains] = -1;
+    const double mass = fill_grain(s, g, &b, cx, cy);
     s->gdef[s->ngrains] = *g;
     if (g->shape == MPM_POLYGON) { /* keep the bounding box, not the caller's vertices */
         s->gdef[s->ngrains].shape = MPM_RECT;
@@ -560,7 +585,7 @@ long mpm_add_grain(mpm_scene *s, const mpm_grain_def *g, core_error *err)
     }
     s->gstart[s->ngrains] = s->np;
     s->gcount[s->ngrains] = count;
-    s->np = p;
+    s->np += count;
     s->lzz_ok = false;
     /* Nodes lighter than 1e-12 of the lightest point take no acceleration (no division blow-up). */
     if (s->m_min == 0 || 1e-12 * mass < s->m_min)

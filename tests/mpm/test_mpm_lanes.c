@@ -1,6 +1,6 @@
 /* The MPM step's lanes against their scalar reference (the same scene with no_lanes,
  * mpm_internal.h), bit for bit, point by point: the stress update (constitutive in
- * src/mpm/step.c: blocks of points, two at a time in SSE2 lanes, the logarithms scalar, the
+ * src/mpm/stress.c: blocks of points, two at a time in SSE2 lanes, the logarithms scalar, the
  * possibly plastic points and the end-of-step check's suspects finished one at a time; the
  * reference is material_update_zz point by point) and G2P (to_points: two points at a time, the
  * last one of an odd range alone; the reference one at a time). The scenes hold what the lanes
