@@ -12,11 +12,12 @@ cd "$(dirname "$0")"
 # Debian packages: compiler and build tools, the libraries grainlab links, jq (tests read
 # report JSON with it), python3-vtk9 and python3-numpy (tests open the VTK files with VTK's
 # readers, whose array access needs numpy, a package --no-install-recommends leaves out) and
-# Open MPI (distributed runs: mpirun -np K grainlab script.lua). scripts/fresh_machine.sh checks
-# this list on a clean Debian 12 root.
+# Open MPI (distributed runs: mpirun -np K grainlab script.lua), universal-ctags (the test
+# src_lengths measures functions with it). scripts/fresh_machine.sh checks this list on a clean
+# Debian 12 root.
 packages=(build-essential cmake pkg-config liblua5.4-dev libreadline-dev libosmesa6-dev
           libpng-dev libfreetype-dev fonts-dejavu-core libcmocka-dev jq libqhull-dev
-          python3-vtk9 python3-numpy libopenmpi-dev openmpi-bin)
+          python3-vtk9 python3-numpy libopenmpi-dev openmpi-bin universal-ctags)
 
 install_packages() {
     local missing=()

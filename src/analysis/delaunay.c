@@ -237,53 +237,72 @@ static core_status duplicate_error(const double *x, const double *y, size_t np, 
                      sqrt(d2min));
 }
 
-core_status analysis_delaunay(const double *x, const double *y, size_t np,
-                              const analysis_delaunay_def *def, analysis_mesh **out,
-                              core_error *err)
+/* The working arrays of the peeling, over the nt triangles tri of np particles. */
+typedef struct peel_work {
+    const long *tri;
+    size_t np, nt;
+    unsigned char *used;      /* particle is a vertex */
+    long *bcount;             /* boundary edges at each particle */
+    size_t *inc_start, *fill; /* CSR lists of the triangles at each particle */
+    long *inc;
+    long *nb; /* the neighbour across each edge, -1: none */
+    unsigned char *alive, *queued;
+    long *stack;
+} peel_work;
+
+static void work_free(peel_work *w)
 {
-    analysis_delaunay_def d = def ? *def : analysis_default_delaunay_def();
-    if (!(d.alpha >= 0) || !isfinite(d.alpha))
-        return core_fail(err, CORE_ERR_ARG, "alpha must be >= 0 (0: keep the convex hull), got %g",
-                         d.alpha);
-    core_status st = check_points(x, y, np, err);
-    if (st)
-        return st;
-    for (size_t i = 0; d.radius && i < np; i++)
-        if (!(d.radius[i] > 0) || !isfinite(d.radius[i]))
-            return core_fail(err, CORE_ERR_ARG,
-                             "particle %zu has radius %g: the alpha rule needs "
-                             "positive finite radii",
-                             i + 1, d.radius[i]);
-    long *tri = NULL;
-    size_t nt = 0;
-    if ((st = run_qhull(x, y, np, &tri, &nt, err)))
-        return st;
+    free(w->used);
+    free(w->bcount);
+    free(w->inc_start);
+    free(w->fill);
+    free(w->inc);
+    free(w->nb);
+    free(w->alive);
+    free(w->queued);
+    free(w->stack);
+}
 
-    /* Every particle must be a vertex: one that is not lies (within qhull's precision) on top
-     * of another. */
-    unsigned char *used = calloc(np, 1);
-    long *bcount = calloc(np, sizeof *bcount);
-    size_t *inc_start = calloc(np + 1, sizeof *inc_start), *fill = calloc(np, sizeof *fill);
-    long *inc = malloc(3 * nt * sizeof *inc);
-    long *nb = malloc(3 * nt * sizeof *nb);
-    unsigned char *alive = malloc(nt), *queued = calloc(nt ? nt : 1, 1);
-    long *stack = malloc(nt * sizeof *stack);
-    analysis_mesh *m = calloc(1, sizeof *m);
-    if (!used || !bcount || !inc_start || !fill || !inc || !nb || !alive || !queued || !stack ||
-        !m) {
-        st = core_fail(err, CORE_ERR_NOMEM, "out of memory for the mesh of %zu particles", np);
-        goto done;
-    }
-    for (size_t k = 0; k < 3 * nt; k++)
-        used[tri[k]] = 1;
-    for (size_t i = 0; i < np; i++)
-        if (!used[i]) {
-            st = duplicate_error(x, y, np, i, err);
-            goto done;
-        }
+/* Returns 0 when out of memory (what was allocated is in w, for work_free). */
+static int work_alloc(peel_work *w, const long *tri, size_t np, size_t nt)
+{
+    w->tri = tri;
+    w->np = np;
+    w->nt = nt;
+    w->used = calloc(np, 1);
+    w->bcount = calloc(np, sizeof *w->bcount);
+    w->inc_start = calloc(np + 1, sizeof *w->inc_start);
+    w->fill = calloc(np, sizeof *w->fill);
+    w->inc = malloc(3 * nt * sizeof *w->inc);
+    w->nb = malloc(3 * nt * sizeof *w->nb);
+    w->alive = malloc(nt);
+    w->queued = calloc(nt ? nt : 1, 1);
+    w->stack = malloc(nt * sizeof *w->stack);
+    return w->used && w->bcount && w->inc_start && w->fill && w->inc && w->nb && w->alive &&
+           w->queued && w->stack;
+}
 
-    /* Neighbours across each edge k = (v[k], v[k+1]): the other triangle at vertex a that
-     * also has b (triangles per vertex in CSR lists; a vertex has about 6). */
+/* Every particle must be a vertex: one that is not lies (within qhull's precision) on top of
+ * another. */
+static core_status check_vertices(const double *x, const double *y, peel_work *w, core_error *err)
+{
+    for (size_t k = 0; k < 3 * w->nt; k++)
+        w->used[w->tri[k]] = 1;
+    for (size_t i = 0; i < w->np; i++)
+        if (!w->used[i])
+            return duplicate_error(x, y, w->np, i, err);
+    return CORE_OK;
+}
+
+/* Neighbours across each edge k = (v[k], v[k+1]): the other triangle at vertex a that also has b
+ * (triangles per vertex in CSR lists; a vertex has about 6); every triangle alive, and the
+ * boundary edges counted at their particles. */
+static void edge_neighbours(peel_work *w)
+{
+    const long *tri = w->tri;
+    const size_t np = w->np, nt = w->nt;
+    size_t *inc_start = w->inc_start, *fill = w->fill;
+    long *inc = w->inc, *nb = w->nb;
     for (size_t q = 0; q < 3 * nt; q++)
         inc_start[tri[q] + 1]++;
     for (size_t i = 0; i < np; i++)
@@ -291,7 +310,7 @@ core_status analysis_delaunay(const double *x, const double *y, size_t np,
     for (size_t q = 0; q < 3 * nt; q++)
         inc[fill[tri[q]]++ + inc_start[tri[q]]] = (long)(q / 3);
     for (size_t t = 0; t < nt; t++) {
-        alive[t] = 1;
+        w->alive[t] = 1;
         for (int k = 0; k < 3; k++) {
             long a = tri[3 * t + k], b = tri[3 * t + (k + 1) % 3], o = -1;
             for (size_t q = inc_start[a]; q < inc_start[a + 1] && o < 0; q++) {
@@ -305,23 +324,31 @@ core_status analysis_delaunay(const double *x, const double *y, size_t np,
     for (size_t t = 0; t < nt; t++)
         for (int k = 0; k < 3; k++)
             if (nb[3 * t + k] < 0) {
-                bcount[tri[3 * t + k]]++;
-                bcount[tri[3 * t + (k + 1) % 3]]++;
+                w->bcount[tri[3 * t + k]]++;
+                w->bcount[tri[3 * t + (k + 1) % 3]]++;
             }
+}
 
-    /* The alpha rule: peel boundary triangles whose outer edge is too long for its pair, and
-     * (whatever alpha) those flat to rounding (see flat()). A triangle can only become
-     * peelable when a neighbour is peeled (bcount never decreases), so the stack holds the
-     * boundary triangles, then the neighbours of each peeled one. A triangle waits on the stack
-     * at most once (queued), which bounds the stack by nt: without that, a small mesh whose
-     * triangles all touch the hull (a square and its centre) pushes nt + 2 x peeled entries and
-     * overflowed it. */
+/* The alpha rule: peel boundary triangles whose outer edge is too long for its pair, and
+ * (whatever alpha) those flat to rounding (see flat()). A triangle can only become
+ * peelable when a neighbour is peeled (bcount never decreases), so the stack holds the
+ * boundary triangles, then the neighbours of each peeled one. A triangle waits on the stack
+ * at most once (queued), which bounds the stack by nt: without that, a small mesh whose
+ * triangles all touch the hull (a square and its centre) pushes nt + 2 x peeled entries and
+ * overflowed it. The number peeled goes to *peeled_out. */
+static core_status peel(const double *x, const double *y, const analysis_delaunay_def *dp,
+                        peel_work *w, size_t *peeled_out, core_error *err)
+{
+    const analysis_delaunay_def d = *dp;
+    const long *tri = w->tri, *nb = w->nb;
+    const size_t nt = w->nt;
+    long *bcount = w->bcount, *stack = w->stack;
+    unsigned char *alive = w->alive, *queued = w->queued;
     size_t peeled = 0;
     double rdef = 0;
-    if (d.alpha > 0 && !d.radius && !((rdef = 0.5 * median_edge(x, y, tri, nt)) > 0)) {
-        st = core_fail(err, CORE_ERR_NOMEM, "out of memory for the edges of %zu particles", np);
-        goto done;
-    }
+    if (d.alpha > 0 && !d.radius && !((rdef = 0.5 * median_edge(x, y, tri, nt)) > 0))
+        return core_fail(err, CORE_ERR_NOMEM, "out of memory for the edges of %zu particles",
+                         w->np);
     /* Two passes: the flat triangles first, else an alpha peel next to one can put its third
      * particle on the outline and leave it stuck (a row of centres on a wall). */
     for (int pass = 0; pass < (d.alpha > 0 ? 2 : 1); pass++) {
@@ -373,8 +400,17 @@ core_status analysis_delaunay(const double *x, const double *y, size_t np,
             }
         }
     }
+    *peeled_out = peeled;
+    return CORE_OK;
+}
 
-    /* The kept cells and the boundary loop (each boundary vertex has one outgoing edge). */
+/* The kept cells and the boundary loop (each boundary vertex has one outgoing edge) into m. */
+static core_status build_mesh(const double *x, const double *y, peel_work *w, size_t peeled,
+                              analysis_mesh *m, core_error *err)
+{
+    const long *tri = w->tri, *nb = w->nb;
+    const size_t np = w->np, nt = w->nt;
+    const unsigned char *alive = w->alive;
     m->np = np;
     m->ndelaunay = nt;
     m->npeeled = peeled;
@@ -382,7 +418,7 @@ core_status analysis_delaunay(const double *x, const double *y, size_t np,
     m->tri = malloc((m->ncells ? m->ncells : 1) * 3 * sizeof *m->tri);
     m->x0 = malloc(np * sizeof *m->x0);
     m->y0 = malloc(np * sizeof *m->y0);
-    long *next = stack; /* reuse: next[v] of the boundary, np entries needed */
+    long *next = w->stack; /* reuse: next[v] of the boundary, np entries needed */
     long *nextbuf = NULL;
     if (nt < np) {
         nextbuf = malloc(np * sizeof *nextbuf);
@@ -390,8 +426,7 @@ core_status analysis_delaunay(const double *x, const double *y, size_t np,
     }
     if (!m->tri || !m->x0 || !m->y0 || !next) {
         free(nextbuf);
-        st = core_fail(err, CORE_ERR_NOMEM, "out of memory for the mesh of %zu particles", np);
-        goto done;
+        return core_fail(err, CORE_ERR_NOMEM, "out of memory for the mesh of %zu particles", np);
     }
     memcpy(m->x0, x, np * sizeof *x);
     memcpy(m->y0, y, np * sizeof *y);
@@ -422,8 +457,7 @@ core_status analysis_delaunay(const double *x, const double *y, size_t np,
     m->loop = malloc((nbe ? nbe : 1) * sizeof *m->loop);
     if (!m->loop) {
         free(nextbuf);
-        st = core_fail(err, CORE_ERR_NOMEM, "out of memory for the boundary loop");
-        goto done;
+        return core_fail(err, CORE_ERR_NOMEM, "out of memory for the boundary loop");
     }
     size_t nl = 0;
     for (long v = start; !bad && nl < nbe; nl++) {
@@ -437,25 +471,66 @@ core_status analysis_delaunay(const double *x, const double *y, size_t np,
         }
     }
     free(nextbuf);
-    if (bad || nl != nbe) {
-        st = core_fail(err, CORE_ERR_STATE, "the boundary of the mesh is not one simple loop "
-                       "(%zu edges, a loop of %zu): report this input", nbe, nl);
-        goto done;
-    }
+    if (bad || nl != nbe)
+        return core_fail(err, CORE_ERR_STATE,
+                         "the boundary of the mesh is not one simple loop "
+                         "(%zu edges, a loop of %zu): report this input",
+                         nbe, nl);
     m->nloop = nl;
-    *out = m;
-    m = NULL;
-done:
+    return CORE_OK;
+}
+
+static core_status check_input(const double *x, const double *y, size_t np,
+                               const analysis_delaunay_def *d, core_error *err)
+{
+    if (!(d->alpha >= 0) || !isfinite(d->alpha))
+        return core_fail(err, CORE_ERR_ARG, "alpha must be >= 0 (0: keep the convex hull), got %g",
+                         d->alpha);
+    core_status st = check_points(x, y, np, err);
+    if (st)
+        return st;
+    for (size_t i = 0; d->radius && i < np; i++)
+        if (!(d->radius[i] > 0) || !isfinite(d->radius[i]))
+            return core_fail(err, CORE_ERR_ARG,
+                             "particle %zu has radius %g: the alpha rule needs "
+                             "positive finite radii",
+                             i + 1, d->radius[i]);
+    return CORE_OK;
+}
+
+core_status analysis_delaunay(const double *x, const double *y, size_t np,
+                              const analysis_delaunay_def *def, analysis_mesh **out,
+                              core_error *err)
+{
+    analysis_delaunay_def d = def ? *def : analysis_default_delaunay_def();
+    core_status st = check_input(x, y, np, &d, err);
+    if (st)
+        return st;
+    long *tri = NULL;
+    size_t nt = 0;
+    if ((st = run_qhull(x, y, np, &tri, &nt, err)))
+        return st;
+    peel_work w;
+    memset(&w, 0, sizeof w);
+    int ok = work_alloc(&w, tri, np, nt);
+    analysis_mesh *m = calloc(1, sizeof *m);
+    size_t peeled = 0;
+    if (!ok || !m)
+        st = core_fail(err, CORE_ERR_NOMEM, "out of memory for the mesh of %zu particles", np);
+    if (!st)
+        st = check_vertices(x, y, &w, err);
+    if (!st) {
+        edge_neighbours(&w);
+        st = peel(x, y, &d, &w, &peeled, err);
+    }
+    if (!st)
+        st = build_mesh(x, y, &w, peeled, m, err);
+    if (!st) {
+        *out = m;
+        m = NULL;
+    }
     analysis_mesh_destroy(m);
     free(tri);
-    free(used);
-    free(bcount);
-    free(inc_start);
-    free(fill);
-    free(inc);
-    free(nb);
-    free(alive);
-    free(queued);
-    free(stack);
+    work_free(&w);
     return st;
 }

@@ -69,6 +69,71 @@ void dsmc_order_cells(dsmc_scene *s);
 #define DSMC_SORT_BLOCKS 64
 int dsmc_sort_shift(size_t ncells);
 
+/* The identity order of a cell's N particles (sort.c): P[k] = the slot (from the cell's first) of
+ * the k-th smallest identity. key: N scratch entries (cells of more than 32 only). */
+void dsmc_cell_perm_big(const uint32_t *id, size_t N, uint64_t *key, uint32_t *P);
+static inline void dsmc_cell_perm(const uint32_t *id, size_t N, uint64_t *key, uint32_t *P)
+{
+    if (N > 4) {
+        dsmc_cell_perm_big(id, N, key, P);
+        return;
+    }
+    /* most cells of a dilute gas (Fig. 2's: 0.7 per cell): in place, without a call */
+    for (size_t k = 0; k < N; k++) {
+        uint32_t r = 0, x = id[k];
+        for (size_t j = 0; j < N; j++)
+            r += id[j] < x;
+        P[r] = (uint32_t)k;
+    }
+}
+/* Puts the particles [a, a + N) of one cell in identity order (sort.c). */
+void dsmc_order_cell(dsmc_scene *s, size_t a, size_t N);
+
+/* ---- the stages of a step: flight.c, sort.c, collide.c, driven by dsmc_run (step.c) ---- */
+/* Below this many particles a step is a few hundred microseconds and threads cost more than they
+ * bring (barriers; on a loaded machine, a descheduled thread stalls every step). */
+#define DSMC_PARALLEL_MIN 50000
+/* The purposes of dsmc_stream: a cell's collisions, a wall hit. */
+enum { DSMC_STREAM_COLLIDE = 1, DSMC_STREAM_WALL = 2 };
+
+typedef struct dsmc_flight_totals {
+    long wall_hits;
+    int bad;
+    long stranded;  /* particles still beyond a wall after the bounce budget (put on it) */
+    long strand_id; /* the smallest identity among them (LONG_MAX: none) */
+} dsmc_flight_totals;
+/* Moves every particle by dt (gravity, walls), finds its cell and counts the particles per sort
+ * range (bcount) (flight.c). */
+dsmc_flight_totals dsmc_flight(dsmc_scene *s, double dt, size_t bcount[DSMC_SORT_BLOCKS]);
+
+/* A cell may take at most this many candidate pairs per particle in one step (Eq. 1): about
+ * half as many collisions per particle, i.e. a step some 50 times the cell's collision time.
+ * Beyond it the cell is left alone and the run stops (dsmc_run): the work of a step stays in
+ * proportion to its particles, whatever dt is asked. */
+#define DSMC_CANDIDATES_PER_PARTICLE 100
+
+/* What stops a run after a step completes, reduced over threads and ranks to one culprit each
+ * (a total order: the result does not depend on the thread or rank count). */
+typedef struct dsmc_verdict {
+    int64_t packed_cells, packed_cell, packed_n; /* cells past close packing; the fullest */
+    int64_t capped_cells, capped_cell, capped_n; /* cells over the candidate cap; the worst */
+    double capped_m;                             /* its candidate pairs */
+    int64_t stranded, strand_id;                 /* particles put on a wall; the first id */
+} dsmc_verdict;
+/* No culprit; and a's culprits joined with b's (collide.c). */
+void dsmc_verdict_clear(dsmc_verdict *v);
+void dsmc_verdict_merge(dsmc_verdict *a, const dsmc_verdict *b);
+
+typedef struct dsmc_collide_totals {
+    long attempts, collisions, raised, overpacked;
+    long overflow; /* cells whose number of candidates was not a number (speeds overflowed) */
+} dsmc_collide_totals;
+/* The collisions of Eq. 1 in every cell of this rank, after the sort; cells past close packing
+ * or over the candidate cap go to *verdict (collide.c). */
+dsmc_collide_totals dsmc_collide(dsmc_scene *s, double dt, dsmc_verdict *verdict);
+/* The most particles whose centres can lie in one cell at the packing limit (collide.c). */
+double dsmc_fit_per_cell(const dsmc_scene *s);
+
 /* Grows the particle arrays to hold n (scene.c); dsmc_resize sets their capacity to cap >= n
  * (returns 0, or -1 when out of memory, the arrays as they were). */
 core_status dsmc_reserve(dsmc_scene *s, size_t n, core_error *err);

@@ -583,153 +583,153 @@ static const char *const VALIDITY_FIELDS[] = {"dt", NULL};
 /* The modes that take no options: a table given to them may hold no key. */
 static const char *const NO_FIELDS[] = {NULL};
 
-static int l_measure(lua_State *L)
+/* measure('temperature') and measure('a2'): the moments, and for a2 also per cell. */
+static int measure_moments(lua_State *L, dsmc_scene *s, int a2_cells)
 {
-    static const char *const what_names[] = {"temperature", "a2", "fields", "histogram", "stats",
-                                             "profile", "validity", NULL};
-    static const char *const *const what_fields[] = {
-        NO_FIELDS, NO_FIELDS, NO_FIELDS, HISTOGRAM_FIELDS, NO_FIELDS, PROFILE_FIELDS,
-        VALIDITY_FIELDS};
-    dsmc_scene *s = check_scene(L, 1);
-    const dsmc_scene_def *d = dsmc_def(s);
-    int D = d->dim;
-    int what = bind_check_option(L, 2, NULL, what_names);
-    int has_opts = bind_mode_options(L, 3, "measure", what_names[what], what_fields[what]);
-    if (what == 1 || what == 2 || what == 3 || what == 5) /* a2, fields, histogram, profile */
-        whole_scene(L, 1, "measure");
-    core_error err;
-    if (what == 0 || what == 1) { /* temperature, a2 */
-        dsmc_moments m;
-        dsmc_measure_moments(s, &m);
-        double N = (double)m.n;
-        lua_createtable(L, 0, 14);
-        set_number(L, "temperature", m.temperature);
-        set_number(L, "t_over_m", m.t_over_m);
-        set_number(L, "kinetic_energy", m.kinetic_energy);
-        push_vec(L, m.momentum, D);
-        lua_setfield(L, -2, "momentum");
-        push_vec(L, m.mean_velocity, D);
-        lua_setfield(L, -2, "mean_velocity");
-        set_number(L, "kurtosis", m.kurtosis);
-        set_number(L, "a2", m.a2);
-        set_number(L, "n", N);
-        set_number(L, "collisions", dsmc_total_collisions(s));
-        set_number(L, "collisions_per_particle", N > 0 ? 2 * dsmc_total_collisions(s) / N : 0);
-        set_number(L, "collision_frequency", dsmc_collision_frequency(s));
-        set_number(L, "time", dsmc_time(s));
-        if (what == 1) {
-            size_t nc = dsmc_cell_count(s);
-            double *a2 = malloc(nc * sizeof *a2);
-            if (!a2)
-                return luaL_error(L, "measure: out of memory");
-            dsmc_fields f = {0};
-            f.a2 = a2;
-            dsmc_measure_fields(s, &f);
-            push_cells(L, s, a2, "cells");
-            free(a2);
-            push_grid(L, s);
-        }
-        return 1;
-    }
-    if (what == 2) { /* fields */
+    const int D = dsmc_def(s)->dim;
+    dsmc_moments m;
+    dsmc_measure_moments(s, &m);
+    double N = (double)m.n;
+    lua_createtable(L, 0, 14);
+    set_number(L, "temperature", m.temperature);
+    set_number(L, "t_over_m", m.t_over_m);
+    set_number(L, "kinetic_energy", m.kinetic_energy);
+    push_vec(L, m.momentum, D);
+    lua_setfield(L, -2, "momentum");
+    push_vec(L, m.mean_velocity, D);
+    lua_setfield(L, -2, "mean_velocity");
+    set_number(L, "kurtosis", m.kurtosis);
+    set_number(L, "a2", m.a2);
+    set_number(L, "n", N);
+    set_number(L, "collisions", dsmc_total_collisions(s));
+    set_number(L, "collisions_per_particle", N > 0 ? 2 * dsmc_total_collisions(s) / N : 0);
+    set_number(L, "collision_frequency", dsmc_collision_frequency(s));
+    set_number(L, "time", dsmc_time(s));
+    if (a2_cells) {
         size_t nc = dsmc_cell_count(s);
-        double *buf = malloc(9 * nc * sizeof *buf);
-        if (!buf)
+        double *a2 = malloc(nc * sizeof *a2);
+        if (!a2)
             return luaL_error(L, "measure: out of memory");
-        dsmc_fields f = {.count = buf, .density = buf + nc, .packing = buf + 2 * nc,
-                         .u = {buf + 3 * nc, buf + 4 * nc, D == 3 ? buf + 5 * nc : NULL},
-                         .temperature = buf + 6 * nc, .a2 = buf + 7 * nc};
+        dsmc_fields f = {0};
+        f.a2 = a2;
         dsmc_measure_fields(s, &f);
-        lua_createtable(L, 0, 12);
-        push_cells(L, s, f.count, "count");
-        push_cells(L, s, f.density, "density");
-        push_cells(L, s, f.packing, "packing");
-        static const char *const un[3] = {"ux", "uy", "uz"};
-        for (int k = 0; k < D; k++)
-            push_cells(L, s, f.u[k], un[k]);
-        push_cells(L, s, f.temperature, "temperature");
-        push_cells(L, s, f.a2, "a2");
-        free(buf);
+        push_cells(L, s, a2, "cells");
+        free(a2);
         push_grid(L, s);
-        return 1;
     }
-    if (what == 3) { /* histogram */
-        static const char *const qn[] = {"component", "speed", NULL};
-        int bins = 40, q = 0;
-        dsmc_moments m;
-        dsmc_measure_moments(s, &m);
-        double sd = sqrt(m.t_over_m), range[2];
-        if (has_opts) {
-            bins = (int)bind_field_integer(L, 3, "measure", "bins", 40, 1, 100000, 0);
-            q = bind_field_option(L, 3, "measure", "quantity", qn, 0, 0);
-        }
-        range[0] = q == 0 ? -5 * sd : 0;
-        range[1] = 5 * sd;
-        if (has_opts &&
-            read_numbers(L, 3, "measure", "range", 2, "array of 2 numbers", 0, range) &&
-            !(range[1] > range[0])) {
-            lua_getfield(L, 3, "range");
-            return bind_field_error(L, 3, "measure", "range", "{lo, hi} with hi > lo");
-        }
-        double *counts = malloc((size_t)bins * sizeof *counts), outside;
-        if (!counts)
-            return luaL_error(L, "measure: out of memory");
-        if (dsmc_measure_histogram(s, q, bins, range[0], range[1], counts, &outside, &err)) {
-            free(counts);
-            return bind_raise(L, "measure", &err);
-        }
-        double total = outside, w = (range[1] - range[0]) / bins;
-        for (int b = 0; b < bins; b++)
-            total += counts[b];
-        lua_createtable(L, 0, 8);
-        lua_createtable(L, bins, 0);
-        for (int b = 0; b < bins; b++) {
-            lua_pushnumber(L, range[0] + (b + 0.5) * w);
-            lua_rawseti(L, -2, b + 1);
-        }
-        lua_setfield(L, -2, "centers");
-        bind_push_array(L, counts, (size_t)bins, "counts");
-        for (int b = 0; b < bins; b++)
-            counts[b] = total > 0 ? counts[b] / (total * w) : 0;
-        bind_push_array(L, counts, (size_t)bins, "pdf");
+    return 1;
+}
+
+/* measure('fields'): count, density, packing, velocity, temperature and a2 per cell. */
+static int measure_fields(lua_State *L, dsmc_scene *s)
+{
+    const int D = dsmc_def(s)->dim;
+    size_t nc = dsmc_cell_count(s);
+    double *buf = malloc(9 * nc * sizeof *buf);
+    if (!buf)
+        return luaL_error(L, "measure: out of memory");
+    dsmc_fields f = {.count = buf, .density = buf + nc, .packing = buf + 2 * nc,
+                     .u = {buf + 3 * nc, buf + 4 * nc, D == 3 ? buf + 5 * nc : NULL},
+                     .temperature = buf + 6 * nc, .a2 = buf + 7 * nc};
+    dsmc_measure_fields(s, &f);
+    lua_createtable(L, 0, 12);
+    push_cells(L, s, f.count, "count");
+    push_cells(L, s, f.density, "density");
+    push_cells(L, s, f.packing, "packing");
+    static const char *const un[3] = {"ux", "uy", "uz"};
+    for (int k = 0; k < D; k++)
+        push_cells(L, s, f.u[k], un[k]);
+    push_cells(L, s, f.temperature, "temperature");
+    push_cells(L, s, f.a2, "a2");
+    free(buf);
+    push_grid(L, s);
+    return 1;
+}
+
+/* measure('histogram', { bins =, range =, quantity = }): of a velocity component or the speed. */
+static int measure_histogram(lua_State *L, dsmc_scene *s, int has_opts)
+{
+    static const char *const qn[] = {"component", "speed", NULL};
+    core_error err;
+    int bins = 40, q = 0;
+    dsmc_moments m;
+    dsmc_measure_moments(s, &m);
+    double sd = sqrt(m.t_over_m), range[2];
+    if (has_opts) {
+        bins = (int)bind_field_integer(L, 3, "measure", "bins", 40, 1, 100000, 0);
+        q = bind_field_option(L, 3, "measure", "quantity", qn, 0, 0);
+    }
+    range[0] = q == 0 ? -5 * sd : 0;
+    range[1] = 5 * sd;
+    if (has_opts && read_numbers(L, 3, "measure", "range", 2, "array of 2 numbers", 0, range) &&
+        !(range[1] > range[0])) {
+        lua_getfield(L, 3, "range");
+        return bind_field_error(L, 3, "measure", "range", "{lo, hi} with hi > lo");
+    }
+    double *counts = malloc((size_t)bins * sizeof *counts), outside;
+    if (!counts)
+        return luaL_error(L, "measure: out of memory");
+    if (dsmc_measure_histogram(s, q, bins, range[0], range[1], counts, &outside, &err)) {
         free(counts);
-        set_number(L, "outside", outside);
-        set_number(L, "samples", total);
-        set_number(L, "kurtosis", m.kurtosis);
-        set_number(L, "t_over_m", m.t_over_m);
-        lua_pushstring(L, qn[q]);
-        lua_setfield(L, -2, "quantity");
-        return 1;
+        return bind_raise(L, "measure", &err);
     }
-    if (what == 4) { /* stats */
-        measure_stats(L, s);
-        return 1;
+    double total = outside, w = (range[1] - range[0]) / bins;
+    for (int b = 0; b < bins; b++)
+        total += counts[b];
+    lua_createtable(L, 0, 8);
+    lua_createtable(L, bins, 0);
+    for (int b = 0; b < bins; b++) {
+        lua_pushnumber(L, range[0] + (b + 0.5) * w);
+        lua_rawseti(L, -2, b + 1);
     }
-    if (what == 5) { /* profile */
-        int axis = D, bins = d->cells[D - 1];
-        if (has_opts) {
-            axis = (int)bind_field_integer(L, 3, "measure", "axis", D, 1, D, 0);
-            bins = (int)bind_field_integer(L, 3, "measure", "bins", d->cells[axis - 1], 1, 1000000,
-                                           0);
-        }
-        double *buf = malloc(5 * (size_t)bins * sizeof *buf);
-        if (!buf)
-            return luaL_error(L, "measure: out of memory");
-        size_t nb = (size_t)bins;
-        dsmc_measure_profile(s, axis - 1, bins, buf, buf + nb, buf + 2 * nb, buf + 3 * nb,
-                             buf + 4 * nb, &err);
-        lua_createtable(L, 0, 6);
-        bind_push_array(L, buf, nb, "position");
-        bind_push_array(L, buf + nb, nb, "count");
-        bind_push_array(L, buf + 2 * nb, nb, "density");
-        bind_push_array(L, buf + 3 * nb, nb, "packing");
-        bind_push_array(L, buf + 4 * nb, nb, "temperature");
-        free(buf);
-        lua_pushinteger(L, axis);
-        lua_setfield(L, -2, "axis");
-        return 1;
+    lua_setfield(L, -2, "centers");
+    bind_push_array(L, counts, (size_t)bins, "counts");
+    for (int b = 0; b < bins; b++)
+        counts[b] = total > 0 ? counts[b] / (total * w) : 0;
+    bind_push_array(L, counts, (size_t)bins, "pdf");
+    free(counts);
+    set_number(L, "outside", outside);
+    set_number(L, "samples", total);
+    set_number(L, "kurtosis", m.kurtosis);
+    set_number(L, "t_over_m", m.t_over_m);
+    lua_pushstring(L, qn[q]);
+    lua_setfield(L, -2, "quantity");
+    return 1;
+}
+
+/* measure('profile', { axis =, bins = }): layers along an axis. */
+static int measure_profile(lua_State *L, dsmc_scene *s, int has_opts)
+{
+    const dsmc_scene_def *d = dsmc_def(s);
+    const int D = d->dim;
+    core_error err;
+    int axis = D, bins = d->cells[D - 1];
+    if (has_opts) {
+        axis = (int)bind_field_integer(L, 3, "measure", "axis", D, 1, D, 0);
+        bins = (int)bind_field_integer(L, 3, "measure", "bins", d->cells[axis - 1], 1, 1000000, 0);
     }
-    /* validity */
+    double *buf = malloc(5 * (size_t)bins * sizeof *buf);
+    if (!buf)
+        return luaL_error(L, "measure: out of memory");
+    size_t nb = (size_t)bins;
+    dsmc_measure_profile(s, axis - 1, bins, buf, buf + nb, buf + 2 * nb, buf + 3 * nb,
+                         buf + 4 * nb, &err);
+    lua_createtable(L, 0, 6);
+    bind_push_array(L, buf, nb, "position");
+    bind_push_array(L, buf + nb, nb, "count");
+    bind_push_array(L, buf + 2 * nb, nb, "density");
+    bind_push_array(L, buf + 3 * nb, nb, "packing");
+    bind_push_array(L, buf + 4 * nb, nb, "temperature");
+    free(buf);
+    lua_pushinteger(L, axis);
+    lua_setfield(L, -2, "axis");
+    return 1;
+}
+
+/* measure('validity', { dt = }): the paper's three conditions. */
+static int measure_validity(lua_State *L, dsmc_scene *s, int has_opts)
+{
+    core_error err;
     double dt = 0;
     if (has_opts)
         dt = bind_field_number(L, 3, "measure", "dt", 0, BIND_NONNEG);
@@ -738,6 +738,29 @@ static int l_measure(lua_State *L)
         return bind_raise(L, "measure", &err);
     push_validity(L, &v);
     return 1;
+}
+
+static int l_measure(lua_State *L)
+{
+    static const char *const what_names[] = {"temperature", "a2", "fields", "histogram", "stats",
+                                             "profile", "validity", NULL};
+    static const char *const *const what_fields[] = {
+        NO_FIELDS, NO_FIELDS, NO_FIELDS, HISTOGRAM_FIELDS, NO_FIELDS, PROFILE_FIELDS,
+        VALIDITY_FIELDS};
+    dsmc_scene *s = check_scene(L, 1);
+    int what = bind_check_option(L, 2, NULL, what_names);
+    int has_opts = bind_mode_options(L, 3, "measure", what_names[what], what_fields[what]);
+    if (what == 1 || what == 2 || what == 3 || what == 5) /* a2, fields, histogram, profile */
+        whole_scene(L, 1, "measure");
+    switch (what) {
+    case 0: return measure_moments(L, s, 0);
+    case 1: return measure_moments(L, s, 1);
+    case 2: return measure_fields(L, s);
+    case 3: return measure_histogram(L, s, has_opts);
+    case 4: measure_stats(L, s); return 1;
+    case 5: return measure_profile(L, s, has_opts);
+    default: return measure_validity(L, s, has_opts);
+    }
 }
 
 static int l_reset_stats(lua_State *L)

@@ -195,11 +195,8 @@ static void field_pixels(const render_field_def *def, const frame *f, int nc, in
     }
 }
 
-core_status render_field(render_context *rc, const render_field_def *def, render_image *out,
-                         render_view *view, core_error *err)
+static core_status check_field_def(const render_field_def *def, core_error *err)
 {
-    out->rgba = NULL;
-    out->width = out->height = 0;
     core_status st = check_size(def->width, def->height, err);
     if (st != CORE_OK)
         return st;
@@ -211,26 +208,30 @@ core_status render_field(render_context *rc, const render_field_def *def, render
         !(e[1][0] > e[0][0]) || !(e[1][1] > e[0][1]))
         return core_fail(err, CORE_ERR_ARG,
                          "extent {{%g, %g}, {%g, %g}}: finite corners with x1 > x0, y1 > y0 "
-                         "expected", e[0][0], e[0][1], e[1][0], e[1][1]);
+                         "expected",
+                         e[0][0], e[0][1], e[1][0], e[1][1]);
     if (!def->values && !def->arrows[0])
         return core_fail(err, CORE_ERR_ARG, "a field needs values, arrows or both");
     if (def->arrows[0] && (!def->arrows[1] || !(def->arrow_scale >= 0) ||
                            !isfinite(def->arrow_scale) || def->arrow_every < 0))
-        return core_fail(err, CORE_ERR_ARG, "arrows need two arrays, a scale >= 0 and a spacing "
-                                            ">= 0");
-    if ((st = check_range(def->range, err)) != CORE_OK)
-        return st;
+        return core_fail(err, CORE_ERR_ARG,
+                         "arrows need two arrays, a scale >= 0 and a spacing "
+                         ">= 0");
+    return check_range(def->range, err);
+}
 
-    const int nx = def->nx, ny = def->ny;
-    const size_t ncell = (size_t)nx * (size_t)ny;
-    frame f;
-    memset(&f, 0, sizeof f);
-    f.lo[0] = e[0][0];
-    f.lo[1] = e[0][1];
-    f.hi[0] = e[1][0];
-    f.hi[1] = e[1][1];
-    f.range[0] = 0;
-    f.range[1] = 1;
+/* The frame's rectangle (the extent) and colour range; returns the number of cells shown. */
+static size_t field_frame(const render_field_def *def, frame *f)
+{
+    const double(*e)[2] = def->extent;
+    const size_t ncell = (size_t)def->nx * (size_t)def->ny;
+    memset(f, 0, sizeof *f);
+    f->lo[0] = e[0][0];
+    f->lo[1] = e[0][1];
+    f->hi[0] = e[1][0];
+    f->hi[1] = e[1][1];
+    f->range[0] = 0;
+    f->range[1] = 1;
     size_t shown = 0;
     if (def->values) {
         double mn = INFINITY, mx = -INFINITY;
@@ -240,8 +241,122 @@ core_status render_field(render_context *rc, const render_field_def *def, render
                 mn = def->values[k] < mn ? def->values[k] : mn;
                 mx = def->values[k] > mx ? def->values[k] : mx;
             }
-        data_range(def->range, mn, mx, f.range);
+        data_range(def->range, mn, mx, f->range);
     }
+    return shown;
+}
+
+/* The field's nc x nr pixels (those whose centre lies inside the extent) in *pixels, allocated
+ * here: the cells' colours, then each pixel's. */
+static core_status field_image(const render_field_def *def, const frame *f, int nc, int nr,
+                               unsigned char **pixels, core_error *err)
+{
+    const size_t ncell = (size_t)def->nx * (size_t)def->ny;
+    unsigned char *cells = malloc(ncell * 4);
+    *pixels = malloc((size_t)nc * nr * 4);
+    if (!cells || !*pixels) {
+        free(cells);
+        free(*pixels);
+        *pixels = NULL;
+        return core_fail(err, CORE_ERR_NOMEM, "render: out of memory for a %d x %d field", def->nx,
+                         def->ny);
+    }
+    const double span = f->range[1] - f->range[0];
+    for (size_t k = 0; k < ncell; k++) {
+        unsigned char *c = cells + 4 * k;
+        if (cell_shown(def, k)) {
+            render_colormap_rgb(def->colormap, (def->values[k] - f->range[0]) / span, c);
+            c[3] = 255;
+        } else if (def->background) { /* opaque: drawn */
+            memcpy(c, def->background, 3);
+            c[3] = 255;
+        } else {
+            memset(c, 0, 4);
+        }
+    }
+    field_pixels(def, f, nc, nr, cells, *pixels);
+    free(cells);
+    return CORE_OK;
+}
+
+/* A field without a single value: a note in the scene saying why it is empty. */
+static void empty_note(render_context *rc, const render_field_def *def, const frame *f)
+{
+    const size_t ncell = (size_t)def->nx * (size_t)def->ny;
+    char note[96];
+    snprintf(note, sizeof note, "no values: all %zu cells are NaN%s", ncell,
+             def->mask ? " or masked" : "");
+    double px = f->fs;
+    double w = canvas_text_width(rc, note, px);
+    if (w > 0.9 * f->bw) /* fits the scene's width */
+        px *= 0.9 * f->bw / w;
+    canvas_text(rc, note, px, f->ox + 0.5 * f->bw, f->oy + 0.5 * f->bh, 0.5, 0.5, 0,
+                rgba(180, 30, 30, 255));
+}
+
+/* Arrows from the cell centres, every k-th cell, with a reference arrow. */
+static void field_arrows(render_context *rc, const render_field_def *def, const frame *f)
+{
+    const double(*e)[2] = def->extent;
+    const int nx = def->nx, ny = def->ny;
+    const double *U = def->arrows[0], *V = def->arrows[1];
+    const double dx = (e[1][0] - e[0][0]) / nx, dy = (e[1][1] - e[0][1]) / ny;
+    const double cell_px = fmin(dx, dy) * f->sc;
+    int every = def->arrow_every;
+    if (every == 0) {
+        every = (int)ceil(1.5 * f->fs / cell_px - 1e-9);
+        every = every < 1 ? 1 : every;
+    }
+    /* the first arrow half a spacing in, or mid-grid on a side shorter than the spacing */
+    const int offx = every / 2 < nx ? every / 2 : (nx - 1) / 2;
+    const int offy = every / 2 < ny ? every / 2 : (ny - 1) / 2;
+    double umax = 0;
+    for (int j = offy; j < ny; j += every)
+        for (int i = offx; i < nx; i += every) {
+            size_t k = (size_t)j * nx + i;
+            if ((!def->mask || def->mask[k]) && isfinite(U[k]) && isfinite(V[k]))
+                umax = fmax(umax, hypot(U[k], V[k]));
+        }
+    const double spacing = every * fmin(dx, dy); /* scene units */
+    double ks = def->arrow_scale;
+    if (ks == 0)
+        ks = umax > 0 ? 0.9 * spacing / umax : 1;
+    const double sp_px = spacing * f->sc;
+    const double aw = fmin(2.5, fmax(1.2, 0.07 * sp_px)), head = fmax(3, 0.3 * sp_px);
+    rgba8 ac = rgba(190, 30, 30, 255), halo = rgba(255, 255, 255, 150);
+    /* on a coloured field a pale halo keeps the arrows readable on dark cells */
+    for (int pass = def->values ? 0 : 1; pass < 2; pass++)
+        for (int j = offy; j < ny; j += every)
+            for (int i = offx; i < nx; i += every) {
+                size_t k = (size_t)j * nx + i;
+                if ((def->mask && !def->mask[k]) || !isfinite(U[k]) || !isfinite(V[k]))
+                    continue;
+                double len = hypot(U[k], V[k]) * ks * f->sc;
+                if (len < 2 * aw) /* a speck, not an arrow */
+                    continue;
+                double x0 = f->ox + (i + 0.5) * dx * f->sc;
+                double y0 = f->oy + (ny - j - 0.5) * dy * f->sc;
+                double ux = U[k] * ks * f->sc / len, uy = -V[k] * ks * f->sc / len;
+                canvas_arrow(rc, x0, y0, x0 + ux * len, y0 + uy * len, ux, uy, pass ? aw : aw + 2,
+                             fmin(0.35 * len, head), pass ? ac : halo);
+            }
+    double right =
+        f->W - f->m - f->band -
+        (def->stamp && *def->stamp ? canvas_text_width(rc, def->stamp, f->fs) + 2 * f->fs : 0);
+    reference_arrow(rc, umax, ks, f->sc, def->arrow_unit, right, f->ay0 - lround(0.45 * f->fs),
+                    f->fs, aw, head, ac);
+}
+
+core_status render_field(render_context *rc, const render_field_def *def, render_image *out,
+                         render_view *view, core_error *err)
+{
+    out->rgba = NULL;
+    out->width = out->height = 0;
+    core_status st = check_field_def(def, err);
+    if (st != CORE_OK)
+        return st;
+    frame f;
+    const size_t shown = field_frame(def, &f);
     /* A field without a single value would be a blank frame with a colour bar of nothing: it gets
      * no bar and a note saying why it is empty instead. */
     const int empty = def->values && shown == 0;
@@ -256,33 +371,9 @@ core_status render_field(render_context *rc, const render_field_def *def, render
     int nc = (int)ceil(f.bw - 0.5), nr = (int)ceil(f.bh - 0.5);
     nc = nc < 1 ? 1 : nc;
     nr = nr < 1 ? 1 : nr;
-    unsigned char *cells = NULL, *pixels = NULL;
-    if (def->values) {
-        cells = malloc(ncell * 4);
-        pixels = malloc((size_t)nc * nr * 4);
-        if (!cells || !pixels) {
-            free(cells);
-            free(pixels);
-            return core_fail(err, CORE_ERR_NOMEM, "render: out of memory for a %d x %d field",
-                             nx, ny);
-        }
-        const double span = f.range[1] - f.range[0];
-        for (size_t k = 0; k < ncell; k++) {
-            unsigned char *c = cells + 4 * k;
-            if (cell_shown(def, k)) {
-                render_colormap_rgb(def->colormap, (def->values[k] - f.range[0]) / span, c);
-                c[3] = 255;
-            } else if (def->background) { /* opaque: drawn */
-                memcpy(c, def->background, 3);
-                c[3] = 255;
-            } else {
-                memset(c, 0, 4);
-            }
-        }
-        field_pixels(def, &f, nc, nr, cells, pixels);
-        free(cells);
-    }
-
+    unsigned char *pixels = NULL;
+    if (def->values && (st = field_image(def, &f, nc, nr, &pixels, err)) != CORE_OK)
+        return st;
     if ((st = canvas_begin(rc, f.W, f.H, err)) != CORE_OK) {
         free(pixels);
         return st;
@@ -290,69 +381,10 @@ core_status render_field(render_context *rc, const render_field_def *def, render
     if (pixels)
         canvas_pixels(rc, (int)f.ox, (int)f.oy, nc, nr, pixels);
     free(pixels);
-    if (empty) {
-        char note[96];
-        snprintf(note, sizeof note, "no values: all %zu cells are NaN%s", ncell,
-                 def->mask ? " or masked" : "");
-        double px = f.fs;
-        double w = canvas_text_width(rc, note, px);
-        if (w > 0.9 * f.bw) /* fits the scene's width */
-            px *= 0.9 * f.bw / w;
-        canvas_text(rc, note, px, f.ox + 0.5 * f.bw, f.oy + 0.5 * f.bh, 0.5, 0.5, 0,
-                    rgba(180, 30, 30, 255));
-    }
-
-    /* ---- arrows from the cell centres, every k-th cell, with a reference arrow ---- */
-    if (def->arrows[0]) {
-        const double *U = def->arrows[0], *V = def->arrows[1];
-        const double dx = (e[1][0] - e[0][0]) / nx, dy = (e[1][1] - e[0][1]) / ny;
-        const double cell_px = fmin(dx, dy) * f.sc;
-        int every = def->arrow_every;
-        if (every == 0) {
-            every = (int)ceil(1.5 * f.fs / cell_px - 1e-9);
-            every = every < 1 ? 1 : every;
-        }
-        /* the first arrow half a spacing in, or mid-grid on a side shorter than the spacing */
-        const int offx = every / 2 < nx ? every / 2 : (nx - 1) / 2;
-        const int offy = every / 2 < ny ? every / 2 : (ny - 1) / 2;
-        double umax = 0;
-        for (int j = offy; j < ny; j += every)
-            for (int i = offx; i < nx; i += every) {
-                size_t k = (size_t)j * nx + i;
-                if ((!def->mask || def->mask[k]) && isfinite(U[k]) && isfinite(V[k]))
-                    umax = fmax(umax, hypot(U[k], V[k]));
-            }
-        const double spacing = every * fmin(dx, dy); /* scene units */
-        double ks = def->arrow_scale;
-        if (ks == 0)
-            ks = umax > 0 ? 0.9 * spacing / umax : 1;
-        const double sp_px = spacing * f.sc;
-        const double aw = fmin(2.5, fmax(1.2, 0.07 * sp_px)), head = fmax(3, 0.3 * sp_px);
-        rgba8 ac = rgba(190, 30, 30, 255), halo = rgba(255, 255, 255, 150);
-        /* on a coloured field a pale halo keeps the arrows readable on dark cells */
-        for (int pass = def->values ? 0 : 1; pass < 2; pass++)
-            for (int j = offy; j < ny; j += every)
-                for (int i = offx; i < nx; i += every) {
-                    size_t k = (size_t)j * nx + i;
-                    if ((def->mask && !def->mask[k]) || !isfinite(U[k]) || !isfinite(V[k]))
-                        continue;
-                    double len = hypot(U[k], V[k]) * ks * f.sc;
-                    if (len < 2 * aw) /* a speck, not an arrow */
-                        continue;
-                    double x0 = f.ox + (i + 0.5) * dx * f.sc;
-                    double y0 = f.oy + (ny - j - 0.5) * dy * f.sc;
-                    double ux = U[k] * ks * f.sc / len, uy = -V[k] * ks * f.sc / len;
-                    canvas_arrow(rc, x0, y0, x0 + ux * len, y0 + uy * len, ux, uy,
-                                 pass ? aw : aw + 2, fmin(0.35 * len, head), pass ? ac : halo);
-                }
-        double right = f.W - f.m - f.band -
-                       (def->stamp && *def->stamp ? canvas_text_width(rc, def->stamp, f.fs) +
-                                                        2 * f.fs
-                                                  : 0);
-        reference_arrow(rc, umax, ks, f.sc, def->arrow_unit, right,
-                        f.ay0 - lround(0.45 * f.fs), f.fs, aw, head, ac);
-    }
-
+    if (empty)
+        empty_note(rc, def, &f);
+    if (def->arrows[0])
+        field_arrows(rc, def, &f);
     if (def->box)
         frame_box(rc, f.ox, f.oy, f.ox + nc, f.oy + nr);
     frame_text(rc, &f, def->title, def->stamp);

@@ -324,32 +324,67 @@ static core_status collect_shapes(dem_scene *s, shape_lines *o, core_error *err)
     }
     return CORE_OK;
 }
+/* ---- a frame of a scene: what is worked out before anything is drawn ------------------------ */
+typedef struct dem_frame {
+    const render_grains_def *def;
+    int D, W, H; /* H: 0 until the layout sets it from the box's aspect */
+    int mapped;  /* coloured through the colour map (speed, rotation, values) */
+    size_t n, nshow;
+    double box_lo[3], box_hi[3], g[3];
+    double *val;     /* the per-grain scalar when mapped */
+    double range[2]; /* its colour-map limits */
+    /* geometry: 2D as it is; 3D projected (x, y, r point into proj), drawn far to near (order) */
+    const double *x, *y, *r;
+    double *proj, box2[8][2];
+    depth_key *order;
+    camera3 cam;
+    double lo[2], hi[2];
+    /* layout: margin, title band, colour bar band, the box's pixels and scale */
+    double fs, sc, bw, bh, ox, oy, ww, mean_r;
+    int m, ay0, band, show_bar;
+    colorbar bar;
+    rgba8 wall_c;
+    /* contacts and wall outlines, taken before anything is drawn */
+    chain_list chains;
+    shape_lines shapes;
+} dem_frame;
 
-core_status render_dem(render_context *rc, dem_scene *s, const render_grains_def *def,
-                       render_image *out, render_view *view, core_error *err)
+static void frame_free(dem_frame *f)
 {
-    out->rgba = NULL;
-    out->width = out->height = 0;
+    shape_lines_free(&f->shapes);
+    free(f->chains.c);
+    free(f->val);
+    free(f->proj);
+    free(f->order);
+}
+
+/* Pixel column and row of scene (image-plane) coordinates. */
+static double col_of(const dem_frame *f, double X) { return f->ox + (X - f->lo[0]) * f->sc; }
+
+static double row_of(const dem_frame *f, double Y) { return f->oy + (f->hi[1] - Y) * f->sc; }
+
+static core_status check_def(dem_scene *s, const render_grains_def *def, core_error *err)
+{
     const int D = dem_dim(s);
     if (D == 3 && (def->force_chains || def->rotation || def->arrows[0]))
         return core_fail(err, CORE_ERR_ARG,
                          "force chains, rotation markers and arrows are drawn "
                          "in 2D scenes only");
-    if (def->arrows[0] && (!def->arrows[1] || !(def->arrow_scale >= 0) ||
-                           !isfinite(def->arrow_scale)))
+    if (def->arrows[0] &&
+        (!def->arrows[1] || !(def->arrow_scale >= 0) || !isfinite(def->arrow_scale)))
         return core_fail(err, CORE_ERR_ARG, "arrows need two arrays and a scale >= 0");
     if (D == 3 && (!(def->camera.fov > 0 && def->camera.fov < 90) ||
                    !isfinite(def->camera.azimuth) || !isfinite(def->camera.elevation)))
-        return core_fail(err, CORE_ERR_ARG, "camera: finite angles and fov in (0, 90) degrees "
-                                            "expected, got fov %g", def->camera.fov);
+        return core_fail(err, CORE_ERR_ARG,
+                         "camera: finite angles and fov in (0, 90) degrees "
+                         "expected, got fov %g",
+                         def->camera.fov);
     int W = def->width ? def->width : RENDER_DEFAULT_WIDTH, H = def->height;
-    if (W < RENDER_MIN_SIZE || W > RENDER_MAX_SIZE || (H && (H < RENDER_MIN_SIZE ||
-                                                             H > RENDER_MAX_SIZE)))
+    if (W < RENDER_MIN_SIZE || W > RENDER_MAX_SIZE ||
+        (H && (H < RENDER_MIN_SIZE || H > RENDER_MAX_SIZE)))
         return core_fail(err, CORE_ERR_ARG, "image size %d x %d outside [%d, %d] pixels", W, H,
                          RENDER_MIN_SIZE, RENDER_MAX_SIZE);
     const size_t n = dem_count(s);
-    int mapped = def->color == RENDER_COLOR_SPEED || def->color == RENDER_COLOR_ROTATION ||
-                 def->color == RENDER_COLOR_VALUES;
     if (def->color == RENDER_COLOR_VALUES && n && !def->values)
         return core_fail(err, CORE_ERR_ARG, "colour by values without values");
     if (def->color == RENDER_COLOR_LABELS && n && !def->labels)
@@ -357,355 +392,437 @@ core_status render_dem(render_context *rc, dem_scene *s, const render_grains_def
     if (def->range[0] > def->range[1] || !isfinite(def->range[0]) || !isfinite(def->range[1]))
         return core_fail(err, CORE_ERR_ARG, "colour range [%g, %g] is not increasing",
                          def->range[0], def->range[1]);
+    return CORE_OK;
+}
 
-    double box_lo[3], box_hi[3], g[3];
-    dem_box(s, box_lo, box_hi, g);
+static void frame_start(dem_frame *f, dem_scene *s, const render_grains_def *def)
+{
+    memset(f, 0, sizeof *f);
+    f->def = def;
+    f->D = dem_dim(s);
+    f->W = def->width ? def->width : RENDER_DEFAULT_WIDTH;
+    f->H = def->height;
+    f->n = dem_count(s);
+    f->mapped = def->color == RENDER_COLOR_SPEED || def->color == RENDER_COLOR_ROTATION ||
+                def->color == RENDER_COLOR_VALUES;
+    f->range[0] = 0;
+    f->range[1] = 1;
+    dem_box(s, f->box_lo, f->box_hi, f->g);
+}
 
-    /* ---- per-grain scalar and its range ---- */
-    double *val = NULL;
-    double range[2] = {0, 1};
-    if (mapped) {
-        val = malloc((n ? n : 1) * sizeof *val);
-        if (!val)
-            return core_fail(err, CORE_ERR_NOMEM, "render: out of memory");
-        const double *v[3] = {NULL, NULL, NULL}, *w[3] = {NULL, NULL, NULL};
+/* The per-grain scalar of a mapped colour and its range. */
+static core_status grain_values(dem_frame *f, dem_scene *s, core_error *err)
+{
+    const render_grains_def *def = f->def;
+    const size_t n = f->n;
+    const int D = f->D;
+    if (!f->mapped)
+        return CORE_OK;
+    double *val = f->val = malloc((n ? n : 1) * sizeof *val);
+    if (!val)
+        return core_fail(err, CORE_ERR_NOMEM, "render: out of memory");
+    const double *v[3] = {NULL, NULL, NULL}, *w[3] = {NULL, NULL, NULL};
+    for (int d = 0; d < D; d++) {
+        v[d] = dem_velocities(s, d);
+        w[d] = D == 3 || d == 0 ? dem_angular_velocities(s, D == 3 ? d : 2) : NULL;
+    }
+    for (size_t i = 0; i < n; i++) {
+        double v2 = 0, w2 = 0;
         for (int d = 0; d < D; d++) {
-            v[d] = dem_velocities(s, d);
-            w[d] = D == 3 || d == 0 ? dem_angular_velocities(s, D == 3 ? d : 2) : NULL;
+            v2 += v[d][i] * v[d][i];
+            w2 += w[d] ? w[d][i] * w[d][i] : 0;
         }
-        for (size_t i = 0; i < n; i++) {
-            double v2 = 0, w2 = 0;
-            for (int d = 0; d < D; d++) {
-                v2 += v[d][i] * v[d][i];
-                w2 += w[d] ? w[d][i] * w[d][i] : 0;
-            }
-            val[i] = def->color == RENDER_COLOR_SPEED ? sqrt(v2)
-                     : def->color == RENDER_COLOR_ROTATION
-                         ? (D == 2 ? (w[0] ? w[0][i] : 0) : sqrt(w2))
-                         : def->values[i];
-        }
-        if (def->range[0] < def->range[1]) {
-            range[0] = def->range[0];
-            range[1] = def->range[1];
-        } else {
-            double mn = INFINITY, mx = -INFINITY;
-            for (size_t i = 0; i < n; i++)
-                if (isfinite(val[i])) {
-                    mn = val[i] < mn ? val[i] : mn;
-                    mx = val[i] > mx ? val[i] : mx;
-                }
-            if (!(mn <= mx))
-                mn = 0, mx = 1;
-            if (mx == mn) { /* one value: put it mid-map */
-                double d = mn != 0 ? 0.5 * fabs(mn) : 0.5;
-                mn -= d;
-                mx += d;
-            }
-            range[0] = mn;
-            range[1] = mx;
-        }
+        val[i] = def->color == RENDER_COLOR_SPEED      ? sqrt(v2)
+                 : def->color == RENDER_COLOR_ROTATION ? (D == 2 ? (w[0] ? w[0][i] : 0) : sqrt(w2))
+                                                       : def->values[i];
     }
+    if (def->range[0] < def->range[1]) {
+        f->range[0] = def->range[0];
+        f->range[1] = def->range[1];
+    } else {
+        double mn = INFINITY, mx = -INFINITY;
+        for (size_t i = 0; i < n; i++)
+            if (isfinite(val[i])) {
+                mn = val[i] < mn ? val[i] : mn;
+                mx = val[i] > mx ? val[i] : mx;
+            }
+        if (!(mn <= mx))
+            mn = 0, mx = 1;
+        if (mx == mn) { /* one value: put it mid-map */
+            double d = mn != 0 ? 0.5 * fabs(mn) : 0.5;
+            mn -= d;
+            mx += d;
+        }
+        f->range[0] = mn;
+        f->range[1] = mx;
+    }
+    return CORE_OK;
+}
 
-    /* ---- geometry: 2D as it is; 3D projected, drawn far to near ---- */
-    double lo[2] = {box_lo[0], box_lo[1]}, hi[2] = {box_hi[0], box_hi[1]};
+/* The image-plane geometry: 2D as it is; 3D projected by the camera, the visible spheres sorted
+ * far to near, the box's corners projected and the extent their bounds. */
+static core_status scene_geometry(dem_frame *f, dem_scene *s, core_error *err)
+{
+    const size_t n = f->n;
+    const double *box_lo = f->box_lo, *box_hi = f->box_hi;
+    double *lo = f->lo, *hi = f->hi;
+    lo[0] = box_lo[0];
+    lo[1] = box_lo[1];
+    hi[0] = box_hi[0];
+    hi[1] = box_hi[1];
     const double *x = dem_positions(s, 0), *y = dem_positions(s, 1), *r = dem_radii(s);
-    double *proj = NULL, box2[8][2];
-    depth_key *order = NULL;
-    size_t nshow = n;
-    if (D == 3) {
-        camera3 cam;
-        camera_setup(&def->camera, box_lo, box_hi, g, &cam);
-        proj = malloc((n ? n : 1) * 3 * sizeof *proj);
-        order = malloc((n ? n : 1) * sizeof *order);
-        if (!proj || !order) {
-            free(proj);
-            free(order);
-            free(val);
-            return core_fail(err, CORE_ERR_NOMEM, "render: out of memory");
-        }
-        const double *z = dem_positions(s, 2);
-        nshow = 0;
-        for (size_t i = 0; i < n; i++) {
-            double q[3] = {x[i], y[i], z[i]}, depth;
-            if (project(&cam, q, r[i], &proj[i], &proj[n + i], &proj[2 * n + i], &depth))
-                order[nshow++] = (depth_key){depth, i};
-        }
-        qsort(order, nshow, sizeof *order, far_first);
-        lo[0] = lo[1] = INFINITY;
-        hi[0] = hi[1] = -INFINITY;
-        for (int k = 0; k < 8; k++) {
-            double q[3] = {k & 1 ? box_hi[0] : box_lo[0], k & 2 ? box_hi[1] : box_lo[1],
-                           k & 4 ? box_hi[2] : box_lo[2]}, R, depth;
-            project(&cam, q, 0, &box2[k][0], &box2[k][1], &R, &depth);
-            for (int d = 0; d < 2; d++) {
-                lo[d] = fmin(lo[d], box2[k][d]);
-                hi[d] = fmax(hi[d], box2[k][d]);
-            }
-        }
-        x = proj;
-        y = proj + n;
-        r = proj + 2 * n;
+    f->x = x;
+    f->y = y;
+    f->r = r;
+    f->nshow = n;
+    if (f->D != 3)
+        return CORE_OK;
+    camera_setup(&f->def->camera, box_lo, box_hi, f->g, &f->cam);
+    double *proj = f->proj = malloc((n ? n : 1) * 3 * sizeof *proj);
+    depth_key *order = f->order = malloc((n ? n : 1) * sizeof *order);
+    if (!proj || !order)
+        return core_fail(err, CORE_ERR_NOMEM, "render: out of memory");
+    const double *z = dem_positions(s, 2);
+    size_t nshow = 0;
+    for (size_t i = 0; i < n; i++) {
+        double q[3] = {x[i], y[i], z[i]}, depth;
+        if (project(&f->cam, q, r[i], &proj[i], &proj[n + i], &proj[2 * n + i], &depth))
+            order[nshow++] = (depth_key){depth, i};
     }
-    const double hx = hi[0] - lo[0], hy = hi[1] - lo[1];
+    qsort(order, nshow, sizeof *order, far_first);
+    f->nshow = nshow;
+    lo[0] = lo[1] = INFINITY;
+    hi[0] = hi[1] = -INFINITY;
+    double(*box2)[2] = f->box2;
+    for (int k = 0; k < 8; k++) {
+        double q[3] = {k & 1 ? box_hi[0] : box_lo[0], k & 2 ? box_hi[1] : box_lo[1],
+                       k & 4 ? box_hi[2] : box_lo[2]},
+               R, depth;
+        project(&f->cam, q, 0, &box2[k][0], &box2[k][1], &R, &depth);
+        for (int d = 0; d < 2; d++) {
+            lo[d] = fmin(lo[d], box2[k][d]);
+            hi[d] = fmax(hi[d], box2[k][d]);
+        }
+    }
+    f->x = proj;
+    f->y = proj + n;
+    f->r = proj + 2 * n;
+    return CORE_OK;
+}
 
-    /* ---- layout ---- */
-    double fs = canvas_font_px(W, H ? H : W);
-    int m = (int)lround(0.8 * fs);
+/* Margins, the title band, the colour bar's band and the box fitted into the rest; the image
+ * height from the box's aspect when none is given. */
+static core_status frame_layout(render_context *rc, dem_frame *f, core_error *err)
+{
+    const render_grains_def *def = f->def;
+    const double hx = f->hi[0] - f->lo[0], hy = f->hi[1] - f->lo[1];
+    const int W = f->W;
+    int H = f->H;
+    double fs = f->fs = canvas_font_px(W, H ? H : W);
+    int m = f->m = (int)lround(0.8 * fs);
     int has_top = (def->title && *def->title) || (def->stamp && *def->stamp) || def->arrows[0];
-    int ay0 = m + (has_top ? (int)lround(1.7 * fs) : 0);
-    int show_bar = mapped && def->colorbar;
+    int ay0 = f->ay0 = m + (has_top ? (int)lround(1.7 * fs) : 0);
+    f->show_bar = f->mapped && def->colorbar;
     const char *bar_label = def->colorbar_label ? def->colorbar_label : COLOR_LABELS[def->color];
-    colorbar bar;
-    int band = show_bar ? colorbar_layout(rc, &bar, range, bar_label, fs) : 0;
-    int ax0 = m, ax1 = W - m - band;
-    if (ax1 - ax0 < 4) {
-        free(val);
-        free(proj);
-        free(order);
+    f->band = f->show_bar ? colorbar_layout(rc, &f->bar, f->range, bar_label, fs) : 0;
+    int ax0 = m, ax1 = W - m - f->band;
+    if (ax1 - ax0 < 4)
         return core_fail(err, CORE_ERR_ARG, "image width %d leaves no room for the scene", W);
-    }
     if (!H) {
         double h = ay0 + (ax1 - ax0) * hy / hx + m;
-        H = h > RENDER_MAX_SIZE ? RENDER_MAX_SIZE : h < RENDER_MIN_SIZE ? RENDER_MIN_SIZE
-                                                                         : (int)lround(h);
+        H = h > RENDER_MAX_SIZE   ? RENDER_MAX_SIZE
+            : h < RENDER_MIN_SIZE ? RENDER_MIN_SIZE
+                                  : (int)lround(h);
     }
+    f->H = H;
     int ay1 = H - m;
-    if (ay1 - ay0 < 4) {
-        free(val);
-        free(proj);
-        free(order);
+    if (ay1 - ay0 < 4)
         return core_fail(err, CORE_ERR_ARG, "image height %d leaves no room for the scene", H);
-    }
-    double sc = fmin((ax1 - ax0) / hx, (ay1 - ay0) / hy);
-    double bw = hx * sc, bh = hy * sc;
-    double ox = ax0 + 0.5 * ((ax1 - ax0) - bw), oy = ay0 + 0.5 * ((ay1 - ay0) - bh);
-    if (view) {
-        memcpy(view->lo, lo, sizeof view->lo);
-        memcpy(view->hi, hi, sizeof view->hi);
-        view->scale = sc;
-        view->origin[0] = ox;
-        view->origin[1] = oy;
-        view->range[0] = range[0];
-        view->range[1] = range[1];
-    }
-#define PX(X) (ox + ((X) - lo[0]) * sc)
-#define PY(Y) (oy + (hi[1] - (Y)) * sc)
+    double sc = f->sc = fmin((ax1 - ax0) / hx, (ay1 - ay0) / hy);
+    f->bw = hx * sc;
+    f->bh = hy * sc;
+    f->ox = ax0 + 0.5 * ((ax1 - ax0) - f->bw);
+    f->oy = ay0 + 0.5 * ((ay1 - ay0) - f->bh);
+    f->wall_c = rgba(60, 60, 60, 255);
+    f->ww = fmax(2, lround(0.25 * fs));
+    double mean_r = 0; /* in pixels: the width of chains, arrows and their heads */
+    for (size_t i = 0; i < f->n; i++)
+        mean_r += f->r[i];
+    f->mean_r = f->n ? mean_r / f->n * sc : 1;
+    return CORE_OK;
+}
 
-    /* Contacts and wall outlines first: if they cannot be had, nothing has been drawn. */
-    chain_list chains = {0};
-    if (def->force_chains && n) {
-        dem_each_contact(s, collect_chain, &chains);
-        if (chains.oom) {
-            free(chains.c);
-            free(val);
-            free(proj);
-            free(order);
+static void frame_view(const dem_frame *f, render_view *view)
+{
+    if (!view)
+        return;
+    memcpy(view->lo, f->lo, sizeof view->lo);
+    memcpy(view->hi, f->hi, sizeof view->hi);
+    view->scale = f->sc;
+    view->origin[0] = f->ox;
+    view->origin[1] = f->oy;
+    view->range[0] = f->range[0];
+    view->range[1] = f->range[1];
+}
+
+/* Contacts and wall outlines: if they cannot be had, nothing has been drawn. */
+static core_status collect_overlays(dem_frame *f, dem_scene *s, core_error *err)
+{
+    if (f->def->force_chains && f->n) {
+        dem_each_contact(s, collect_chain, &f->chains);
+        if (f->chains.oom)
             return core_fail(err, CORE_ERR_NOMEM, "render: out of memory for force chains");
-        }
     }
-    shape_lines shapes = {0};
-    if (def->shapes && collect_shapes(s, &shapes, err) != CORE_OK) {
-        free(chains.c);
-        free(val);
-        free(proj);
-        free(order);
+    if (f->def->shapes && collect_shapes(s, &f->shapes, err) != CORE_OK)
         return err ? err->status : CORE_ERR_NOMEM;
-    }
+    return CORE_OK;
+}
 
-    core_status st = canvas_begin(rc, W, H, err);
-    if (st != CORE_OK) {
-        shape_lines_free(&shapes);
-        free(chains.c);
-        free(val);
-        free(proj);
-        free(order);
-        return st;
-    }
+/* ---- 3D: the box's edges and the walls' outlines behind the spheres ---- */
+static void draw_box_3d(render_context *rc, const dem_frame *f)
+{
+    rgba8 bc = rgba(170, 170, 170, 255);
+    const double(*box2)[2] = f->box2;
+    for (int a = 0; a < 8; a++)
+        for (int bit = 1; bit < 8; bit <<= 1)
+            if (!(a & bit))
+                canvas_segment(rc, col_of(f, box2[a][0]), row_of(f, box2[a][1]),
+                               col_of(f, box2[a | bit][0]), row_of(f, box2[a | bit][1]), 1, 1, bc);
+}
 
-    /* ---- 3D: the box's edges and the walls' outlines behind the spheres ---- */
-    rgba8 wall_c = rgba(60, 60, 60, 255);
-    double ww = fmax(2, lround(0.25 * fs));
-    if (D == 3 && def->box) {
-        rgba8 bc = rgba(170, 170, 170, 255);
-        for (int a = 0; a < 8; a++)
-            for (int bit = 1; bit < 8; bit <<= 1)
-                if (!(a & bit))
-                    canvas_segment(rc, PX(box2[a][0]), PY(box2[a][1]), PX(box2[a | bit][0]),
-                                   PY(box2[a | bit][1]), 1, 1, bc);
-    }
-    if (D == 3 && def->nwalls) {
-        camera3 cam;
-        camera_setup(&def->camera, box_lo, box_hi, g, &cam);
-        for (int k = 0; k < def->nwalls; k++) {
-            double poly[6][3], P[6][2], R, depth;
-            int nv = box_section(box_lo, box_hi, def->walls[k].point, def->walls[k].normal, poly);
-            int seen = 1;
-            for (int i = 0; i < nv; i++)
-                seen &= project(&cam, poly[i], 0, &P[i][0], &P[i][1], &R, &depth);
-            for (int i = 0; seen && i < nv && nv >= 2; i++) {
-                int j = (i + 1) % nv;
-                if (nv == 2 && i == 1)
-                    break;
-                canvas_segment(rc, PX(P[i][0]), PY(P[i][1]), PX(P[j][0]), PY(P[j][1]), 0.5 * ww, 1,
-                               wall_c);
-            }
+static void draw_planes_3d(render_context *rc, const dem_frame *f)
+{
+    const render_grains_def *def = f->def;
+    for (int k = 0; k < def->nwalls; k++) {
+        double poly[6][3], P[6][2], R, depth;
+        int nv = box_section(f->box_lo, f->box_hi, def->walls[k].point, def->walls[k].normal, poly);
+        int seen = 1;
+        for (int i = 0; i < nv; i++)
+            seen &= project(&f->cam, poly[i], 0, &P[i][0], &P[i][1], &R, &depth);
+        for (int i = 0; seen && i < nv && nv >= 2; i++) {
+            int j = (i + 1) % nv;
+            if (nv == 2 && i == 1)
+                break;
+            canvas_segment(rc, col_of(f, P[i][0]), row_of(f, P[i][1]), col_of(f, P[j][0]),
+                           row_of(f, P[j][1]), 0.5 * f->ww, 1, f->wall_c);
         }
     }
+}
 
-    if (D == 3 && shapes.n) { /* triangles' edges, cylinders' rims and four lines along them */
-        camera3 cam;
-        camera_setup(&def->camera, box_lo, box_hi, g, &cam);
-        const double *pt = shapes.pts;
-        for (int k = 0; k < shapes.n; pt += 3 * shapes.nv[k], k++) {
-            const int nv = shapes.nv[k], close = nv == 3; /* a triangle */
-            double P0[2], P1[2], R, depth;
-            for (int i = 0; i + 1 < nv + close; i++) {
-                const int j = (i + 1) % nv;
-                if (project(&cam, pt + 3 * i, 0, &P0[0], &P0[1], &R, &depth) &&
-                    project(&cam, pt + 3 * j, 0, &P1[0], &P1[1], &R, &depth))
-                    canvas_segment(rc, PX(P0[0]), PY(P0[1]), PX(P1[0]), PY(P1[1]), 0.5 * ww, 1,
-                                   wall_c);
-            }
-            const int step = nv > 8 ? (nv - 1) / 4 : 1;
-            for (int i = 0; shapes.cyl[k] && i + 1 < nv; i += step) {
-                const double *b = pt + 3 * nv; /* the other rim, the same angles */
-                if (project(&cam, pt + 3 * i, 0, &P0[0], &P0[1], &R, &depth) &&
-                    project(&cam, b + 3 * i, 0, &P1[0], &P1[1], &R, &depth))
-                    canvas_segment(rc, PX(P0[0]), PY(P0[1]), PX(P1[0]), PY(P1[1]), 0.5 * ww, 1,
-                                   wall_c);
-            }
+/* Triangles' edges, cylinders' rims and four lines along them. */
+static void draw_shapes_3d(render_context *rc, const dem_frame *f)
+{
+    const shape_lines *sh = &f->shapes;
+    const double *pt = sh->pts;
+    for (int k = 0; k < sh->n; pt += 3 * sh->nv[k], k++) {
+        const int nv = sh->nv[k], close = nv == 3; /* a triangle */
+        double P0[2], P1[2], R, depth;
+        for (int i = 0; i + 1 < nv + close; i++) {
+            const int j = (i + 1) % nv;
+            if (project(&f->cam, pt + 3 * i, 0, &P0[0], &P0[1], &R, &depth) &&
+                project(&f->cam, pt + 3 * j, 0, &P1[0], &P1[1], &R, &depth))
+                canvas_segment(rc, col_of(f, P0[0]), row_of(f, P0[1]), col_of(f, P1[0]),
+                               row_of(f, P1[1]), 0.5 * f->ww, 1, f->wall_c);
+        }
+        const int step = nv > 8 ? (nv - 1) / 4 : 1;
+        for (int i = 0; sh->cyl[k] && i + 1 < nv; i += step) {
+            const double *b = pt + 3 * nv; /* the other rim, the same angles */
+            if (project(&f->cam, pt + 3 * i, 0, &P0[0], &P0[1], &R, &depth) &&
+                project(&f->cam, b + 3 * i, 0, &P1[0], &P1[1], &R, &depth))
+                canvas_segment(rc, col_of(f, P0[0]), row_of(f, P0[1]), col_of(f, P1[0]),
+                               row_of(f, P1[1]), 0.5 * f->ww, 1, f->wall_c);
         }
     }
+}
 
-    /* ---- grains ---- */
-    double mean_r = 0;
-    for (size_t i = 0; i < n; i++)
-        mean_r += r[i];
-    mean_r = n ? mean_r / n * sc : 1;
-    const double span = range[1] - range[0];
-    for (size_t k = 0; k < nshow; k++) {
-        size_t i = D == 3 ? order[k].i : k;
+/* ---- grains, their rotation markers, force chains and arrows ---- */
+static void draw_grains(render_context *rc, const dem_frame *f)
+{
+    const render_grains_def *def = f->def;
+    const double span = f->range[1] - f->range[0];
+    for (size_t k = 0; k < f->nshow; k++) {
+        size_t i = f->D == 3 ? f->order[k].i : k;
         unsigned char c[3];
-        if (mapped)
-            render_colormap_rgb(def->colormap, (val[i] - range[0]) / span, c);
+        if (f->mapped)
+            render_colormap_rgb(def->colormap, (f->val[i] - f->range[0]) / span, c);
         else
             render_label_rgb(def->color == RENDER_COLOR_LABELS ? def->labels[i] : (long)i, c);
-        if (chains.n || def->force_chains) /* pale grains under the chains */
+        if (f->chains.n || def->force_chains) /* pale grains under the chains */
             for (int ch = 0; ch < 3; ch++)
                 c[ch] = (unsigned char)(c[ch] + (255 - c[ch]) * 0.6);
-        double rp = r[i] * sc;
-        double edge = D == 3 ? -1 : rp >= 3 ? fmin(1.2, 0.1 * rp) : 0;
-        canvas_disk(rc, PX(x[i]), PY(y[i]), rp, edge, rgba(c[0], c[1], c[2], 255));
+        double rp = f->r[i] * f->sc;
+        double edge = f->D == 3 ? -1 : rp >= 3 ? fmin(1.2, 0.1 * rp) : 0;
+        canvas_disk(rc, col_of(f, f->x[i]), row_of(f, f->y[i]), rp, edge,
+                    rgba(c[0], c[1], c[2], 255));
     }
+}
 
-    /* ---- rotation markers ---- */
-    if (def->rotation)
-        for (size_t i = 0; i < n; i++) {
-            double rp = r[i] * sc;
-            if (rp < 2.5)
-                continue;
-            double a = def->angles ? def->angles[i] : 0;
-            double ex = x[i] + 0.92 * r[i] * cos(a), ey = y[i] + 0.92 * r[i] * sin(a);
-            canvas_segment(rc, PX(x[i]), PY(y[i]), PX(ex), PY(ey), fmin(3, fmax(1, 0.15 * rp)),
-                           1, rgba(25, 25, 25, 230));
-        }
-
-    /* ---- force chains: strongest on top ---- */
-    if (chains.n) {
-        qsort(chains.c, chains.n, sizeof *chains.c, by_force);
-        double fbig = chains.c[chains.n - 1].fn;
-        double wmax = fmax(1.5, 0.8 * mean_r);
-        for (size_t k = 0; k < chains.n; k++) {
-            const chain *c = &chains.c[k];
-            double u = c->fn / fbig;
-            /* The far end is the partner's image along the normal (from j to i), which is
-             * also right across a periodic edge. */
-            double d = r[c->i] + r[c->j] - c->overlap;
-            unsigned char gray = (unsigned char)lround(200 * (1 - u));
-            double x0 = x[c->i], y0 = y[c->i];
-            double x1 = x0 - c->nx * d, y1 = y0 - c->ny * d;
-            canvas_segment(rc, PX(x0), PY(y0), PX(x1), PY(y1), fmax(0.3, wmax * u), 1,
-                           rgba(gray, gray, gray, 255));
-        }
+static void draw_rotation(render_context *rc, const dem_frame *f)
+{
+    const double *x = f->x, *y = f->y, *r = f->r;
+    for (size_t i = 0; i < f->n; i++) {
+        double rp = r[i] * f->sc;
+        if (rp < 2.5)
+            continue;
+        double a = f->def->angles ? f->def->angles[i] : 0;
+        double ex = x[i] + 0.92 * r[i] * cos(a), ey = y[i] + 0.92 * r[i] * sin(a);
+        canvas_segment(rc, col_of(f, x[i]), row_of(f, y[i]), col_of(f, ex), row_of(f, ey),
+                       fmin(3, fmax(1, 0.15 * rp)), 1, rgba(25, 25, 25, 230));
     }
+}
 
-    /* ---- arrows, with a reference arrow of a round length in the title band ---- */
-    if (def->arrows[0] && n) {
-        const double *ux = def->arrows[0], *uy = def->arrows[1];
-        double umax = 0;
-        for (size_t i = 0; i < n; i++)
-            if (isfinite(ux[i]) && isfinite(uy[i]))
-                umax = fmax(umax, hypot(ux[i], uy[i]));
-        double k = def->arrow_scale; /* scene metres per unit */
-        if (k == 0)
-            k = umax > 0 ? 3 * (mean_r / sc) / umax : 1;
-        rgba8 ac = rgba(190, 30, 30, 255);
-        double aw = fmin(3, fmax(1.2, 0.12 * mean_r));
-        for (size_t i = 0; i < n; i++) {
-            if (!isfinite(ux[i]) || !isfinite(uy[i]))
-                continue;
-            double len = hypot(ux[i], uy[i]) * k * sc;
-            if (len < 0.5)
-                continue;
-            double x0 = PX(x[i]), y0 = PY(y[i]);
-            double dx = ux[i] * k * sc / len, dy = -uy[i] * k * sc / len;
-            double x1 = x0 + dx * len, y1 = y0 + dy * len;
-            canvas_arrow(rc, x0, y0, x1, y1, dx, dy, aw, fmin(0.35 * len, fmax(3, 0.9 * mean_r)),
-                         ac);
-        }
-        double right = W - m - band -
-                       (def->stamp && *def->stamp ? canvas_text_width(rc, def->stamp, fs) + 2 * fs
-                                                  : 0);
-        reference_arrow(rc, umax, k, sc, "m", right, ay0 - lround(0.45 * fs), fs, aw,
-                        fmax(3, 0.9 * mean_r), ac);
+/* Force chains: the strongest on top. */
+static void draw_chains(render_context *rc, dem_frame *f)
+{
+    chain_list *chains = &f->chains;
+    const double *x = f->x, *y = f->y, *r = f->r;
+    qsort(chains->c, chains->n, sizeof *chains->c, by_force);
+    double fbig = chains->c[chains->n - 1].fn;
+    double wmax = fmax(1.5, 0.8 * f->mean_r);
+    for (size_t k = 0; k < chains->n; k++) {
+        const chain *c = &chains->c[k];
+        double u = c->fn / fbig;
+        /* The far end is the partner's image along the normal (from j to i), which is
+         * also right across a periodic edge. */
+        double d = r[c->i] + r[c->j] - c->overlap;
+        unsigned char gray = (unsigned char)lround(200 * (1 - u));
+        double x0 = x[c->i], y0 = y[c->i];
+        double x1 = x0 - c->nx * d, y1 = y0 - c->ny * d;
+        canvas_segment(rc, col_of(f, x0), row_of(f, y0), col_of(f, x1), row_of(f, y1),
+                       fmax(0.3, wmax * u), 1, rgba(gray, gray, gray, 255));
     }
+}
 
-    /* ---- walls and box ---- */
-    for (int k = 0; D == 2 && k < def->nwalls; k++) {
-        const render_wall *wl = &def->walls[k];
+/* Arrows, with a reference arrow of a round length in the title band. */
+static void draw_arrows(render_context *rc, const dem_frame *f)
+{
+    const render_grains_def *def = f->def;
+    const size_t n = f->n;
+    const double *x = f->x, *y = f->y, sc = f->sc, mean_r = f->mean_r, fs = f->fs;
+    const double *ux = def->arrows[0], *uy = def->arrows[1];
+    double umax = 0;
+    for (size_t i = 0; i < n; i++)
+        if (isfinite(ux[i]) && isfinite(uy[i]))
+            umax = fmax(umax, hypot(ux[i], uy[i]));
+    double k = def->arrow_scale; /* scene metres per unit */
+    if (k == 0)
+        k = umax > 0 ? 3 * (mean_r / sc) / umax : 1;
+    rgba8 ac = rgba(190, 30, 30, 255);
+    double aw = fmin(3, fmax(1.2, 0.12 * mean_r));
+    for (size_t i = 0; i < n; i++) {
+        if (!isfinite(ux[i]) || !isfinite(uy[i]))
+            continue;
+        double len = hypot(ux[i], uy[i]) * k * sc;
+        if (len < 0.5)
+            continue;
+        double x0 = col_of(f, x[i]), y0 = row_of(f, y[i]);
+        double dx = ux[i] * k * sc / len, dy = -uy[i] * k * sc / len;
+        double x1 = x0 + dx * len, y1 = y0 + dy * len;
+        canvas_arrow(rc, x0, y0, x1, y1, dx, dy, aw, fmin(0.35 * len, fmax(3, 0.9 * mean_r)), ac);
+    }
+    double right = f->W - f->m - f->band -
+                   (def->stamp && *def->stamp ? canvas_text_width(rc, def->stamp, fs) + 2 * fs : 0);
+    reference_arrow(rc, umax, k, sc, "m", right, f->ay0 - lround(0.45 * fs), fs, aw,
+                    fmax(3, 0.9 * mean_r), ac);
+}
+
+/* ---- 2D: walls and box over the grains ---- */
+static void draw_planes_2d(render_context *rc, const dem_frame *f)
+{
+    const double ww = f->ww;
+    for (int k = 0; k < f->def->nwalls; k++) {
+        const render_wall *wl = &f->def->walls[k];
         double nn = hypot(wl->normal[0], wl->normal[1]);
         if (!(nn > 0))
             continue;
         double nx = wl->normal[0] / nn, ny = wl->normal[1] / nn, t[2] = {-ny, nx}, a[2], b[2];
-        if (!clip_line(wl->point, t, lo, hi, a, b))
+        if (!clip_line(wl->point, t, f->lo, f->hi, a, b))
             continue;
         /* the stroke lies outside the domain, its inner edge on the wall */
         double sx = -nx * 0.5 * ww, sy = ny * 0.5 * ww;
-        canvas_segment(rc, PX(a[0]) + sx, PY(a[1]) + sy, PX(b[0]) + sx, PY(b[1]) + sy, ww, 1,
-                       wall_c);
+        canvas_segment(rc, col_of(f, a[0]) + sx, row_of(f, a[1]) + sy, col_of(f, b[0]) + sx,
+                       row_of(f, b[1]) + sy, ww, 1, f->wall_c);
     }
-    /* Polylines and circles: a line along the surface, over the grains (a baffle inside a drum
-     * crosses them); their contact points lie within its half width of the surface. */
-    const double *pt = shapes.pts;
-    for (int k = 0; D == 2 && k < shapes.n; pt += 3 * shapes.nv[k], k++)
-        for (int i = 0; i + 1 < shapes.nv[k]; i++)
-            canvas_segment(rc, PX(pt[3 * i]), PY(pt[3 * i + 1]), PX(pt[3 * i + 3]),
-                           PY(pt[3 * i + 4]), 0.6 * ww, 1, wall_c);
-    shape_lines_free(&shapes);
-    if (D == 2 && def->box) {
-        rgba8 bc = rgba(150, 150, 150, 255);
-        double l = ox - 0.5, rt = ox + bw + 0.5, tp = oy - 0.5, bt = oy + bh + 0.5;
-        canvas_segment(rc, l - 0.5, tp, rt + 0.5, tp, 1, 0, bc);
-        canvas_segment(rc, l - 0.5, bt, rt + 0.5, bt, 1, 0, bc);
-        canvas_segment(rc, l, tp, l, bt, 1, 0, bc);
-        canvas_segment(rc, rt, tp, rt, bt, 1, 0, bc);
-    }
+}
 
-    /* ---- text ---- */
+/* Polylines and circles: a line along the surface, over the grains (a baffle inside a drum
+ * crosses them); their contact points lie within its half width of the surface. */
+static void draw_shapes_2d(render_context *rc, const dem_frame *f)
+{
+    const shape_lines *sh = &f->shapes;
+    const double *pt = sh->pts;
+    for (int k = 0; k < sh->n; pt += 3 * sh->nv[k], k++)
+        for (int i = 0; i + 1 < sh->nv[k]; i++)
+            canvas_segment(rc, col_of(f, pt[3 * i]), row_of(f, pt[3 * i + 1]),
+                           col_of(f, pt[3 * i + 3]), row_of(f, pt[3 * i + 4]), 0.6 * f->ww, 1,
+                           f->wall_c);
+}
+
+static void draw_box_2d(render_context *rc, const dem_frame *f)
+{
+    rgba8 bc = rgba(150, 150, 150, 255);
+    double l = f->ox - 0.5, rt = f->ox + f->bw + 0.5, tp = f->oy - 0.5, bt = f->oy + f->bh + 0.5;
+    canvas_segment(rc, l - 0.5, tp, rt + 0.5, tp, 1, 0, bc);
+    canvas_segment(rc, l - 0.5, bt, rt + 0.5, bt, 1, 0, bc);
+    canvas_segment(rc, l, tp, l, bt, 1, 0, bc);
+    canvas_segment(rc, rt, tp, rt, bt, 1, 0, bc);
+}
+
+static void draw_text(render_context *rc, const dem_frame *f)
+{
+    const render_grains_def *def = f->def;
     rgba8 ink = rgba(20, 20, 20, 255);
-    double ty = ay0 - lround(0.45 * fs);
+    double ty = f->ay0 - lround(0.45 * f->fs);
     if (def->title && *def->title)
-        canvas_text(rc, def->title, fs, m, ty, 0, 1, 0, ink);
+        canvas_text(rc, def->title, f->fs, f->m, ty, 0, 1, 0, ink);
     if (def->stamp && *def->stamp)
-        canvas_text(rc, def->stamp, fs, W - m - band, ty, 1, 1, 0, ink);
+        canvas_text(rc, def->stamp, f->fs, f->W - f->m - f->band, ty, 1, 1, 0, ink);
+}
 
-    if (show_bar)
-        colorbar_draw(rc, &bar, def->colormap, ox + bw, oy, oy + bh);
-#undef PX
-#undef PY
-    free(chains.c);
-    free(val);
-    free(proj);
-    free(order);
+core_status render_dem(render_context *rc, dem_scene *s, const render_grains_def *def,
+                       render_image *out, render_view *view, core_error *err)
+{
+    out->rgba = NULL;
+    out->width = out->height = 0;
+    core_status st = check_def(s, def, err);
+    if (st != CORE_OK)
+        return st;
+    dem_frame f;
+    frame_start(&f, s, def);
+    if ((st = grain_values(&f, s, err)) != CORE_OK ||
+        (st = scene_geometry(&f, s, err)) != CORE_OK ||
+        (st = frame_layout(rc, &f, err)) != CORE_OK) {
+        frame_free(&f);
+        return st;
+    }
+    frame_view(&f, view);
+    if ((st = collect_overlays(&f, s, err)) != CORE_OK ||
+        (st = canvas_begin(rc, f.W, f.H, err)) != CORE_OK) {
+        frame_free(&f);
+        return st;
+    }
+    if (f.D == 3 && def->box)
+        draw_box_3d(rc, &f);
+    if (f.D == 3 && def->nwalls)
+        draw_planes_3d(rc, &f);
+    if (f.D == 3 && f.shapes.n)
+        draw_shapes_3d(rc, &f);
+    draw_grains(rc, &f);
+    if (def->rotation)
+        draw_rotation(rc, &f);
+    if (f.chains.n)
+        draw_chains(rc, &f);
+    if (def->arrows[0] && f.n)
+        draw_arrows(rc, &f);
+    if (f.D == 2) {
+        draw_planes_2d(rc, &f);
+        draw_shapes_2d(rc, &f);
+        if (def->box)
+            draw_box_2d(rc, &f);
+    }
+    draw_text(rc, &f);
+    if (f.show_bar)
+        colorbar_draw(rc, &f.bar, def->colormap, f.ox + f.bw, f.oy, f.oy + f.bh);
+    frame_free(&f);
     return canvas_end(rc, out, err);
 }
