@@ -360,8 +360,8 @@ static void read_contact(reader *r, dem_contact_def *c)
     c->exponent = get_finite(r, "exponent");
     c->clip = get_flag(r, "clip");
     c->rolling = get_flag(r, "rolling");
-    if (normal > DEM_NORMAL_HERTZ || damping > DEM_DAMPING_BRILLIANTOV ||
-        tangential > DEM_TANGENT_REGULARIZED)
+    if (normal >= DEM_NORMAL_COUNT || damping >= DEM_DAMPING_COUNT ||
+        tangential >= DEM_TANGENT_COUNT) /* laws.h's lists */
         bad(r, "unknown contact law");
     c->normal = (dem_normal_law)normal;
     c->damping = (dem_damping_law)damping;
@@ -630,7 +630,7 @@ static void read_rolling(reader *r, dem_scene *s)
 {
     dem_contact_def *c = &s->contact;
     uint32_t law = u32(r);
-    if (law > DEM_ROLLING_CONSTANT)
+    if (law >= DEM_ROLLING_COUNT)
         bad(r, "unknown rolling law");
     c->rolling_law = (dem_rolling_law)law;
     c->rolling_friction = f64(r);
@@ -692,10 +692,10 @@ static const char *inconsistent(const dem_scene *s, int gear_ready, int prev_rea
                 return "pair forces missing";
             if (s->rot && (D == 3 || d == 2) && !p->c[d])
                 return "pair torques missing";
-            if (s->contact.tangential == DEM_TANGENT_SPRING && d < D && !p->hist[d])
+            if (dem_tangent_history(s->contact.tangential) && d < D && !p->hist[d])
                 return "contact history missing";
         }
-        if (s->contact.tangential == DEM_TANGENT_SPRING && p->n > 0 && !p->hist[3])
+        if (dem_tangent_history(s->contact.tangential) && p->n > 0 && !p->hist[3])
             return "contact history missing";
         for (int d = 0; d < dem_rolling_slots(s) && p->n > 0; d++)
             if (!p->hist[DEM_HIST_ROLL + d])

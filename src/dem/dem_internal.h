@@ -301,7 +301,7 @@ double dem_elastic_energy(const dem_contact_def *c, double k, double delta);
  * rolling 3 only with a rolling history (a scene without it sends what it sent before). */
 static inline int dem_rolling_slots(const dem_scene *s)
 {
-    return s->contact.rolling_law == DEM_ROLLING_EPSD ? (s->dim == 2 ? 1 : 3) : 0;
+    return dem_rolling_history(s->contact.rolling_law) ? (s->dim == 2 ? 1 : 3) : 0;
 }
 static inline int dem_hist_width(const dem_scene *s) { return dem_rolling_slots(s) ? DEM_HIST : 4; }
 

@@ -1107,10 +1107,10 @@ core_status dem_replicate(dem_scene *s, core_error *err)
                 ok &= (p->f[d] = malloc(cap * sizeof(double))) != NULL;
             if (s->rot && (s->dim == 3 || d == 2))
                 ok &= (p->c[d] = malloc(cap * sizeof(double))) != NULL;
-            if (s->contact.tangential == DEM_TANGENT_SPRING && d < s->dim)
+            if (dem_tangent_history(s->contact.tangential) && d < s->dim)
                 ok &= (p->hist[d] = malloc(cap * sizeof(double))) != NULL;
         }
-        if (s->contact.tangential == DEM_TANGENT_SPRING)
+        if (dem_tangent_history(s->contact.tangential))
             ok &= (p->hist[3] = malloc(cap * sizeof(double))) != NULL;
         for (int d = s->dim == 2 ? 2 : 0; d < 3 && s->contact.rolling_law; d++)
             ok &= (p->rt[d] = malloc(cap * sizeof(double))) != NULL;

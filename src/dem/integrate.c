@@ -25,7 +25,7 @@ static core_status prepare(dem_scene *s, const dem_run_def *run, core_error *err
     const int D = s->dim;
     if (s->nmat == 0 || (dem_domain_count(s) == 0 && !dem_flow_inserting(s)))
         return core_fail(err, CORE_ERR_STATE, "the scene has no particles: add some first");
-    if (s->contact.tangential == DEM_TANGENT_SPRING) {
+    if (dem_tangent_history(s->contact.tangential)) {
         for (int w = 0; w < s->nwalls; w++) {
             if (!s->walls[w].active || s->walls[w].hist[0])
                 continue;
@@ -93,12 +93,12 @@ static int side_open(const dem_scene *s, int d, int sign)
 static void stiffness_text(const dem_scene *s, size_t i, char *buf, size_t n)
 {
     const dem_contact_def *c = &s->contact;
-    if (c->normal == DEM_NORMAL_HERTZ)
+    if (dem_normal_from_moduli(c->normal))
         snprintf(buf, n, "E = %.3g Pa", s->mats[s->mat[i]].young);
-    else if (c->normal == DEM_NORMAL_LINEAR)
+    else if (dem_law_beta(c) == 1)
         snprintf(buf, n, "k = %.3g N/m", c->stiffness);
     else
-        snprintf(buf, n, "k = %.3g N/m^%g", c->stiffness, c->beta);
+        snprintf(buf, n, "k = %.3g N/m^%g", c->stiffness, dem_law_beta(c));
 }
 
 static void likely_cause(const dem_scene *s, size_t i, char *buf, size_t n)
@@ -141,9 +141,7 @@ static void likely_cause(const dem_scene *s, size_t i, char *buf, size_t n)
     g = sqrt(g);
     const double r = s->r[i], m = s->m[i];
     const dem_contact_def *c = &s->contact;
-    double beta = c->normal == DEM_NORMAL_LINEAR  ? 1
-                  : c->normal == DEM_NORMAL_POWER ? c->beta
-                                                  : 1.5;
+    double beta = dem_law_beta(c);
     double k = 0, gamma = 0;
     if (r > 0 && m > 0 && isfinite(m))
         dem_probe_parameters(s, s->mat[i], r, m, &k, &gamma);
@@ -1014,9 +1012,7 @@ static double contact_integral(double p)
 static void contact_limits(const dem_scene *s, double k, double gamma, double m_eff, double v,
                            double *t, double *b)
 {
-    double beta = s->contact.normal == DEM_NORMAL_LINEAR  ? 1
-                  : s->contact.normal == DEM_NORMAL_POWER ? s->contact.beta
-                                                          : 1.5;
+    double beta = dem_law_beta(&s->contact);
     double dmax = pow((beta + 1) * m_eff * v * v / (2 * k), 1 / (beta + 1));
     *t = 2 * dmax / v * contact_integral(beta + 1);
     if (beta == 1)

@@ -45,8 +45,8 @@ static void law_parameters(const dem_scene *s, int ma, int mb, double r_eff, dou
 {
     const dem_contact_def *c = &s->contact;
     const dem_material *a = &s->mats[ma], *b = &s->mats[mb];
-    *k = c->normal == DEM_NORMAL_HERTZ ? 4.0 / 3.0 * effective_modulus(a, b) * sqrt(r_eff)
-                                       : c->stiffness;
+    *k = dem_normal_from_moduli(c->normal) ? 4.0 / 3.0 * effective_modulus(a, b) * sqrt(r_eff)
+                                           : c->stiffness;
     *gamma = 0;
     const int given = c->restitution > 0; /* s:contact's restitution */
     if (c->damping == DEM_DAMPING_VISCOUS) {
@@ -148,10 +148,10 @@ static core_status reserve_pairs(dem_scene *s, size_t n, core_error *err)
             st = dem_alloc_array(&p->f[d], cap, err);
         if (!st && s->rot && (s->dim == 3 || d == 2))
             st = dem_alloc_array(&p->c[d], cap, err);
-        if (!st && s->contact.tangential == DEM_TANGENT_SPRING && d < s->dim)
+        if (!st && dem_tangent_history(s->contact.tangential) && d < s->dim)
             st = dem_alloc_array(&p->hist[d], cap, err);
     }
-    if (!st && s->contact.tangential == DEM_TANGENT_SPRING)
+    if (!st && dem_tangent_history(s->contact.tangential))
         st = dem_alloc_array(&p->hist[3], cap, err);
     /* rolling resistance: the torques (rotations are on), the EPSD spring's history */
     for (int d = s->dim == 2 ? 2 : 0; d < 3 && !st && s->contact.rolling_law; d++)

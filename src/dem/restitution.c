@@ -172,11 +172,6 @@ core_status dem_contact_damping(double e, double beta, double a, bool clip, doub
     return CORE_OK;
 }
 
-double dem_law_beta(const dem_contact_def *c)
-{
-    return c->normal == DEM_NORMAL_LINEAR ? 1 : c->normal == DEM_NORMAL_POWER ? c->beta : 1.5;
-}
-
 int dem_damping_solved(const dem_contact_def *c)
 {
     if (c->restitution >= 0) /* s:contact's restitution: one coefficient (scene.c) */
@@ -195,7 +190,8 @@ core_status dem_damping_coefficient(const dem_contact_def *c, double e, double *
 {
     const int brill = c->damping == DEM_DAMPING_BRILLIANTOV;
     double beta = dem_law_beta(c), x;
-    core_status st = dem_contact_damping(e, beta, brill ? 0.5 : 0, c->clip, &x, err);
+    core_status st =
+        dem_contact_damping(e, beta, dem_damping_exponent(c->damping), c->clip, &x, err);
     if (st != CORE_OK)
         return st;
     *out = brill ? x * pow(c->impact_velocity, -0.2) : x;

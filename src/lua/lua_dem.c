@@ -195,11 +195,7 @@ static void default_material_notice(lua_State *L, dem_scene *s, int scene, int a
 }
 
 /* ---- s:contact{...} ------------------------------------------------------------------------ */
-static const char *const NORMAL_NAMES[] = {"linear", "power", "hertz", NULL};
-static const char *const DAMPING_NAMES[] = {"none", "viscous", "brilliantov", NULL};
-static const char *const TANGENT_NAMES[] = {"none", "viscous", "spring", "coulomb_regularized",
-                                            NULL};
-static const char *const ROLLING_NAMES[] = {"none", "epsd", "constant", NULL};
+/* The laws' names: dem_normal_names and its kin, from laws.h's lists. */
 
 static const char *const CONTACT_FIELDS[] = {"normal",
                                              "stiffness",
@@ -223,12 +219,31 @@ static const char *const CONTACT_FIELDS[] = {"normal",
                                              "rolling_rate",
                                              NULL};
 
+/* The normal laws whose k is s:contact's stiffness (moduli 0), or comes from the materials
+ * (moduli 1), as "'linear' or 'power'" (quoted) or "hertz" (plain). */
+static void normal_names_by_k(int moduli, int quoted, char *buf, size_t size)
+{
+    int count = 0;
+    for (int i = 0; dem_normal_names[i]; i++)
+        count += dem_normal_from_moduli((dem_normal_law)i) == moduli;
+    buf[0] = 0;
+    for (int i = 0, k = 0; dem_normal_names[i]; i++) {
+        if (dem_normal_from_moduli((dem_normal_law)i) != moduli)
+            continue;
+        const char *parts[4] = {k == 0 ? "" : k == count - 1 ? " or " : ", ", quoted ? "'" : "",
+                                dem_normal_names[i], quoted ? "'" : ""};
+        for (int p = 0; p < 4; p++)
+            strncat(buf, parts[p], size - 1 - strlen(buf));
+        k++;
+    }
+}
+
 /* A field given although the chosen law ignores it is refused: a typo'd law must not leave the
  * user believing a value took effect. `why` names the field and value that give it meaning. */
 static void only_with(lua_State *L, const char *field, int meaningful, const char *why)
 {
     if (!meaningful && lua_getfield(L, 2, field) != LUA_TNIL) {
-        char expected[160];
+        char expected[320];
         snprintf(expected, sizeof expected, "nothing unless %s", why);
         bind_field_error(L, 2, "contact", field, expected);
     }
@@ -244,12 +259,12 @@ static int l_contact(lua_State *L)
     bind_check_table(L, 2, "contact");
     bind_check_fields(L, 2, "contact", CONTACT_FIELDS);
     dem_contact_def c = dem_default_contact_def();
-    c.normal = (dem_normal_law)bind_field_option(L, 2, "contact", "normal", NORMAL_NAMES,
+    c.normal = (dem_normal_law)bind_field_option(L, 2, "contact", "normal", dem_normal_names,
                                                  DEM_NORMAL_HERTZ, 0);
-    c.damping = (dem_damping_law)bind_field_option(L, 2, "contact", "damping", DAMPING_NAMES,
+    c.damping = (dem_damping_law)bind_field_option(L, 2, "contact", "damping", dem_damping_names,
                                                    DEM_DAMPING_NONE, 0);
     c.tangential = (dem_tangential_law)bind_field_option(L, 2, "contact", "tangential",
-                                                         TANGENT_NAMES, DEM_TANGENT_NONE, 0);
+                                                         dem_tangent_names, DEM_TANGENT_NONE, 0);
     lua_settop(L, 2);
     if (c.damping == DEM_DAMPING_BRILLIANTOV && c.normal != DEM_NORMAL_HERTZ) {
         lua_getfield(L, 2, "damping");
@@ -258,8 +273,11 @@ static int l_contact(lua_State *L)
                                 "damping needs normal = 'hertz'; viscous damping honours a "
                                 "restitution with every law)");
     }
-    only_with(L, "stiffness", c.normal != DEM_NORMAL_HERTZ,
-              "'normal' is 'linear' or 'power' (hertz takes the materials' moduli)");
+    char given[96], moduli[96], why[256];
+    normal_names_by_k(0, 1, given, sizeof given);
+    normal_names_by_k(1, 0, moduli, sizeof moduli);
+    snprintf(why, sizeof why, "'normal' is %s (%s takes the materials' moduli)", given, moduli);
+    only_with(L, "stiffness", !dem_normal_from_moduli(c.normal), why);
     only_with(L, "beta", c.normal == DEM_NORMAL_POWER, "'normal' is 'power'");
     only_with(L, "gamma_n", c.damping == DEM_DAMPING_VISCOUS, "'damping' is 'viscous'");
     only_with(L, "damping_time", c.damping == DEM_DAMPING_BRILLIANTOV,
@@ -270,7 +288,7 @@ static int l_contact(lua_State *L)
               "'tangential' is 'coulomb_regularized'");
     only_with(L, "exponent", c.tangential == DEM_TANGENT_REGULARIZED,
               "'tangential' is 'coulomb_regularized'");
-    unsigned need_k = c.normal == DEM_NORMAL_HERTZ ? 0 : BIND_REQUIRED;
+    unsigned need_k = dem_normal_from_moduli(c.normal) ? 0 : BIND_REQUIRED;
     c.stiffness = bind_field_number(L, 2, "contact", "stiffness", 0, BIND_POSITIVE | need_k);
     c.beta = bind_field_number(L, 2, "contact", "beta", c.normal == DEM_NORMAL_LINEAR ? 1 : 1.5,
                                BIND_POSITIVE);
@@ -334,7 +352,7 @@ static int l_contact(lua_State *L)
     c.rolling = bind_field_boolean(L, 2, "contact", "rolling", 0);
     /* Rolling resistance (dem.h, rolling.inc) */
     c.rolling_law = (dem_rolling_law)bind_field_option(L, 2, "contact", "rolling_resistance",
-                                                       ROLLING_NAMES, DEM_ROLLING_NONE, 0);
+                                                       dem_rolling_names, DEM_ROLLING_NONE, 0);
     lua_settop(L, 2);
     const int roll = c.rolling_law != DEM_ROLLING_NONE;
     only_with(L, "rolling_friction", roll, "'rolling_resistance' is 'epsd' or 'constant'");
@@ -1452,13 +1470,13 @@ static int l_info(lua_State *L)
     lua_pushinteger(L, dem_force_evaluations(s));
     lua_setfield(L, -2, "force_evaluations");
     const dem_contact_def *c = dem_contact(s);
-    lua_pushstring(L, NORMAL_NAMES[c->normal]);
+    lua_pushstring(L, dem_normal_names[c->normal]);
     lua_setfield(L, -2, "normal");
-    lua_pushstring(L, DAMPING_NAMES[c->damping]);
+    lua_pushstring(L, dem_damping_names[c->damping]);
     lua_setfield(L, -2, "damping");
-    lua_pushstring(L, TANGENT_NAMES[c->tangential]);
+    lua_pushstring(L, dem_tangent_names[c->tangential]);
     lua_setfield(L, -2, "tangential");
-    lua_pushstring(L, ROLLING_NAMES[c->rolling_law]);
+    lua_pushstring(L, dem_rolling_names[c->rolling_law]);
     lua_setfield(L, -2, "rolling_resistance");
     lua_pushnumber(L, c->damping_time);
     lua_setfield(L, -2, "damping_time");
