@@ -458,7 +458,7 @@ core_status dem_vtk_particles(const dem_scene *s, const char *path, core_error *
 core_status dem_vtk_contacts(dem_scene *s, const char *path, core_error *err);
 core_status dem_vtk_walls(const dem_scene *s, const char *path, core_error *err);
 
-/* ---- LAMMPS data and dump files (lammps.c) -------------------------------------------------- *
+/* ---- LAMMPS data and dump files (lammps.c, lammps_write.c) --------------------------------- *
  * Data files in atom_style sphere (LIGGGHTS: granular): Atoms "id type diameter density x y z
  * [ix iy iz]", Velocities "id vx vy vz wx wy wz". The density column is the material's density
  * (kg/m^3); LAMMPS's mass rule density 4/3 pi r^3 is grainlab's for spheres and for 2D disks
@@ -523,7 +523,7 @@ core_status dem_write_lammps_dump(const dem_scene *s, const char *path,
 int dem_material_count(const dem_scene *s);
 const dem_material *dem_material_get(const dem_scene *s, int index); /* NULL if out of range */
 
-/* ---- checkpoints (checkpoint.c) ------------------------------------------------------------ *
+/* ---- checkpoints (checkpoint.c, checkpoint_save.c) ----------------------------------------- *
  * The whole state a run continues from, laid out by particle id (core/checkpoint.h container,
  * engine kind "dem"): run N + M steps, or N, save, load (in another process, with another thread
  * count), M: the same bits. Boundary conditions are stored (edges, pressure, the minimal-boundary

@@ -1,10 +1,10 @@
 /* Particles in and out during a run: inserters (a region, a rate or a count or a mass, a size
  * distribution, a velocity; positions drawn from the inserter's own random stream, never
  * overlapping) and outflows (a box, or an open side of the domain), applied between steps. A
- * removal compacts every per-particle array (domain.c's table), the pair list with its history
- * and the walls' candidates in place, so the list stays valid without a rebuild; an insertion
- * appends particles and asks for a rebuild (the history of the others carries over by index).
- * Their checkpoint section: flow_checkpoint.c. */
+ * removal compacts every per-particle array (domain_gather.c's table), the pair list with its
+ * history and the walls' candidates in place, so the list stays valid without a rebuild; an
+ * insertion appends particles and asks for a rebuild (the history of the others carries over by
+ * index). Their checkpoint section: flow_checkpoint.c. */
 #include <limits.h>
 #include <math.h>
 #include <stdio.h>
@@ -126,7 +126,7 @@ core_status dem_outflow_counts(const dem_scene *s, int id, dem_flow_counts *out,
 
 core_status dem_flow_check_run(const dem_scene *s, core_error *err)
 {
-    /* tags alone (a LAMMPS file's ids) travel with their particles (domain.c's table) */
+    /* tags alone (a LAMMPS file's ids) travel with their particles (domain_gather.c's table) */
     if (comm_size() > 1 && (s->flow->nins > 0 || s->flow->nout > 0))
         return core_fail(err, CORE_ERR_STATE,
                          "particle insertion and removal (inserters, outflows) do not yet run "
