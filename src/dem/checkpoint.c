@@ -5,7 +5,8 @@
  * last displacement, the two-timescales phase), the Verlet list with its per-pair parameters and
  * contact history (keyed by the particle pair i < j, in (i, j) order), the walls with their
  * candidates and histories, the energy watch. Nothing is recomputed on load except tables that
- * are a pure function of stored values (the power table, the list's incidence arrays). */
+ * are a pure function of stored values (the power table, the list's incidence arrays). This file
+ * reads them back; checkpoint_save.c writes them. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -14,264 +15,6 @@
 #include "core/memory.h"
 #include "dem/checkpoint_reader.h"
 #include "dem/dem_internal.h"
-
-/* ---- saving --------------------------------------------------------------------------------- */
-
-/* An array that may be absent: a presence flag, then the values. */
-static void put_opt(ckpt_writer *w, const double *a, size_t n)
-{
-    ckpt_put_u32(w, a != NULL);
-    if (a)
-        ckpt_put_f64s(w, a, n);
-}
-
-static void put_i32s(ckpt_writer *w, const int *a, size_t n)
-{
-    ckpt_put_u64(w, n);
-    for (size_t k = 0; k < n; k++)
-        ckpt_put_i64(w, a[k]);
-}
-
-static core_status end(ckpt_writer *w, core_error *err) { return ckpt_section_end(w, err); }
-
-static void put_contact(ckpt_writer *w, const dem_contact_def *c)
-{
-    ckpt_put_u32(w, (uint32_t)c->normal);
-    ckpt_put_f64(w, c->stiffness);
-    ckpt_put_f64(w, c->beta);
-    ckpt_put_u32(w, (uint32_t)c->damping);
-    ckpt_put_f64(w, c->gamma_n);
-    ckpt_put_f64(w, c->damping_time);
-    ckpt_put_f64(w, c->restitution);
-    ckpt_put_f64(w, c->impact_velocity);
-    ckpt_put_u32(w, (uint32_t)c->tangential);
-    ckpt_put_f64(w, c->gamma_t);
-    ckpt_put_f64(w, c->kt);
-    ckpt_put_f64(w, c->v_r);
-    ckpt_put_f64(w, c->exponent);
-    ckpt_put_u32(w, c->clip);
-    ckpt_put_u32(w, c->rolling);
-}
-
-/* Rolling resistance (rolling.inc) has its own section, written only by a scene that uses it (a
- * rolling law, or a material with a rolling friction): a file without it loads as before, and a
- * grainlab without rolling resistance refuses a file with it by the section's name. It holds the
- * law, the materials' mu_r, and the rolling spring's history of the pairs and walls. */
-static int uses_rolling(const dem_scene *s)
-{
-    int used = s->contact.rolling_law != DEM_ROLLING_NONE;
-    for (int k = 0; k < s->nmat; k++)
-        used |= s->mats[k].rolling_friction != 0;
-    return used;
-}
-
-static core_status write_rolling(const dem_scene *s, ckpt_writer *w, core_error *err)
-{
-    core_status st;
-    if ((st = ckpt_section_begin(w, "rolling", CKPT_REQUIRED, err)))
-        return st;
-    const dem_contact_def *c = &s->contact;
-    ckpt_put_u32(w, (uint32_t)c->rolling_law);
-    ckpt_put_f64(w, c->rolling_friction);
-    ckpt_put_f64(w, c->rolling_stiffness);
-    ckpt_put_f64(w, c->rolling_damping);
-    ckpt_put_f64(w, c->rolling_rate);
-    ckpt_put_u64(w, (uint64_t)s->nmat);
-    for (int k = 0; k < s->nmat; k++)
-        ckpt_put_f64(w, s->mats[k].rolling_friction);
-    for (int d = 0; d < 3; d++)
-        put_opt(w, s->pairs.hist[DEM_HIST_ROLL + d], s->pairs.n);
-    ckpt_put_u64(w, (uint64_t)s->nwalls);
-    for (int k = 0; k < s->nwalls; k++)
-        for (int d = 0; d < 3; d++)
-            put_opt(w, s->walls[k].hist[DEM_HIST_ROLL + d], s->n);
-    return end(w, err);
-}
-
-/* Damping solved from a restitution (restitution.c) has its own section, written only by a
- * scene whose law uses it: the coefficients of s:contact's restitution and of each material, as
- * they were solved (a file without it, from a scene whose law needs it, is refused). */
-static int uses_solved_damping(const dem_contact_def *c)
-{
-    return dem_damping_solved(c) ||
-           (c->damping == DEM_DAMPING_VISCOUS && c->restitution > 0 && c->gamma_n < 0 &&
-            (c->clip || dem_law_beta(c) != 1));
-}
-
-static core_status write_damping(const dem_scene *s, ckpt_writer *w, core_error *err)
-{
-    core_status st;
-    if ((st = ckpt_section_begin(w, "damping", CKPT_REQUIRED, err)))
-        return st;
-    ckpt_put_f64(w, s->damp_c);
-    static const double none = 0; /* a scene without materials may have no table */
-    ckpt_put_f64s(w, s->nmat > 0 ? s->mat_damp : &none, (size_t)s->nmat); /* count, values */
-    return end(w, err);
-}
-
-static core_status write_scene(const dem_scene *s, ckpt_writer *w, core_error *err)
-{
-    const size_t n = s->n;
-    const int D = s->dim, d0 = D == 2 ? 2 : 0;
-    core_status st;
-    if ((st = ckpt_section_begin(w, "scene", CKPT_REQUIRED, err)))
-        return st;
-    ckpt_put_u32(w, (uint32_t)D);
-    ckpt_put_bytes(w, s->lo, sizeof s->lo);
-    ckpt_put_bytes(w, s->hi, sizeof s->hi);
-    for (int d = 0; d < 3; d++)
-        ckpt_put_u32(w, s->periodic[d]);
-    ckpt_put_bytes(w, s->gravity, sizeof s->gravity);
-    ckpt_put_f64(w, s->thickness);
-    ckpt_put_f64(w, s->drag);
-    ckpt_put_f64(w, s->skin_def);
-    ckpt_put_f64(w, s->skin);
-    ckpt_put_f64(w, s->r_max);
-    ckpt_put_u64(w, n);
-    ckpt_put_u32(w, (uint32_t)s->rot);
-    ckpt_put_f64(w, s->time);
-    ckpt_put_i64(w, s->steps);
-    ckpt_put_i64(w, s->force_evals);
-    ckpt_put_i64(w, s->last_integrator);
-    ckpt_put_i64(w, s->tt_phase);
-    ckpt_put_u32(w, (uint32_t)s->gear_ready);
-    ckpt_put_u32(w, (uint32_t)s->prev_ready);
-    ckpt_put_u32(w, (uint32_t)s->forces_ready);
-    ckpt_put_u32(w, (uint32_t)s->suspect);
-    ckpt_put_u32(w, (uint32_t)s->need_rebuild);
-    ckpt_put_f64(w, s->gear_dt);
-    ckpt_put_f64(w, s->prev_dt);
-    ckpt_put_u32(w, (uint32_t)s->watch_on);
-    ckpt_put_i64(w, s->watch_next);
-    ckpt_put_i64(w, s->watch_min_step);
-    ckpt_put_f64(w, s->watch_min);
-    ckpt_put_f64(w, s->watch_min_t);
-    ckpt_put_f64(w, s->watch_scale);
-    ckpt_put_f64(w, s->brill_c);
-    if ((st = end(w, err)))
-        return st;
-
-    if ((st = ckpt_section_begin(w, "contact", CKPT_REQUIRED, err)))
-        return st;
-    put_contact(w, &s->contact);
-    if ((st = end(w, err)))
-        return st;
-
-    if ((st = ckpt_section_begin(w, "materials", CKPT_REQUIRED, err)))
-        return st;
-    ckpt_put_u64(w, (uint64_t)s->nmat);
-    for (int k = 0; k < s->nmat; k++) {
-        const dem_material *m = &s->mats[k];
-        const double v[5] = {m->density, m->young, m->poisson, m->friction, m->restitution};
-        ckpt_put_f64s(w, v, 5);
-    }
-    if ((st = end(w, err)))
-        return st;
-
-    /* Particles by id: every per-particle array the steps read. */
-    if ((st = ckpt_section_begin(w, "particles", CKPT_REQUIRED, err)))
-        return st;
-    for (int d = 0; d < D; d++) {
-        ckpt_put_f64s(w, s->x[d], n);
-        ckpt_put_f64s(w, s->v[d], n);
-        ckpt_put_f64s(w, s->f[d], n);
-        ckpt_put_f64s(w, s->x_build[d], n);
-    }
-    ckpt_put_f64s(w, s->r, n);
-    ckpt_put_f64s(w, s->m, n);
-    ckpt_put_f64s(w, s->inv_m, n);
-    ckpt_put_f64s(w, s->inv_inertia, n);
-    put_i32s(w, s->mat, n);
-    ckpt_put_u64(w, n);
-    ckpt_put_bytes(w, s->flags, n);
-    for (int d = d0; d < 3; d++) {
-        put_opt(w, s->w[d], n);
-        put_opt(w, s->tq[d], n);
-    }
-    put_opt(w, s->angle, n);
-    for (int d = 0; d < D; d++) {
-        put_opt(w, s->fext[d], n);
-        put_opt(w, s->x_ref[d], n);
-        put_opt(w, s->x_prev[d], n);
-    }
-    for (int k = 0; k < 6; k++) {
-        for (int d = 0; d < D; d++)
-            put_opt(w, s->gear[k][d], n);
-        for (int d = d0; d < 3; d++)
-            put_opt(w, s->gear_w[k][d], n);
-    }
-    if ((st = end(w, err)))
-        return st;
-
-    if ((st = ckpt_section_begin(w, "walls", CKPT_REQUIRED, err)))
-        return st;
-    ckpt_put_u64(w, (uint64_t)s->nwalls);
-    for (int k = 0; k < s->nwalls; k++) {
-        const dem_wall *wl = &s->walls[k];
-        ckpt_put_u32(w, (uint32_t)wl->active);
-        ckpt_put_bytes(w, wl->point, sizeof wl->point);
-        ckpt_put_bytes(w, wl->normal, sizeof wl->normal);
-        ckpt_put_bytes(w, wl->velocity, sizeof wl->velocity);
-        ckpt_put_f64(w, wl->friction);
-        ckpt_put_i64(w, wl->material);
-        ckpt_put_bytes(w, wl->point_build, sizeof wl->point_build);
-        ckpt_put_f64(w, wl->fn);
-        ckpt_put_u32(w, (uint32_t)wl->servo);
-        ckpt_put_f64(w, wl->servo_force);
-        ckpt_put_f64(w, wl->servo_mass);
-        ckpt_put_f64(w, wl->servo_rate);
-        for (int d = 0; d < 4; d++)
-            put_opt(w, wl->hist[d], n);
-        ckpt_put_u32s(w, wl->cand, wl->ncand);
-    }
-    if ((st = end(w, err)))
-        return st;
-    int shaped = 0; /* walls beyond planes: their own section, absent from a scene without them */
-    for (int k = 0; k < s->nwalls; k++)
-        shaped |= s->walls[k].shape != NULL;
-    if (shaped && (st = dem_shapes_save(s, w, err)))
-        return st;
-
-    /* The Verlet list as built, with what each pair carries between steps. */
-    const dem_pairs *p = &s->pairs;
-    if ((st = ckpt_section_begin(w, "pairs", CKPT_REQUIRED, err)))
-        return st;
-    ckpt_put_u32(w, p->start != NULL);
-    ckpt_put_u64(w, p->np);
-    ckpt_put_u32s(w, p->i, p->n);
-    ckpt_put_u32s(w, p->j, p->n);
-    ckpt_put_f64s(w, p->k, p->n);
-    ckpt_put_f64s(w, p->gamma, p->n);
-    ckpt_put_f64s(w, p->mu, p->n);
-    for (int d = 0; d < 3; d++) {
-        put_opt(w, p->f[d], p->n);
-        put_opt(w, p->c[d], p->n);
-    }
-    for (int d = 0; d < 4; d++)
-        put_opt(w, p->hist[d], p->n);
-    if ((st = end(w, err)))
-        return st;
-    if (uses_rolling(s) && (st = write_rolling(s, w, err)))
-        return st;
-    if (uses_solved_damping(&s->contact) && (st = write_damping(s, w, err)))
-        return st;
-    if (s->bnd && (st = dem_boundary_save(s, w, err)))
-        return st;
-    return s->flow ? dem_flow_save(s, w, err) : CORE_OK;
-}
-
-core_status dem_save(const dem_scene *s, const char *path, const char *version, core_error *err)
-{
-    ckpt_writer *w;
-    core_status st = ckpt_writer_open(&w, path, "dem", version, err);
-    if (st)
-        return st;
-    if ((st = write_scene(s, w, err))) {
-        ckpt_writer_abort(w);
-        return st;
-    }
-    return ckpt_writer_commit(w, err);
-}
 
 /* ---- loading -------------------------------------------------------------------------------- */
 
@@ -360,8 +103,8 @@ static void read_contact(reader *r, dem_contact_def *c)
     c->exponent = get_finite(r, "exponent");
     c->clip = get_flag(r, "clip");
     c->rolling = get_flag(r, "rolling");
-    if (normal > DEM_NORMAL_HERTZ || damping > DEM_DAMPING_BRILLIANTOV ||
-        tangential > DEM_TANGENT_REGULARIZED)
+    if (normal >= DEM_NORMAL_COUNT || damping >= DEM_DAMPING_COUNT ||
+        tangential >= DEM_TANGENT_COUNT) /* laws.h's lists */
         bad(r, "unknown contact law");
     c->normal = (dem_normal_law)normal;
     c->damping = (dem_damping_law)damping;
@@ -630,7 +373,7 @@ static void read_rolling(reader *r, dem_scene *s)
 {
     dem_contact_def *c = &s->contact;
     uint32_t law = u32(r);
-    if (law > DEM_ROLLING_CONSTANT)
+    if (law >= DEM_ROLLING_COUNT)
         bad(r, "unknown rolling law");
     c->rolling_law = (dem_rolling_law)law;
     c->rolling_friction = f64(r);
@@ -692,10 +435,10 @@ static const char *inconsistent(const dem_scene *s, int gear_ready, int prev_rea
                 return "pair forces missing";
             if (s->rot && (D == 3 || d == 2) && !p->c[d])
                 return "pair torques missing";
-            if (s->contact.tangential == DEM_TANGENT_SPRING && d < D && !p->hist[d])
+            if (dem_tangent_history(s->contact.tangential) && d < D && !p->hist[d])
                 return "contact history missing";
         }
-        if (s->contact.tangential == DEM_TANGENT_SPRING && p->n > 0 && !p->hist[3])
+        if (dem_tangent_history(s->contact.tangential) && p->n > 0 && !p->hist[3])
             return "contact history missing";
         for (int d = 0; d < dem_rolling_slots(s) && p->n > 0; d++)
             if (!p->hist[DEM_HIST_ROLL + d])
@@ -706,72 +449,9 @@ static const char *inconsistent(const dem_scene *s, int gear_ready, int prev_rea
     return NULL;
 }
 
-static void read_all(reader *r, ckpt_reader *ck, const dem_boundary_restorer *restorer,
-                     dem_scene **out)
+/* The section "materials": each through dem_add_material's checks. */
+static void read_materials(reader *r, ckpt_reader *ck, dem_scene *s)
 {
-    dem_scene_def def = dem_default_scene_def();
-    open_section(r, ck, "scene");
-    uint32_t dim = u32(r);
-    if (dim != 2 && dim != 3)
-        bad(r, "dimension not 2 or 3");
-    def.dim = (int)dim;
-    bytes(r, def.lo, sizeof def.lo);
-    bytes(r, def.hi, sizeof def.hi);
-    for (int d = 0; d < 3; d++)
-        def.periodic[d] = u32(r) != 0;
-    bytes(r, def.gravity, sizeof def.gravity);
-    def.thickness = f64(r);
-    double drag = get_num_in(r, "drag", 0, DBL_MAX);
-    def.skin = f64(r);
-    if (r->st)
-        return;
-    if (relay(r, dem_create(&def, out, r->err)))
-        return;
-    dem_scene *s = *out;
-    const int D = s->dim, d0 = D == 2 ? 2 : 0;
-    s->drag = drag;
-    s->skin = get_num_in(r, "skin", 0, DBL_MAX);
-    s->r_max = get_num_in(r, "largest radius", 0, DBL_MAX);
-    const uint64_t n64 = u64(r);
-    if (!r->st && n64 >= UINT32_MAX - 1)
-        bad_int(r, "particle count", (long long)n64, 0, UINT32_MAX - 2);
-    const size_t n = (size_t)n64;
-    s->rot = get_flag(r, "rotation");
-    s->time = get_finite(r, "time");
-    s->steps = get_counter(r, "steps");
-    s->force_evals = get_counter(r, "force evaluations");
-    s->last_integrator = (int)get_int_in(r, "last integrator", 0, DEM_TWO_TIMESCALES);
-    s->tt_phase = get_counter(r, "two-timescales phase");
-    /* set at the end: restoring the boundary goes through calls that reset them */
-    const int gear_ready = get_flag(r, "gear_ready"), prev_ready = get_flag(r, "prev_ready");
-    const int forces_ready = get_flag(r, "forces_ready");
-    s->suspect = get_flag(r, "suspect");
-    const int need_rebuild = get_flag(r, "need_rebuild");
-    s->gear_dt = get_num_in(r, "Gear dt", 0, DBL_MAX);
-    s->prev_dt = get_num_in(r, "position Verlet dt", 0, DBL_MAX);
-    const int watch_on = get_flag(r, "energy watch");
-    s->watch_next = get_counter(r, "energy watch step");
-    s->watch_min_step = get_counter(r, "energy watch minimum step");
-    s->watch_min = f64(r);
-    s->watch_min_t = f64(r);
-    s->watch_scale = f64(r);
-    if (watch_on && !r->st &&
-        !(isfinite(s->watch_min) && isfinite(s->watch_min_t) && s->watch_scale >= 0 &&
-          isfinite(s->watch_scale)))
-        bad(r, "the energy watch's reference is not finite");
-    s->brill_c = get_num_in(r, "Brilliantov coefficient", 0, DBL_MAX);
-    close_section(r);
-
-    open_section(r, ck, "contact");
-    read_contact(r, &s->contact);
-    if (!r->st)
-        check_contact(r, &def, &s->contact);
-    close_section(r);
-    if (r->st)
-        return;
-    dem_power_init(&s->slip_pow,
-                   s->contact.tangential == DEM_TANGENT_REGULARIZED ? 1 / s->contact.exponent : 0);
-
     open_section(r, ck, "materials");
     uint64_t nmat = u64(r);
     if (nmat > (uint64_t)r->sec.size / 48)
@@ -799,7 +479,12 @@ static void read_all(reader *r, ckpt_reader *ck, const dem_boundary_restorer *re
             break;
     }
     close_section(r);
+}
 
+/* The section "particles": n particles' arrays, the optional ones in whole sets. */
+static void read_particles(reader *r, ckpt_reader *ck, dem_scene *s, size_t n)
+{
+    const int D = s->dim, d0 = D == 2 ? 2 : 0;
     open_section(r, ck, "particles");
     if (r->st)
         return;
@@ -864,7 +549,12 @@ static void read_all(reader *r, ckpt_reader *ck, const dem_boundary_restorer *re
             rot_ok = rot_ok && !s->gear[k][d] == !s->gear[0][0];
     if (!rot_ok)
         bad(r, "incomplete set of optional arrays");
+}
 
+/* The section "walls": planes (their spring history and candidates among the n particles). */
+static void read_walls(reader *r, ckpt_reader *ck, dem_scene *s, size_t n)
+{
+    const size_t cap = n ? n : 1;
     open_section(r, ck, "walls");
     uint64_t nw = u64(r);
     if (nw > (uint64_t)r->sec.size / 64)
@@ -903,6 +593,84 @@ static void read_all(reader *r, ckpt_reader *ck, const dem_boundary_restorer *re
                 bad(r, "wall candidate out of range");
     }
     close_section(r);
+}
+
+static void read_all(reader *r, ckpt_reader *ck, const dem_boundary_restorer *restorer,
+                     dem_scene **out)
+{
+    dem_scene_def def = dem_default_scene_def();
+    open_section(r, ck, "scene");
+    uint32_t dim = u32(r);
+    if (dim != 2 && dim != 3)
+        bad(r, "dimension not 2 or 3");
+    def.dim = (int)dim;
+    bytes(r, def.lo, sizeof def.lo);
+    bytes(r, def.hi, sizeof def.hi);
+    for (int d = 0; d < 3; d++)
+        def.periodic[d] = u32(r) != 0;
+    bytes(r, def.gravity, sizeof def.gravity);
+    def.thickness = f64(r);
+    double drag = get_num_in(r, "drag", 0, DBL_MAX);
+    def.skin = f64(r);
+    if (r->st)
+        return;
+    if (relay(r, dem_create(&def, out, r->err)))
+        return;
+    dem_scene *s = *out;
+    s->drag = drag;
+    s->skin = get_num_in(r, "skin", 0, DBL_MAX);
+    s->r_max = get_num_in(r, "largest radius", 0, DBL_MAX);
+    const uint64_t n64 = u64(r);
+    if (!r->st && n64 >= UINT32_MAX - 1)
+        bad_int(r, "particle count", (long long)n64, 0, UINT32_MAX - 2);
+    const size_t n = (size_t)n64;
+    s->rot = get_flag(r, "rotation");
+    s->time = get_finite(r, "time");
+    s->steps = get_counter(r, "steps");
+    s->force_evals = get_counter(r, "force evaluations");
+    s->last_integrator = (int)get_int_in(r, "last integrator", 0, DEM_TWO_TIMESCALES);
+    s->tt_phase = get_counter(r, "two-timescales phase");
+    /* set at the end: restoring the boundary goes through calls that reset them */
+    const int gear_ready = get_flag(r, "gear_ready"), prev_ready = get_flag(r, "prev_ready");
+    const int forces_ready = get_flag(r, "forces_ready");
+    s->suspect = get_flag(r, "suspect");
+    const int need_rebuild = get_flag(r, "need_rebuild");
+    s->gear_dt = get_num_in(r, "Gear dt", 0, DBL_MAX);
+    s->prev_dt = get_num_in(r, "position Verlet dt", 0, DBL_MAX);
+    const int watch_on = get_flag(r, "energy watch");
+    s->watch_next = get_counter(r, "energy watch step");
+    s->watch_min_step = get_counter(r, "energy watch minimum step");
+    s->watch_min = f64(r);
+    s->watch_min_t = f64(r);
+    s->watch_scale = f64(r);
+    if (watch_on && !r->st &&
+        !(isfinite(s->watch_min) && isfinite(s->watch_min_t) && s->watch_scale >= 0 &&
+          isfinite(s->watch_scale)))
+        bad(r, "the energy watch's reference is not finite");
+    s->brill_c = get_num_in(r, "Brilliantov coefficient", 0, DBL_MAX);
+    close_section(r);
+
+    open_section(r, ck, "contact");
+    read_contact(r, &s->contact);
+    if (!r->st)
+        check_contact(r, &def, &s->contact);
+    close_section(r);
+    if (r->st)
+        return;
+    dem_power_init(&s->slip_pow,
+                   s->contact.tangential == DEM_TANGENT_REGULARIZED ? 1 / s->contact.exponent : 0);
+
+    read_materials(r, ck, s);
+    if (r->st)
+        return;
+
+    read_particles(r, ck, s, n);
+    if (r->st)
+        return;
+
+    read_walls(r, ck, s, n);
+    if (r->st)
+        return;
     if (!r->st && ckpt_has(ck, "wall_shapes")) {
         open_section(r, ck, "wall_shapes");
         if (!r->st)
@@ -923,7 +691,7 @@ static void read_all(reader *r, ckpt_reader *ck, const dem_boundary_restorer *re
         open_section(r, ck, "damping");
         read_damping(r, s);
         close_section(r);
-    } else if (!r->st && uses_solved_damping(&s->contact)) {
+    } else if (!r->st && dem_checkpoint_damping(&s->contact)) {
         r->st = core_fail(r->err, CORE_ERR_IO,
                           "'%s' has no section 'damping', which its contact law (%s damping from "
                           "a restitution) needs: a file from a grainlab whose damping of this "

@@ -1,6 +1,6 @@
 /* Reading a DEM checkpoint section with a sticky status: after the first failure every read is
- * a no-op returning 0, and the caller checks r->st once (checkpoint.c, and flow.c for its own
- * section). bad() names the file and the section. */
+ * a no-op returning 0, and the caller checks r->st once (checkpoint.c, and flow_checkpoint.c for
+ * its own section). bad() names the file and the section. */
 #ifndef GRAINLAB_DEM_CHECKPOINT_READER_H
 #define GRAINLAB_DEM_CHECKPOINT_READER_H
 

@@ -14,6 +14,7 @@
 
 #include "core/error.h"
 #include "core/progress.h"
+#include "dem/laws.h"
 
 typedef struct dem_scene dem_scene;
 
@@ -79,38 +80,8 @@ dem_material dem_default_material(void); /* quartz: 2650, 30 GPa, 0.3, 0.45, 0.5
 int dem_add_material(dem_scene *s, const dem_material *m, core_error *err);
 
 /* ---- contact laws -------------------------------------------------------------------------- */
-typedef enum dem_normal_law {
-    DEM_NORMAL_LINEAR,  /* f = k delta (Herrmann Eq. 1a, beta = 1) */
-    DEM_NORMAL_POWER,   /* f = k delta^beta, beta in {1, 3/2, 2} (Eq. 1a) */
-    DEM_NORMAL_HERTZ    /* f = K delta^{3/2}, K = 4/3 E* sqrt(R) (Padbidri Eq. 1.1, 2.16) */
-} dem_normal_law;
-
-typedef enum dem_damping_law {
-    DEM_DAMPING_NONE,
-    DEM_DAMPING_VISCOUS,     /* f = gamma ddelta/dt (Herrmann Eq. 1b); gamma = gamma_n, or per
-                              * pair from a restitution (dem_contact_damping) */
-    DEM_DAMPING_BRILLIANTOV  /* f = T K delta^{1/2} ddelta/dt (Padbidri Eq. 2.16), Hertz only; T =
-                              * damping_time, or per pair from a restitution */
-} dem_damping_law;
-
-typedef enum dem_tangential_law {
-    DEM_TANGENT_NONE,
-    DEM_TANGENT_VISCOUS,     /* f_t = -gamma_t s (Herrmann Eq. 2a) */
-    DEM_TANGENT_SPRING,      /* Cundall-Strack spring with Coulomb cap (Herrmann Eq. 2b) */
-    DEM_TANGENT_REGULARIZED  /* |f_t| = mu f_n min(1, (s/v_R)^{1/c}) (Padbidri Eq. 1.3, 2.18) */
-} dem_tangential_law;
-
-/* Rolling resistance (rolling.inc): a torque against the relative rolling of the two surfaces,
- * at most mu_r R_eff F_n (R_eff = r_i r_j / (r_i + r_j); against a wall R_eff = r_i). */
-typedef enum dem_rolling_law {
-    DEM_ROLLING_NONE,
-    DEM_ROLLING_EPSD,    /* Ai, Chen, Rotter & Ooi (2011) type C: elastic-plastic spring-dashpot,
-                          * an incremental spring k_r per contact (history), capped at the limit,
-                          * a viscous part of damping ratio eta_r below it */
-    DEM_ROLLING_CONSTANT /* Ai et al. type A: M = -mu_r R_eff F_n w_rel / |w_rel|, linear below
-                          * a rate w_c so that a grain at rest does not chatter */
-} dem_rolling_law;
-
+/* dem_normal_law, dem_damping_law, dem_tangential_law, dem_rolling_law and their names
+ * (dem_normal_names, ...): one row per law in laws.h. */
 typedef struct dem_contact_def {
     dem_normal_law normal;
     double stiffness;        /* k for LINEAR / POWER, N/m^beta */
@@ -487,7 +458,7 @@ core_status dem_vtk_particles(const dem_scene *s, const char *path, core_error *
 core_status dem_vtk_contacts(dem_scene *s, const char *path, core_error *err);
 core_status dem_vtk_walls(const dem_scene *s, const char *path, core_error *err);
 
-/* ---- LAMMPS data and dump files (lammps.c) -------------------------------------------------- *
+/* ---- LAMMPS data and dump files (lammps.c, lammps_write.c) --------------------------------- *
  * Data files in atom_style sphere (LIGGGHTS: granular): Atoms "id type diameter density x y z
  * [ix iy iz]", Velocities "id vx vy vz wx wy wz". The density column is the material's density
  * (kg/m^3); LAMMPS's mass rule density 4/3 pi r^3 is grainlab's for spheres and for 2D disks
@@ -552,7 +523,7 @@ core_status dem_write_lammps_dump(const dem_scene *s, const char *path,
 int dem_material_count(const dem_scene *s);
 const dem_material *dem_material_get(const dem_scene *s, int index); /* NULL if out of range */
 
-/* ---- checkpoints (checkpoint.c) ------------------------------------------------------------ *
+/* ---- checkpoints (checkpoint.c, checkpoint_save.c) ----------------------------------------- *
  * The whole state a run continues from, laid out by particle id (core/checkpoint.h container,
  * engine kind "dem"): run N + M steps, or N, save, load (in another process, with another thread
  * count), M: the same bits. Boundary conditions are stored (edges, pressure, the minimal-boundary

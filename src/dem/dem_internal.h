@@ -4,6 +4,7 @@
 #ifndef GRAINLAB_DEM_INTERNAL_H
 #define GRAINLAB_DEM_INTERNAL_H
 
+#include <math.h>
 #include <stdint.h>
 
 #include "dem/dem.h"
@@ -136,14 +137,14 @@ struct dem_scene {
     unsigned char *ghost;  /* 1: a copy, integrated here but overwritten by the halo */
     dem_domain_stats dstats; /* kept when the scene is gathered back */
 
-    /* Energy watch (integrate.c): in a scene without drivers the mechanical energy must not
+    /* Energy watch (unstable.c): in a scene without drivers the mechanical energy must not
      * grow; checked every DEM_WATCH_EVERY steps against the lowest energy since the reference,
      * which any change to the scene from outside a step resets (dem_invalidate). */
     int watch_on;
     long watch_next, watch_min_step;
     double watch_min, watch_min_t, watch_scale;
 
-    /* The run in progress (integrate.c), for the likely cause of an instability. */
+    /* The run in progress (integrate.c), for the likely cause of an instability (unstable.c). */
     const dem_run_def *run;
 };
 
@@ -176,7 +177,24 @@ size_t dem_domain_bundle(const dem_scene *s, size_t i, const uint32_t **gj, cons
 /* The global id (1-based in messages: + 1) of local particle i. */
 static inline size_t dem_gid(const dem_scene *s, size_t i) { return s->gid ? s->gid[i] : i; }
 
-/* Every per-particle array of s->cap entries the scene has now (domain.c): the table a
+/* Every one of a[0..n) finite. */
+static inline int dem_finite_n(const double *a, size_t n)
+{
+    for (size_t k = 0; k < n; k++)
+        if (!isfinite(a[k]))
+            return 0;
+    return 1;
+}
+
+/* Lexicographic order of two pairs of keys: (wall, id), (i, j). */
+static inline int dem_order2(uint32_t a0, uint32_t a1, uint32_t b0, uint32_t b1)
+{
+    if (a0 != b0)
+        return (a0 > b0) - (a0 < b0);
+    return (a1 > b1) - (a1 < b1);
+}
+
+/* Every per-particle array of s->cap entries the scene has now (domain_gather.c): the table a
  * migration, a gather and a removal (flow.c) go through. a[] needs dem_max_particle_arrays. */
 typedef struct dem_parray {
     void **p;
@@ -185,6 +203,13 @@ typedef struct dem_parray {
 } dem_parray;
 int dem_particle_arrays(dem_scene *s, dem_parray *a);
 int dem_max_particle_arrays(const dem_scene *s);
+/* A particle's record: its bytes, i's arrays packed into out / unpacked from in (each returns
+ * the end of the record), and every array (and gid, ghost when `local`) made to hold n. */
+size_t dem_parray_bytes(const dem_parray *a, int na);
+char *dem_parray_pack(char *out, const dem_parray *a, int na, size_t i);
+const char *dem_parray_unpack(const char *in, const dem_parray *a, int na, size_t i);
+core_status dem_parray_resize(dem_scene *s, const dem_parray *a, int na, size_t n, int local,
+                              core_error *err);
 
 /* flow.c: inserters and outflows, between steps (dem_run calls dem_flow_step before the first
  * step and after every step when s->flow is set): removal, then insertion, keeping every
@@ -210,8 +235,19 @@ core_status dem_flow_save(const dem_scene *s, struct ckpt_writer *w, core_error 
 struct dem_reader; /* dem/checkpoint_reader.h: the section being read, with its sticky status */
 core_status dem_flow_load(dem_scene *s, struct dem_reader *r);
 
+/* forces.c: the normal law's exponent (laws.h, normal_NAME_beta) */
+double dem_law_beta(const dem_contact_def *c);
+
+/* unstable.c: a run stopped at particle i (local index) that `what` ("went through a wall"),
+ * with the likely cause in the message; the energy watch every DEM_WATCH_EVERY steps. */
+core_status dem_unstable(dem_scene *s, size_t i, const char *what, core_error *err);
+core_status dem_energy_watch(dem_scene *s, double dt, core_error *err);
+
+/* checkpoint_save.c: the law's damping solved from a restitution is saved in a section of its
+ * own ("damping"), which a scene with this law cannot load without. */
+int dem_checkpoint_damping(const dem_contact_def *c);
+
 /* restitution.c: damping from a restitution (dem.h, dem_contact_damping) */
-double dem_law_beta(const dem_contact_def *c); /* the normal law's exponent */
 /* The law takes each pair's damping from its materials' restitution through a solved
  * coefficient (mat_damp): viscous without gamma_n (except the unclipped linear spring, a closed
  * form), Brilliantov without damping_time; neither with s:contact's restitution. */
@@ -301,7 +337,7 @@ double dem_elastic_energy(const dem_contact_def *c, double k, double delta);
  * rolling 3 only with a rolling history (a scene without it sends what it sent before). */
 static inline int dem_rolling_slots(const dem_scene *s)
 {
-    return s->contact.rolling_law == DEM_ROLLING_EPSD ? (s->dim == 2 ? 1 : 3) : 0;
+    return dem_rolling_history(s->contact.rolling_law) ? (s->dim == 2 ? 1 : 3) : 0;
 }
 static inline int dem_hist_width(const dem_scene *s) { return dem_rolling_slots(s) ? DEM_HIST : 4; }
 

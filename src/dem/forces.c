@@ -9,31 +9,57 @@
 #include "core/clones.h"
 #include "dem/dem_internal.h"
 
-/* Normal force magnitude, positive when repulsive. gamma is the pair's viscous coefficient, or
- * its Brilliantov damping time. ddelta is the rate of overlap, positive while
- * the particles approach: ddelta = -(v_i - v_j).n with n from j to i. (Padbidri's Eq. 2.A3 prints
+#include "dem/laws.inc"
+
+/* A law outside its list's range never gets here: dem_set_contact and the checkpoint reader check
+ * every law against its list's count. */
+#define LAW_OUT_OF_RANGE() __builtin_unreachable()
+
+/* Normal force magnitude, positive when repulsive: the normal law's elastic force, its damping,
+ * the clip, then the attraction of a law that has one. gamma is the pair's viscous coefficient, or
+ * its Brilliantov damping time. ddelta is the rate of overlap, positive while the particles
+ * approach: ddelta = -(v_i - v_j).n with n from j to i. (Padbidri's Eq. 2.A3 prints
  * +(v^k - v^j).n; with that sign the damping would push separating grains together.) */
 static inline double normal_force(const dem_contact_def *c, double k, double gamma, double delta,
                                   double sqrt_delta, double ddelta)
 {
     double f;
     switch (c->normal) {
-    case DEM_NORMAL_LINEAR:
-        f = k * delta;
+#define LAW_(a, ID, name, ...)                                                                     \
+    case DEM_NORMAL_##ID:                                                                          \
+        f = normal_##name(c, k, delta, sqrt_delta);                                                \
         break;
-    case DEM_NORMAL_POWER:
-        f = c->beta == 1 ? k * delta : c->beta == 2 ? k * delta * delta : k * delta * sqrt_delta;
-        break;
-    default: /* Hertz */
-        f = k * delta * sqrt_delta;
-        break;
+        DEM_NORMAL_LAWS(LAW_, _)
+#undef LAW_
+    default:
+        LAW_OUT_OF_RANGE();
     }
-    if (c->damping == DEM_DAMPING_VISCOUS)
-        f += gamma * ddelta; /* Eq. 1b */
-    else if (c->damping == DEM_DAMPING_BRILLIANTOV)
-        f += gamma * k * sqrt_delta * ddelta; /* Eq. 2.16; gamma = the pair's damping time T */
+    switch (c->damping) {
+#define LAW_(a, ID, name, ...)                                                                     \
+    case DEM_DAMPING_##ID:                                                                         \
+        f = damping_##name(f, k, gamma, sqrt_delta, ddelta);                                       \
+        break;
+        DEM_DAMPING_LAWS(LAW_, _)
+#undef LAW_
+    default:
+        LAW_OUT_OF_RANGE();
+    }
     if (c->clip && f < 0)
         f = 0;
+    switch (c->normal) { /* the laws with a tension column of 1 */
+#define TENSION_0(ID, name)
+#define TENSION_1(ID, name)                                                                        \
+    case DEM_NORMAL_##ID:                                                                          \
+        f += normal_##name##_tension(c, k, delta, sqrt_delta);                                     \
+        break;
+#define LAW_(a, ID, name, k, tension, ...) TENSION_##tension(ID, name)
+        DEM_NORMAL_LAWS(LAW_, _)
+#undef LAW_
+#undef TENSION_1
+#undef TENSION_0
+    default:
+        break;
+    }
     return f;
 }
 
@@ -46,29 +72,43 @@ double dem_normal_force(const dem_contact_def *c, double k, double gamma, double
 double dem_elastic_energy(const dem_contact_def *c, double k, double delta)
 {
     switch (c->normal) {
-    case DEM_NORMAL_LINEAR:
-        return 0.5 * k * delta * delta;
-    case DEM_NORMAL_POWER:
-        return k * pow(delta, c->beta + 1) / (c->beta + 1);
+#define LAW_(a, ID, name, ...)                                                                     \
+    case DEM_NORMAL_##ID:                                                                          \
+        return normal_##name##_energy(c, k, delta);
+        DEM_NORMAL_LAWS(LAW_, _)
+#undef LAW_
     default:
-        return 0.4 * k * delta * delta * sqrt(delta);
+        LAW_OUT_OF_RANGE();
     }
 }
 
-/* Tangential spring stiffness: given, or 2/7 of the normal tangent stiffness d f_n / d delta
- * (the ratio of a linear spring pair; for Hertz this scales like Mindlin's k_t ~ sqrt(delta)). */
+double dem_law_beta(const dem_contact_def *c)
+{
+    switch (c->normal) {
+#define LAW_(a, ID, name, ...)                                                                     \
+    case DEM_NORMAL_##ID:                                                                          \
+        return normal_##name##_beta(c);
+        DEM_NORMAL_LAWS(LAW_, _)
+#undef LAW_
+    default:
+        LAW_OUT_OF_RANGE();
+    }
+}
+
+/* Tangential spring stiffness: given, or the normal law's default (2/7 of d f / d delta). */
 static inline double spring_stiffness(const dem_contact_def *c, double k, double delta,
                                       double sqrt_delta)
 {
     if (c->kt > 0)
         return c->kt;
     switch (c->normal) {
-    case DEM_NORMAL_LINEAR:
-        return 2.0 / 7.0 * k;
-    case DEM_NORMAL_POWER:
-        return 2.0 / 7.0 * c->beta * k * (c->beta == 1 ? 1 : c->beta == 2 ? delta : sqrt_delta);
+#define LAW_(a, ID, name, ...)                                                                     \
+    case DEM_NORMAL_##ID:                                                                          \
+        return normal_##name##_kt(c, k, delta, sqrt_delta);
+        DEM_NORMAL_LAWS(LAW_, _)
+#undef LAW_
     default:
-        return 2.0 / 7.0 * 1.5 * k * sqrt_delta;
+        LAW_OUT_OF_RANGE();
     }
 }
 

@@ -1,6 +1,7 @@
 /* Time stepping: velocity Verlet (default), position Verlet (Padbidri Eq. 1.6), Gear's 5th-order
  * predictor-corrector (Herrmann Sec. 2) and Padbidri's two-timescales schedule (Sec. 2.4); the
- * run loop with Ctrl-C and instability checks; the contact-time step rule (Padbidri Sec. 2.3). */
+ * run loop with Ctrl-C and instability checks (unstable.c names their likely cause); the
+ * contact-time step rule (Padbidri Sec. 2.3). */
 #include <float.h>
 #include <math.h>
 #include <stdio.h>
@@ -25,7 +26,7 @@ static core_status prepare(dem_scene *s, const dem_run_def *run, core_error *err
     const int D = s->dim;
     if (s->nmat == 0 || (dem_domain_count(s) == 0 && !dem_flow_inserting(s)))
         return core_fail(err, CORE_ERR_STATE, "the scene has no particles: add some first");
-    if (s->contact.tangential == DEM_TANGENT_SPRING) {
+    if (dem_tangent_history(s->contact.tangential)) {
         for (int w = 0; w < s->nwalls; w++) {
             if (!s->walls[w].active || s->walls[w].hist[0])
                 continue;
@@ -63,223 +64,6 @@ static core_status prepare(dem_scene *s, const dem_run_def *run, core_error *err
         s->gear_ready = 0;
     }
     return CORE_OK;
-}
-
-/* ---- the likely cause of an instability ------------------------------------------------------
- * Read from what the scene shows, in this order: a time step the user forced above the stability
- * limit (only then is dt blamed); a particle that left the box by a side that has no wall;
- * contacts so soft that gravity alone, or an impact at the speed the step was chosen for,
- * squeezes a grain by a large part of its radius (no time step cures that: a modulus in the
- * wrong units, E = 5 Pa for 5 MPa). Local data only (particle i, the walls, the run's settings):
- * on several ranks only the one that holds the particle writes the message. */
-#define DEM_SOFT_LOAD 0.1   /* overlap under a grain's own weight, of its radius */
-#define DEM_SOFT_IMPACT 0.5 /* overlap of a head-on impact at the reference speed, of its radius */
-
-static const char AXES[3] = {'x', 'y', 'z'};
-
-/* A side of the box (axis d, sign +1 for hi, -1 for lo) that no wall closes: no plane faces it,
- * and no wall beyond planes (a drum, a hopper) may hold the particles in. */
-static int side_open(const dem_scene *s, int d, int sign)
-{
-    for (int w = 0; w < s->nwalls; w++) {
-        const dem_wall *wl = &s->walls[w];
-        if (wl->active && (wl->shape || sign * wl->normal[d] < -0.5))
-            return 0;
-    }
-    return 1;
-}
-
-/* The "k = ..." of a pair of particle i's material, as the user gave it. */
-static void stiffness_text(const dem_scene *s, size_t i, char *buf, size_t n)
-{
-    const dem_contact_def *c = &s->contact;
-    if (c->normal == DEM_NORMAL_HERTZ)
-        snprintf(buf, n, "E = %.3g Pa", s->mats[s->mat[i]].young);
-    else if (c->normal == DEM_NORMAL_LINEAR)
-        snprintf(buf, n, "k = %.3g N/m", c->stiffness);
-    else
-        snprintf(buf, n, "k = %.3g N/m^%g", c->stiffness, c->beta);
-}
-
-static void likely_cause(const dem_scene *s, size_t i, char *buf, size_t n)
-{
-    const int D = s->dim;
-    const dem_run_def *run = s->run;
-    double dt = run ? run->dt * (run->integrator == DEM_TWO_TIMESCALES ? run->tt_n : 1) : 0;
-    if (run && !run->dt_auto && run->dt_limit > 0 && dt > run->dt_limit) {
-        snprintf(buf, n,
-                 "the time step is too large: dt = %.3g s is %.3g times the stability limit "
-                 "%.3g s (forced); use dt = \"auto\" or a smaller dt",
-                 dt, dt / run->dt_limit, run->dt_limit);
-        return;
-    }
-    for (int d = 0; d < D; d++) { /* out of the box: by which side, and is it open? */
-        int sign = s->x[d][i] > s->hi[d] ? 1 : s->x[d][i] < s->lo[d] ? -1 : 0;
-        if (s->periodic[d] || !sign || !side_open(s, d, sign))
-            continue;
-        char point[96], normal[32];
-        int pl = 0, nl = 0;
-        for (int e = 0; e < D; e++) {
-            double p = e == d ? (sign > 0 ? s->hi[e] : s->lo[e]) : s->lo[e];
-            pl += snprintf(point + pl, sizeof point - (size_t)pl, "%s%.6g", e ? ", " : "", p);
-            nl += snprintf(normal + nl, sizeof normal - (size_t)nl, "%s%d", e ? ", " : "",
-                           e == d ? -sign : 0);
-        }
-        snprintf(buf, n,
-                 "no wall on the %c%c side of the box (%c = %.6g m): add one, s:add_wall{ point "
-                 "= {%s}, normal = {%s} }, or make the %c axis periodic",
-                 sign > 0 ? '+' : '-', AXES[d], AXES[d], sign > 0 ? s->hi[d] : s->lo[d], point,
-                 normal, AXES[d]);
-        return;
-    }
-    double g = 0, h = 0;
-    for (int d = 0; d < D; d++) {
-        g += s->gravity[d] * s->gravity[d];
-        if (s->gravity[d] != 0)
-            h = fmax(h, s->len[d]);
-    }
-    g = sqrt(g);
-    const double r = s->r[i], m = s->m[i];
-    const dem_contact_def *c = &s->contact;
-    double beta = c->normal == DEM_NORMAL_LINEAR  ? 1
-                  : c->normal == DEM_NORMAL_POWER ? c->beta
-                                                  : 1.5;
-    double k = 0, gamma = 0;
-    if (r > 0 && m > 0 && isfinite(m))
-        dem_probe_parameters(s, s->mat[i], r, m, &k, &gamma);
-    char stiff[64];
-    stiffness_text(s, i, stiff, sizeof stiff);
-    if (k > 0) {
-        /* on a grain like it: k delta^beta = m g */
-        double load = pow(m * g / k, 1 / beta) / r;
-        if (load > DEM_SOFT_LOAD) {
-            snprintf(buf, n,
-                     "the contact stiffness is too small for the load: %s gives overlaps of %.3g "
-                     "times the radius (r = %.3g m) under gravity alone; check the units (Pa)",
-                     stiff, load, r);
-            return;
-        }
-        /* a head-on impact on a grain like it at the speed the step was chosen for, or of a
-         * fall through the box: (beta + 1)/2 m_eff v^2 = k delta^(beta + 1), m_eff = m/2 */
-        double v = run && run->dt_speed > 0 ? run->dt_speed : fmax(sqrt(2 * g * h), 0.1);
-        double impact = pow((beta + 1) * 0.25 * m * v * v / k, 1 / (beta + 1)) / r;
-        if (impact > DEM_SOFT_IMPACT) {
-            snprintf(buf, n,
-                     "the contact stiffness is too small for the impacts: %s gives overlaps of "
-                     "%.3g times the radius (r = %.3g m) at %.3g m/s; check the units (Pa)",
-                     stiff, impact, r, v);
-            return;
-        }
-    }
-    if (run && run->dt_limit > 0 && run->dt_speed > 0) {
-        snprintf(buf, n,
-                 "a contact faster or stiffer than the time step was chosen for (dt = %.3g s%s, "
-                 "for impacts up to %.3g m/s at the limit %.3g s): a driver (a moving wall, a "
-                 "prescribed particle, an inserter) or a fall from higher up; give run{ "
-                 "impact_velocity = ... } the fastest impact, or a smaller dt",
-                 dt, run->dt_auto ? ", \"auto\"" : "", run->dt_speed, run->dt_limit);
-        return;
-    }
-    snprintf(buf, n,
-             "the time step is too large for the contact stiffness or the impact speed (use dt = "
-             "\"auto\" or a smaller dt)");
-}
-
-/* The step being taken when a check fails is s->steps + 1 (steps counts completed ones); i is the
- * local index. */
-static core_status unstable(dem_scene *s, size_t i, const char *what, core_error *err)
-{
-    dem_invalidate(s, 1); /* a later run must not reuse this step's forces */
-    char cause[400];
-    likely_cause(s, i, cause, sizeof cause);
-    return core_fail(err, CORE_ERR_UNSTABLE, "particle %zu %s at step %ld (t = %.6g s); likely cause: %s",
-                     dem_gid(s, i) + 1, what, s->steps + 1, s->time, cause);
-}
-
-/* ---- energy watch ---------------------------------------------------------------------------- *
- * Without a driver (a moving or servo wall, a prescribed particle, an external force, a boundary
- * condition, gravity along a periodic axis) kinetic + rotational + elastic + gravitational energy
- * can only stay or fall: contacts conserve it (Hertz, springs) or dissipate it (damping, friction,
- * drag). Verlet at a stable step only makes it fluctuate, O(dt^2): measured at most 0.3% of the
- * mechanical energy at the stable limit (60 undamped disks, 20,000 steps), 2% at twice the limit,
- * while at three times it grows without bound. The watch stops a run whose energy rises more than
- * DEM_WATCH_GROWTH of the largest kinetic + rotational + elastic energy seen above the lowest total
- * since the reference. One O(N) energy sum every DEM_WATCH_EVERY steps (callgrind, 225 disks, 3
- * walls: +0.75% of the run's instructions; +1.5% when every 64 steps). Driven scenes are not
- * watched (their work is not accounted). */
-#define DEM_WATCH_EVERY 256
-#define DEM_WATCH_GROWTH 0.1
-
-static int driven(const dem_scene *s)
-{
-    if (s->bnd || s->fext[0])
-        return 1;
-    for (int d = 0; d < s->dim; d++) /* gravity along a periodic axis: no bounded potential */
-        if (s->periodic[d] && s->gravity[d] != 0)
-            return 1;
-    for (int w = 0; w < s->nwalls; w++) {
-        const dem_wall *wl = &s->walls[w];
-        if (wl->active &&
-            (wl->servo || wl->velocity[0] != 0 || wl->velocity[1] != 0 || wl->velocity[2] != 0))
-            return 1;
-    }
-    if (s->nshaped && dem_shapes_driven(s))
-        return 1;
-    int pres = 0;
-    for (size_t i = 0; i < s->n && !pres; i++)
-        pres = (s->flags[i] & DEM_PRESCRIBED) != 0;
-    return s->dom ? comm_any(pres) : pres;
-}
-
-static core_status energy_watch(dem_scene *s, double dt, core_error *err)
-{
-    s->watch_next = s->steps + DEM_WATCH_EVERY;
-    if (driven(s)) {
-        s->watch_on = 0;
-        return CORE_OK;
-    }
-    dem_energy e;
-    dem_measure_energy(s, &e);
-    double mobile = e.kinetic + e.rotational + e.elastic;
-    if (!s->watch_on || !isfinite(e.total)) {
-        s->watch_on = isfinite(e.total);
-        s->watch_min = e.total;
-        s->watch_min_step = s->steps;
-        s->watch_min_t = s->time;
-        s->watch_scale = mobile;
-        return CORE_OK;
-    }
-    s->watch_scale = fmax(s->watch_scale, mobile);
-    if (e.total < s->watch_min) {
-        s->watch_min = e.total;
-        s->watch_min_step = s->steps;
-        s->watch_min_t = s->time;
-        return CORE_OK;
-    }
-    double grow = e.total - s->watch_min, scale = s->watch_scale;
-    /* round-off of the sum of terms that may be large and cancel (gravity's potential) */
-    double noise = 1e-12 * (fabs(e.total) + fabs(e.potential) + scale);
-    if (!(grow > DEM_WATCH_GROWTH * scale && grow > noise))
-        return CORE_OK;
-    dem_timestep ts;
-    char limit[96] = "";
-    if (dem_timestep_info(s, 0, &ts, NULL) == CORE_OK)
-        snprintf(limit, sizeof limit, " (the stable limit at the current speeds is %.3g s)",
-                 ts.limit);
-    s->watch_on = 0;
-    dem_invalidate(s, 1);
-    const bool automatic = s->run && s->run->dt_auto; /* then "use dt = auto" would not help */
-    return core_fail(err, CORE_ERR_UNSTABLE,
-                     "energy grew in a scene without drivers: %.6g J at step %ld (t = %.6g s), "
-                     "%.6g J at step %ld (t = %.6g s), +%.3g J = %.3g of the largest mechanical "
-                     "energy %.6g J (kinetic + rotational + elastic; limit %.3g); likely cause: "
-                     "the time step %.3g s%s is too large for the contact stiffness%s; %s",
-                     s->watch_min, s->watch_min_step, s->watch_min_t, e.total, s->steps, s->time,
-                     grow, grow / scale, scale, DEM_WATCH_GROWTH, dt, automatic ? " (\"auto\")" : "",
-                     limit,
-                     automatic ? "give run{ impact_velocity = ... } the fastest impact, or a "
-                                 "smaller dt"
-                               : "use dt = \"auto\" or a smaller dt, without force");
 }
 
 /* A particle outside the domain on an axis that is not periodic (index, or (size_t)-1). */
@@ -380,7 +164,7 @@ static core_status forces(dem_scene *s, double dt, double disp2, core_error *err
     }
     size_t t = dem_compute_forces(s, dt);
     if (t != (size_t)-1)
-        return unstable(s, t, "went through a wall", err);
+        return dem_unstable(s, t, "went through a wall", err);
     if (s->bnd) {
         core_status st = dem_boundary_apply(s, dt, err);
         if (st)
@@ -431,7 +215,7 @@ static core_status forces_distributed(dem_scene *s, double dt, double disp2, cor
         servo |= s->walls[w].active && s->walls[w].servo;
     st = dem_domain_walls_due(s, servo, err);
     if (!st && t != (size_t)-1)
-        st = unstable(s, t, "went through a wall", err);
+        st = dem_unstable(s, t, "went through a wall", err);
     /* A local error waits for the end of the step, where every rank agrees on the first one:
      * the rest of the step makes the same collective calls on every rank. */
     dem_domain_defer(s, st, err);
@@ -860,9 +644,9 @@ static core_status full_checks(dem_scene *s, core_error *err)
 {
     size_t bad = check_finite(s);
     if (bad != (size_t)-1)
-        return unstable(s, bad, "has a non-finite position or velocity", err);
+        return dem_unstable(s, bad, "has a non-finite position or velocity", err);
     if ((bad = check_domain(s)) != (size_t)-1)
-        return unstable(s, bad,
+        return dem_unstable(s, bad,
                         "left the domain (a box side without a wall and not periodic)", err);
     return CORE_OK;
 }
@@ -993,7 +777,7 @@ static core_status run_steps(dem_scene *s, const dem_run_def *run, core_error *e
         s->steps++;
         done += advance;
         threads_tune_step();
-        if (s->steps >= s->watch_next && (st = energy_watch(s, h, err)))
+        if (s->steps >= s->watch_next && (st = dem_energy_watch(s, h, err)))
             return st;
         if (run->progress)
             progress_update(run->progress, (double)done);
@@ -1014,9 +798,7 @@ static double contact_integral(double p)
 static void contact_limits(const dem_scene *s, double k, double gamma, double m_eff, double v,
                            double *t, double *b)
 {
-    double beta = s->contact.normal == DEM_NORMAL_LINEAR  ? 1
-                  : s->contact.normal == DEM_NORMAL_POWER ? s->contact.beta
-                                                          : 1.5;
+    double beta = dem_law_beta(&s->contact);
     double dmax = pow((beta + 1) * m_eff * v * v / (2 * k), 1 / (beta + 1));
     *t = 2 * dmax / v * contact_integral(beta + 1);
     if (beta == 1)
@@ -1099,98 +881,5 @@ core_status dem_timestep_info(const dem_scene *s, double v_imp, dem_timestep *ou
     if (bmax > 0) /* a stiff dashpot needs b dt small, whatever the spring */
         out->limit = fmin(out->limit, 0.2 / bmax);
     out->dt_auto = out->limit / 5;
-    return CORE_OK;
-}
-
-/* ---- Brilliantov damping time from a restitution ------------------------------------------ */
-/* x'' = -x^{3/2} - lambda x^{1/2} x', x(0) = 0, x'(0) = 1 (lengths in d* = (m v^2/K)^{2/5}, times
- * in units of d* / v), integrated with RK4 until x returns to 0. With clip the force is never
- * attractive, so once it vanishes the particles separate at constant speed. */
-double dem_brilliantov_restitution(double lambda, bool clip)
-{
-    const double h = 2e-4; /* of a contact lasting about 3.2 */
-    double x = 0, u = 1;
-    for (int step = 0; step < 1000000; step++) {
-        double kx[4], ku[4], xs = x, us = u;
-        for (int stage = 0; stage < 4; stage++) {
-            double xx = xs > 0 ? xs : 0;
-            double a = -xx * sqrt(xx) - lambda * sqrt(xx) * us;
-            if (clip && a > 0)
-                a = 0; /* no attraction */
-            kx[stage] = us;
-            ku[stage] = a;
-            double c = stage < 2 ? 0.5 * h : h;
-            if (stage < 3) {
-                xs = x + c * kx[stage];
-                us = u + c * ku[stage];
-            }
-        }
-        double xn = x + h / 6 * (kx[0] + 2 * kx[1] + 2 * kx[2] + kx[3]);
-        double un = u + h / 6 * (ku[0] + 2 * ku[1] + 2 * ku[2] + ku[3]);
-        if (step > 0 && xn <= 0)
-            return -un;
-        x = xn;
-        u = un;
-    }
-    return 0; /* overdamped: never came back */
-}
-
-core_status dem_brilliantov_lambda(double e, bool clip, double *lambda, core_error *err)
-{
-    if (!(e > 0 && e <= 1))
-        return core_fail(err, CORE_ERR_ARG, "restitution must be in (0, 1], got %g", e);
-    if (e == 1) {
-        *lambda = 0;
-        return CORE_OK;
-    }
-    /* e falls monotonically with lambda: bracket, then bisect. */
-    double lo = 0, hi = 1;
-    while (dem_brilliantov_restitution(hi, clip) > e) {
-        lo = hi;
-        hi *= 2;
-        if (hi > 1e6)
-            return core_fail(err, CORE_ERR_ARG,
-                             "restitution %g is below what brilliantov damping reaches", e);
-    }
-    for (int it = 0; it < 60 && hi - lo > 1e-12 * hi; it++) {
-        double mid = 0.5 * (lo + hi);
-        if (dem_brilliantov_restitution(mid, clip) > e)
-            lo = mid;
-        else
-            hi = mid;
-    }
-    *lambda = 0.5 * (lo + hi);
-    return CORE_OK;
-}
-
-core_status dem_brilliantov_time(double e, double m_eff, double K, double v, double *T,
-                                 core_error *err)
-{
-    if (!(m_eff > 0) || !(K > 0) || !(v > 0))
-        return core_fail(err, CORE_ERR_ARG, "mass, stiffness and speed must be > 0");
-    double lambda;
-    core_status st = dem_brilliantov_lambda(e, true, &lambda, err);
-    if (st != CORE_OK)
-        return st;
-    *T = lambda * pow(m_eff / K, 0.4) * pow(v, -0.2);
-    return CORE_OK;
-}
-
-core_status dem_pair_damping(const dem_scene *s, size_t i, size_t j, int wall, double *out,
-                             core_error *err)
-{
-    if (i >= s->n || (wall < 0 && j >= s->n))
-        return core_fail(err, CORE_ERR_ARG, "particle %zu out of range (the scene has %zu)",
-                         (i >= s->n ? i : j) + 1, s->n);
-    if (wall >= s->nwalls)
-        return core_fail(err, CORE_ERR_ARG, "wall %d out of range (the scene has %d)", wall + 1,
-                         s->nwalls);
-    if (wall < 0 && i == j)
-        return core_fail(err, CORE_ERR_ARG, "particle %zu paired with itself", i + 1);
-    double k, mu;
-    if (wall >= 0)
-        dem_wall_parameters(s, &s->walls[wall], i, &k, out, &mu);
-    else
-        dem_pair_parameters((dem_scene *)s, i, j, &k, out, &mu);
     return CORE_OK;
 }

@@ -1,20 +1,16 @@
-/* LAMMPS exchange for DEM scenes: data files in atom_style sphere (read and written) and `dump
- * custom` frames (written), the formats LAMMPS, LIGGGHTS and OVITO read. The parser is strict:
- * every line it does not understand is an error naming the file and the line, because a packing
- * that loads half right is worse than one that does not load. */
+/* LAMMPS exchange for DEM scenes: data files in atom_style sphere (read here, written by
+ * lammps_write.c with `dump custom` frames), the formats LAMMPS, LIGGGHTS and OVITO read. The
+ * parser is strict: every line it does not understand is an error naming the file and the line,
+ * because a packing that loads half right is worse than one that does not load. */
 #define _POSIX_C_SOURCE 200809L
 #include <ctype.h>
 #include <errno.h>
-#include <fcntl.h>
 #include <float.h>
 #include <math.h>
-#include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #include "core/fileio.h"
 #include "dem/dem_internal.h"
@@ -397,26 +393,15 @@ static core_status sort_atoms(const reader *r, dem_lammps_data *d, id_index **or
     return CORE_OK;
 }
 
-static core_status parse(reader *r, dem_lammps_data *d, core_error *err)
+/* The header: counts and box, up to the first section (*in_body: one was found, its title
+ * line read); d->n, d->ntypes and the box from it. */
+static core_status parse_header(reader *r, dem_lammps_data *d, long long *ntypes_out,
+                                int *in_body_out, core_error *err)
 {
     char msg[320], key[128];
-    if (!next_line(r))
-        return r->nul ? bad_line(err, r, "")
-                      : core_fail(err, CORE_ERR_ARG, "%s: the file is empty", r->path);
-    /* The title line keeps its '#' text: it is free text. */
-    rewind(r->fp);
-    {
-        ssize_t len = getline(&r->buf, &r->cap, r->fp);
-        if (len > 0) {
-            while (len > 0 && (r->buf[len - 1] == '\n' || r->buf[len - 1] == '\r'))
-                r->buf[--len] = 0;
-            snprintf(d->title, sizeof d->title, "%s", r->buf);
-        }
-    }
     long long natoms = -1, ntypes = -1;
     long natoms_line = 0;
     int have_box[3] = {0, 0, 0};
-    /* ---- header: counts and box, up to the first section ---- */
     int in_body = 0;
     while (!in_body) {
         if (!next_content(r))
@@ -517,7 +502,60 @@ static core_status parse(reader *r, dem_lammps_data *d, core_error *err)
     }
     d->n = (size_t)natoms;
     d->ntypes = (int)ntypes;
-    core_status st = alloc_atoms(d, d->n, err);
+    *ntypes_out = ntypes;
+    *in_body_out = in_body;
+    return CORE_OK;
+}
+
+/* A section of per-type data (Masses, Pair Coeffs, PairIJ Coeffs, Atom Type Labels) whose title
+ * line was read: skipped, its lines counted. */
+static core_status skip_section(reader *r, const char *key, long long ntypes, core_error *err)
+{
+    char msg[320];
+    core_status st = CORE_OK;
+    /* Per-type data grainlab takes elsewhere (masses come from diameter and density,
+     * contact laws from s:contact): skipped, but still checked for its line count. */
+    long long lines = !strcmp(key, "PairIJ Coeffs") ? ntypes * (ntypes + 1) / 2 : ntypes;
+    long start = r->line;
+    for (long long k = 0; k < lines && st == CORE_OK; k++) {
+        if (!next_content(r)) {
+            snprintf(msg, sizeof msg,
+                     "the file ends in the %s section started on line %ld (truncated?)",
+                     key, start);
+            st = bad_line(err, r, msg);
+        } else if (r->ntok == 1 && is_section(r->tok[0]) &&
+                   strcmp(key, "Atom Type Labels")) {
+            snprintf(msg, sizeof msg,
+                     "section '%s' starts inside the %s section (%lld lines expected)",
+                     r->tok[0], key, lines);
+            st = bad_line(err, r, msg);
+        }
+    }
+    return st;
+}
+
+static core_status parse(reader *r, dem_lammps_data *d, core_error *err)
+{
+    char msg[320], key[128];
+    if (!next_line(r))
+        return r->nul ? bad_line(err, r, "")
+                      : core_fail(err, CORE_ERR_ARG, "%s: the file is empty", r->path);
+    /* The title line keeps its '#' text: it is free text. */
+    rewind(r->fp);
+    {
+        ssize_t len = getline(&r->buf, &r->cap, r->fp);
+        if (len > 0) {
+            while (len > 0 && (r->buf[len - 1] == '\n' || r->buf[len - 1] == '\r'))
+                r->buf[--len] = 0;
+            snprintf(d->title, sizeof d->title, "%s", r->buf);
+        }
+    }
+    long long ntypes = 0;
+    int in_body = 0;
+    core_status st = parse_header(r, d, &ntypes, &in_body, err);
+    if (st != CORE_OK)
+        return st;
+    st = alloc_atoms(d, d->n, err);
     if (st != CORE_OK)
         return st;
 
@@ -545,24 +583,7 @@ static core_status parse(reader *r, dem_lammps_data *d, core_error *err)
                 d->has_velocities = 1;
         } else if (!strcmp(key, "Masses") || !strcmp(key, "Pair Coeffs") ||
                    !strcmp(key, "PairIJ Coeffs") || !strcmp(key, "Atom Type Labels")) {
-            /* Per-type data grainlab takes elsewhere (masses come from diameter and density,
-             * contact laws from s:contact): skipped, but still checked for its line count. */
-            long long lines = !strcmp(key, "PairIJ Coeffs") ? ntypes * (ntypes + 1) / 2 : ntypes;
-            long start = r->line;
-            for (long long k = 0; k < lines && st == CORE_OK; k++) {
-                if (!next_content(r)) {
-                    snprintf(msg, sizeof msg,
-                             "the file ends in the %s section started on line %ld (truncated?)",
-                             key, start);
-                    st = bad_line(err, r, msg);
-                } else if (r->ntok == 1 && is_section(r->tok[0]) &&
-                           strcmp(key, "Atom Type Labels")) {
-                    snprintf(msg, sizeof msg,
-                             "section '%s' starts inside the %s section (%lld lines expected)",
-                             r->tok[0], key, lines);
-                    st = bad_line(err, r, msg);
-                }
-            }
+            st = skip_section(r, key, ntypes, err);
         } else {
             snprintf(msg, sizeof msg,
                      "section '%s' is not read by grainlab (it reads Atoms and Velocities of "
@@ -664,6 +685,108 @@ static void rollback(dem_scene *s, size_t n0, int nmat0)
     dem_invalidate(s, 1);
 }
 
+/* The checks of atom k of d against scene s, before the scene changes. */
+static core_status check_atom(const dem_scene *s, const dem_lammps_data *d,
+                              const dem_lammps_type *types, size_t k, core_error *err)
+{
+    const int D = s->dim;
+    const dem_lammps_type *ty = &types[d->type[k] - 1];
+    if (!ty->mapped)
+        return core_fail(err, CORE_ERR_ARG,
+                         "%s:%ld: atom %lld has type %d, which has no material (give it one "
+                         "in types, or give material)",
+                         d->path, d->line[k], d->id[k], d->type[k]);
+    if (ty->density == DEM_LAMMPS_DENSITY_STRICT &&
+        !close_density(d->density[k], ty->material.density))
+        return core_fail(err, CORE_ERR_ARG,
+                         "%s:%ld: atom %lld has density %.17g but type %d's material has "
+                         "density %.17g (density = 'file' keeps the file's densities, "
+                         "'material' the material's)",
+                         d->path, d->line[k], d->id[k], d->density[k], d->type[k],
+                         ty->material.density);
+    if (D == 2 && (d->x[2][k] != 0 || d->v[2][k] != 0 || d->w[0][k] != 0 || d->w[1][k] != 0))
+        return core_fail(err, CORE_ERR_ARG,
+                         "%s:%ld: atom %lld has z = %g, vz = %g, wx = %g, wy = %g: a 2D scene "
+                         "needs all four 0 (is this a 3D file?)",
+                         d->path, d->line[k], d->id[k], d->x[2][k], d->v[2][k], d->w[0][k],
+                         d->w[1][k]);
+    if (D == 2 && d->image[2][k] != 0)
+        return core_fail(err, CORE_ERR_ARG,
+                         "%s:%ld: atom %lld has image flag %d on axis z of a 2D scene (a 2D "
+                         "file's iz is 0)",
+                         d->path, d->line[k], d->id[k], d->image[2][k]);
+    for (int a = 0; a < D; a++) {
+        double x = d->x[a][k];
+        if (!s->periodic[a] && d->image[a][k] != 0)
+            return core_fail(err, CORE_ERR_ARG,
+                             "%s:%ld: atom %lld has image flag %d on axis %c, which is not "
+                             "periodic in this scene (periodic = {...} as in the LAMMPS "
+                             "run's boundary?)",
+                             d->path, d->line[k], d->id[k], d->image[a][k], 'x' + a);
+        if (!s->periodic[a] && (x < s->lo[a] || x > s->hi[a]))
+            return core_fail(err, CORE_ERR_ARG,
+                             "%s:%ld: atom %lld: %c = %.17g is outside the scene's box [%g, "
+                             "%g] on an axis that is not periodic",
+                             d->path, d->line[k], d->id[k], 'x' + a, x, s->lo[a], s->hi[a]);
+        /* wrapped below; beyond LAMMPS's image range (512 box lengths) a coordinate is no
+         * image of an atom, and wrapping it would keep little of its digits */
+        double boxes = (x < s->lo[a] ? s->lo[a] - x : x - s->hi[a]) / s->len[a];
+        if (s->periodic[a] && boxes > 512)
+            return core_fail(err, CORE_ERR_ARG,
+                             "%s:%ld: atom %lld: %c = %.17g is more than 512 box lengths "
+                             "(LAMMPS's image range) outside the periodic box [%g, %g]",
+                             d->path, d->line[k], d->id[k], 'x' + a, x, s->lo[a], s->hi[a]);
+    }
+    /* a speed whose kinetic energy overflows is no grain's (the energy measures sum v^2) */
+    for (int a = 0; a < 3; a++) {
+        const double v = d->v[a][k], w = d->w[a][k] * d->radius[k];
+        if (!isfinite(v * v) || !isfinite(w * w))
+            return core_fail(err, CORE_ERR_ARG,
+                             "%s:%ld: atom %lld: %s = %g is too large (its square, in the "
+                             "kinetic energy, overflows)",
+                             d->path, d->line[k], d->id[k],
+                             !isfinite(v * v) ? (const char *[]){"vx", "vy", "vz"}[a]
+                                              : (const char *[]){"wx", "wy", "wz"}[a],
+                             !isfinite(v * v) ? v : d->w[a][k]);
+    }
+    return CORE_OK;
+}
+
+/* Densities within DENSITY_RTOL of a run's first share one copy, whose density is the most
+ * frequent exact value of the run (LAMMPS's round-off scatters a few ulps around it): the copies
+ * of the atoms of keys (a density the file gives, not the type's), their indices into mat. */
+static core_status density_copies(dem_scene *s, const dem_lammps_type *types, dens_key *keys,
+                                  size_t nkeys, int *mat, core_error *err)
+{
+    core_status st = CORE_OK;
+    qsort(keys, nkeys, sizeof *keys, cmp_dens);
+    for (size_t a = 0; a < nkeys && st == CORE_OK;) {
+        size_t b = a + 1;
+        while (b < nkeys && keys[b].type == keys[a].type &&
+               close_density(keys[b].density, keys[a].density))
+            b++;
+        double best = keys[a].density;
+        size_t best_run = 0;
+        for (size_t c = a; c < b;) {
+            size_t e = c + 1;
+            while (e < b && keys[e].density == keys[c].density)
+                e++;
+            if (e - c > best_run)
+                best_run = e - c, best = keys[c].density;
+            c = e;
+        }
+        dem_material m = types[keys[a].type].material;
+        m.density = best;
+        int idx = material_for(s, &m, err);
+        if (idx < 0)
+            st = err ? err->status : CORE_ERR_ARG;
+        for (size_t c = a; c < b; c++)
+            mat[keys[c].k] = idx;
+        a = b;
+    }
+    return st;
+}
+
 core_status dem_lammps_add(dem_scene *s, const dem_lammps_data *d, const dem_lammps_type *types,
                            int *type_material, size_t *first, core_error *err)
 {
@@ -673,65 +796,9 @@ core_status dem_lammps_add(dem_scene *s, const dem_lammps_data *d, const dem_lam
         type_material[t] = -1;
     /* ---- every check before the scene changes ---- */
     for (size_t k = 0; k < d->n; k++) {
-        const dem_lammps_type *ty = &types[d->type[k] - 1];
-        if (!ty->mapped)
-            return core_fail(err, CORE_ERR_ARG,
-                             "%s:%ld: atom %lld has type %d, which has no material (give it one "
-                             "in types, or give material)",
-                             d->path, d->line[k], d->id[k], d->type[k]);
-        if (ty->density == DEM_LAMMPS_DENSITY_STRICT &&
-            !close_density(d->density[k], ty->material.density))
-            return core_fail(err, CORE_ERR_ARG,
-                             "%s:%ld: atom %lld has density %.17g but type %d's material has "
-                             "density %.17g (density = 'file' keeps the file's densities, "
-                             "'material' the material's)",
-                             d->path, d->line[k], d->id[k], d->density[k], d->type[k],
-                             ty->material.density);
-        if (D == 2 && (d->x[2][k] != 0 || d->v[2][k] != 0 || d->w[0][k] != 0 || d->w[1][k] != 0))
-            return core_fail(err, CORE_ERR_ARG,
-                             "%s:%ld: atom %lld has z = %g, vz = %g, wx = %g, wy = %g: a 2D scene "
-                             "needs all four 0 (is this a 3D file?)",
-                             d->path, d->line[k], d->id[k], d->x[2][k], d->v[2][k], d->w[0][k],
-                             d->w[1][k]);
-        if (D == 2 && d->image[2][k] != 0)
-            return core_fail(err, CORE_ERR_ARG,
-                             "%s:%ld: atom %lld has image flag %d on axis z of a 2D scene (a 2D "
-                             "file's iz is 0)",
-                             d->path, d->line[k], d->id[k], d->image[2][k]);
-        for (int a = 0; a < D; a++) {
-            double x = d->x[a][k];
-            if (!s->periodic[a] && d->image[a][k] != 0)
-                return core_fail(err, CORE_ERR_ARG,
-                                 "%s:%ld: atom %lld has image flag %d on axis %c, which is not "
-                                 "periodic in this scene (periodic = {...} as in the LAMMPS "
-                                 "run's boundary?)",
-                                 d->path, d->line[k], d->id[k], d->image[a][k], 'x' + a);
-            if (!s->periodic[a] && (x < s->lo[a] || x > s->hi[a]))
-                return core_fail(err, CORE_ERR_ARG,
-                                 "%s:%ld: atom %lld: %c = %.17g is outside the scene's box [%g, "
-                                 "%g] on an axis that is not periodic",
-                                 d->path, d->line[k], d->id[k], 'x' + a, x, s->lo[a], s->hi[a]);
-            /* wrapped below; beyond LAMMPS's image range (512 box lengths) a coordinate is no
-             * image of an atom, and wrapping it would keep little of its digits */
-            double boxes = (x < s->lo[a] ? s->lo[a] - x : x - s->hi[a]) / s->len[a];
-            if (s->periodic[a] && boxes > 512)
-                return core_fail(err, CORE_ERR_ARG,
-                                 "%s:%ld: atom %lld: %c = %.17g is more than 512 box lengths "
-                                 "(LAMMPS's image range) outside the periodic box [%g, %g]",
-                                 d->path, d->line[k], d->id[k], 'x' + a, x, s->lo[a], s->hi[a]);
-        }
-        /* a speed whose kinetic energy overflows is no grain's (the energy measures sum v^2) */
-        for (int a = 0; a < 3; a++) {
-            const double v = d->v[a][k], w = d->w[a][k] * d->radius[k];
-            if (!isfinite(v * v) || !isfinite(w * w))
-                return core_fail(err, CORE_ERR_ARG,
-                                 "%s:%ld: atom %lld: %s = %g is too large (its square, in the "
-                                 "kinetic energy, overflows)",
-                                 d->path, d->line[k], d->id[k],
-                                 !isfinite(v * v) ? (const char *[]){"vx", "vy", "vz"}[a]
-                                                  : (const char *[]){"wx", "wy", "wz"}[a],
-                                 !isfinite(v * v) ? v : d->w[a][k]);
-        }
+        core_status st = check_atom(s, d, types, k, err);
+        if (st != CORE_OK)
+            return st;
     }
     /* Ids other than 1..n (a scene written after removals) become the particles' tags, so that
      * a grain keeps its number across the round trip; 1..n is what the particles get anyway. */
@@ -783,33 +850,8 @@ core_status dem_lammps_add(dem_scene *s, const dem_lammps_data *d, const dem_lam
     for (size_t k = 0; k < d->n && st == CORE_OK; k++)
         if (mat[k] == -1 && type_material[d->type[k] - 1] >= 0)
             mat[k] = type_material[d->type[k] - 1];
-    /* Densities within DENSITY_RTOL of a run's first share one copy, whose density is the most
-     * frequent exact value of the run (LAMMPS's round-off scatters a few ulps around it). */
-    qsort(keys, nkeys, sizeof *keys, cmp_dens);
-    for (size_t a = 0; a < nkeys && st == CORE_OK;) {
-        size_t b = a + 1;
-        while (b < nkeys && keys[b].type == keys[a].type &&
-               close_density(keys[b].density, keys[a].density))
-            b++;
-        double best = keys[a].density;
-        size_t best_run = 0;
-        for (size_t c = a; c < b;) {
-            size_t e = c + 1;
-            while (e < b && keys[e].density == keys[c].density)
-                e++;
-            if (e - c > best_run)
-                best_run = e - c, best = keys[c].density;
-            c = e;
-        }
-        dem_material m = types[keys[a].type].material;
-        m.density = best;
-        int idx = material_for(s, &m, err);
-        if (idx < 0)
-            st = err ? err->status : CORE_ERR_ARG;
-        for (size_t c = a; c < b; c++)
-            mat[keys[c].k] = idx;
-        a = b;
-    }
+    if (st == CORE_OK)
+        st = density_copies(s, types, keys, nkeys, mat, err);
     free(keys);
     /* Angular velocities in the file are kept: they need the rotational state. */
     int spin = 0;
@@ -859,244 +901,5 @@ core_status dem_lammps_add(dem_scene *s, const dem_lammps_data *d, const dem_lam
         return st;
     }
     dem_invalidate(s, 1);
-    return CORE_OK;
-}
-
-/* ---- writing ----------------------------------------------------------------------------------
- */
-static core_status atom_types(const dem_scene *s, const dem_lammps_write_def *def, int **out,
-                              int *ntypes, core_error *err)
-{
-    int *type = malloc((s->n ? s->n : 1) * sizeof *type);
-    if (!type)
-        return core_fail(err, CORE_ERR_NOMEM, "cannot allocate %zu particles", s->n);
-    int top = 0;
-    for (size_t i = 0; i < s->n; i++) {
-        int m = s->mat[i];
-        int t = def && def->type_of_material ? def->type_of_material[m] : m + 1;
-        if (t < 1) {
-            free(type);
-            return core_fail(err, CORE_ERR_ARG,
-                             "particle %zu's material (number %d of the scene) has no atom type",
-                             i + 1, m + 1);
-        }
-        type[i] = t;
-        if (t > top)
-            top = t;
-    }
-    int want = def && def->ntypes > 0 ? def->ntypes : 0;
-    if (want && want < top) {
-        free(type);
-        return core_fail(err, CORE_ERR_ARG, "atom types %d is less than the largest type %d", want,
-                         top);
-    }
-    *ntypes = want ? want : (top > 0 ? top : (s->nmat > 0 ? s->nmat : 1));
-    *out = type;
-    return CORE_OK;
-}
-
-/* The z extent of a 2D scene's file: LAMMPS needs zlo < 0 < zhi there. */
-static double slab_half(const dem_scene *s)
-{
-    if (s->thickness > 0)
-        return s->thickness / 2;
-    if (s->r_max > 0)
-        return s->r_max;
-    return 0.5 * (s->len[0] < s->len[1] ? s->len[0] : s->len[1]);
-}
-
-static void box3(const dem_scene *s, double lo[3], double hi[3])
-{
-    for (int a = 0; a < 3; a++)
-        lo[a] = s->lo[a], hi[a] = s->hi[a];
-    if (s->dim == 2)
-        lo[2] = -slab_half(s), hi[2] = slab_half(s);
-}
-
-/* Position of particle i wrapped into the box on periodic axes, with its image flags. */
-static void wrapped(const dem_scene *s, size_t i, double x[3], long img[3])
-{
-    for (int a = 0; a < 3; a++) {
-        x[a] = a < s->dim ? s->x[a][i] : 0;
-        img[a] = 0;
-        if (a < s->dim && s->periodic[a] && (x[a] < s->lo[a] || x[a] >= s->hi[a])) {
-            double f = floor((x[a] - s->lo[a]) / s->len[a]);
-            img[a] = (long)f;
-            x[a] -= f * s->len[a];
-            if (x[a] >= s->hi[a]) /* rounding at the upper side */
-                x[a] -= s->len[a], img[a]++;
-            if (x[a] < s->lo[a])
-                x[a] = s->lo[a];
-        }
-    }
-}
-
-static double omega_of(const dem_scene *s, int a, size_t i) { return s->w[a] ? s->w[a][i] : 0; }
-
-/* The atom id of particle i: its tag + 1 in a scene with insertion or removal (OVITO follows a
- * grain across a removal by it; dem_lammps_add reads it back as the tag), else index + 1. */
-static long long atom_id(const dem_scene *s, size_t i)
-{
-    return (s->tag ? (long long)s->tag[i] : (long long)i) + 1;
-}
-
-core_status dem_write_lammps_data(const dem_scene *s, const char *path,
-                                  const dem_lammps_write_def *def, core_error *err)
-{
-    int *type = NULL, ntypes = 0;
-    core_status st = atom_types(s, def, &type, &ntypes, err);
-    if (st != CORE_OK)
-        return st;
-    atomic_file f;
-    if ((st = atomic_open(&f, path, err)) != CORE_OK) {
-        free(type);
-        return st;
-    }
-    FILE *fp = f.fp;
-    char title[256];
-    if (def && def->title)
-        snprintf(title, sizeof title, "%s", def->title);
-    else
-        snprintf(title, sizeof title,
-                 "LAMMPS data file (atom_style sphere) from grainlab: %dD, "
-                 "boundary %c %c %c, time %.17g s",
-                 s->dim, s->periodic[0] ? 'p' : 'f', s->periodic[1] ? 'p' : 'f',
-                 s->dim == 2 || s->periodic[2] ? 'p' : 'f', s->time);
-    for (char *c = title; *c; c++) /* one line */
-        if (*c == '\n' || *c == '\r')
-            *c = ' ';
-    double lo[3], hi[3];
-    box3(s, lo, hi);
-    fprintf(fp, "%s\n\n%zu atoms\n%d atom types\n\n", title, s->n, ntypes);
-    for (int a = 0; a < 3; a++)
-        fprintf(fp, "%.17g %.17g %clo %chi\n", lo[a], hi[a], 'x' + a, 'x' + a);
-    fprintf(fp, "\nAtoms # sphere\n\n");
-    for (size_t i = 0; i < s->n; i++) {
-        double x[3];
-        long img[3];
-        wrapped(s, i, x, img);
-        fprintf(fp, "%lld %d %.17g %.17g %.17g %.17g %.17g %ld %ld %ld\n", atom_id(s, i), type[i],
-                2 * s->r[i], s->mats[s->mat[i]].density, x[0], x[1], x[2], img[0], img[1], img[2]);
-    }
-    fprintf(fp, "\nVelocities\n\n");
-    for (size_t i = 0; i < s->n; i++) {
-        double v[3] = {s->v[0][i], s->v[1][i], s->dim == 3 ? s->v[2][i] : 0};
-        fprintf(fp, "%lld %.17g %.17g %.17g %.17g %.17g %.17g\n", atom_id(s, i), v[0], v[1], v[2],
-                omega_of(s, 0, i), omega_of(s, 1, i), omega_of(s, 2, i));
-    }
-    free(type);
-    return atomic_commit(&f, err);
-}
-
-/* Appends printf output to a growing buffer. */
-typedef struct strbuf {
-    char *p;
-    size_t len, cap;
-    int failed;
-} strbuf;
-
-static void sb_printf(strbuf *b, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-static void sb_printf(strbuf *b, const char *fmt, ...)
-{
-    if (b->failed)
-        return;
-    for (;;) {
-        va_list ap;
-        va_start(ap, fmt);
-        int k = vsnprintf(b->p ? b->p + b->len : NULL, b->p ? b->cap - b->len : 0, fmt, ap);
-        va_end(ap);
-        if (k < 0) {
-            b->failed = 1;
-            return;
-        }
-        if (b->p && b->len + (size_t)k < b->cap) {
-            b->len += (size_t)k;
-            return;
-        }
-        size_t cap = b->cap ? b->cap : 4096;
-        while (cap <= b->len + (size_t)k)
-            cap *= 2;
-        char *q = realloc(b->p, cap);
-        if (!q) {
-            b->failed = 1;
-            return;
-        }
-        b->p = q;
-        b->cap = cap;
-    }
-}
-
-core_status dem_write_lammps_dump(const dem_scene *s, const char *path,
-                                  const dem_lammps_write_def *def, core_error *err)
-{
-    int *type = NULL, ntypes = 0;
-    core_status st = atom_types(s, def, &type, &ntypes, err);
-    if (st != CORE_OK)
-        return st;
-    /* The frame is made in memory first, so that it reaches the file in one write. */
-    strbuf b = {0};
-    double lo[3], hi[3];
-    box3(s, lo, hi);
-    /* No "ITEM: TIME": read_dump and rerun of LAMMPS 29 Sep 2021 (Debian 12) refuse it. */
-    sb_printf(&b, "ITEM: TIMESTEP\n%ld\nITEM: NUMBER OF ATOMS\n%zu\n", s->steps, s->n);
-    char bc[3];
-    for (int a = 0; a < 3; a++)
-        bc[a] = (a >= s->dim || s->periodic[a]) ? 'p' : 'f';
-    sb_printf(&b, "ITEM: BOX BOUNDS %c%c %c%c %c%c\n", bc[0], bc[0], bc[1], bc[1], bc[2], bc[2]);
-    for (int a = 0; a < 3; a++)
-        sb_printf(&b, "%.17g %.17g\n", lo[a], hi[a]);
-    sb_printf(&b, "ITEM: ATOMS id type radius mass x y z vx vy vz fx fy fz omegax omegay "
-                  "omegaz\n");
-    for (size_t i = 0; i < s->n; i++) {
-        double x[3];
-        long img[3];
-        wrapped(s, i, x, img);
-        double v[3], f[3];
-        for (int a = 0; a < 3; a++) {
-            v[a] = a < s->dim ? s->v[a][i] : 0;
-            f[a] = a < s->dim ? s->f[a][i] : 0;
-        }
-        sb_printf(&b,
-                  "%lld %d %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g "
-                  "%.17g %.17g %.17g\n",
-                  atom_id(s, i), type[i], s->r[i], s->m[i], x[0], x[1], x[2], v[0], v[1], v[2],
-                  f[0], f[1], f[2], omega_of(s, 0, i), omega_of(s, 1, i), omega_of(s, 2, i));
-    }
-    free(type);
-    if (b.failed) {
-        free(b.p);
-        return core_fail(err, CORE_ERR_NOMEM, "cannot format a dump frame of %zu atoms", s->n);
-    }
-    if (!(def && def->append)) {
-        st = atomic_write(path, b.p, b.len, err);
-        free(b.p);
-        return st;
-    }
-    int fd = open(path, O_WRONLY | O_APPEND | O_CREAT, 0666);
-    if (fd < 0) {
-        free(b.p);
-        return core_fail(err, CORE_ERR_IO, "cannot append to '%s': %s", path, strerror(errno));
-    }
-    struct stat sb;
-    off_t before = fstat(fd, &sb) == 0 ? sb.st_size : -1;
-    size_t done = 0;
-    int e = 0;
-    while (done < b.len) {
-        ssize_t k = write(fd, b.p + done, b.len - done);
-        if (k < 0) {
-            if (errno == EINTR)
-                continue;
-            e = errno;
-            break;
-        }
-        done += (size_t)k;
-    }
-    free(b.p);
-    if (e && before >= 0 && ftruncate(fd, before) != 0) /* no half frame after a failure */
-        e = errno;
-    if (close(fd) != 0 && !e)
-        e = errno;
-    if (e)
-        return core_fail(err, CORE_ERR_IO, "cannot append to '%s': %s", path, strerror(e));
     return CORE_OK;
 }

@@ -166,31 +166,57 @@ static double wall_slip(const dem_scene *s, const dem_wall_hit *hit, size_t i)
     return sqrt(sl2);
 }
 
-/* The tangential force a wall contact carries now, without advancing the spring history. */
-static double wall_tangential(const dem_scene *s, const dem_wall *wl, const dem_wall_hit *hit,
-                              int first, size_t i, double fn, double k, double mu, double delta)
+/* The tangential laws (laws.h's DEM_TANGENT_LAWS): the force a wall contact carries now, without
+ * advancing the spring history. */
+#define WALL_TANGENTIAL_ARGS                                                                       \
+    const dem_scene *s, const dem_wall *wl, const dem_wall_hit *hit, int first, size_t i,          \
+        double fn, double k, double mu, double delta
+static double wall_tangential_none(WALL_TANGENTIAL_ARGS)
 {
+    (void)s, (void)wl, (void)hit, (void)first, (void)i, (void)fn, (void)k, (void)mu, (void)delta;
+    return 0;
+}
+
+static double wall_tangential_viscous(WALL_TANGENTIAL_ARGS)
+{
+    (void)wl, (void)first, (void)fn, (void)k, (void)mu, (void)delta;
+    return s->contact.gamma_t * wall_slip(s, hit, i);
+}
+
+static double wall_tangential_coulomb_regularized(WALL_TANGENTIAL_ARGS)
+{
+    (void)wl, (void)first, (void)k, (void)delta;
     const dem_contact_def *c = &s->contact;
-    switch (c->tangential) {
-    case DEM_TANGENT_VISCOUS:
-        return c->gamma_t * wall_slip(s, hit, i);
-    case DEM_TANGENT_REGULARIZED: {
-        double x = wall_slip(s, hit, i) / c->v_r;
-        return x >= 1 ? mu * fn : mu * fn * pow(x, 1 / c->exponent);
-    }
-    case DEM_TANGENT_SPRING: { /* the stored force (already capped at mu f_n) */
-        if (!wl->hist[0] || !first) /* further hits of a shaped wall carry no history */
-            return 0;
-        double f2 = 0;
-        for (int d = 0; d < s->dim; d++)
-            f2 += wl->hist[d][i] * wl->hist[d][i];
-        (void)k, (void)delta;
-        return fmin(sqrt(f2), mu * fn);
-    }
+    double x = wall_slip(s, hit, i) / c->v_r;
+    return x >= 1 ? mu * fn : mu * fn * pow(x, 1 / c->exponent);
+}
+
+static double wall_tangential_spring(WALL_TANGENTIAL_ARGS)
+{
+    (void)hit;
+    /* the stored force (already capped at mu f_n) */
+    if (!wl->hist[0] || !first) /* further hits of a shaped wall carry no history */
+        return 0;
+    double f2 = 0;
+    for (int d = 0; d < s->dim; d++)
+        f2 += wl->hist[d][i] * wl->hist[d][i];
+    (void)k, (void)delta;
+    return fmin(sqrt(f2), mu * fn);
+}
+
+static double wall_tangential(WALL_TANGENTIAL_ARGS)
+{
+    switch (s->contact.tangential) {
+#define LAW_(a, ID, name, ...)                                                                     \
+    case DEM_TANGENT_##ID:                                                                         \
+        return wall_tangential_##name(s, wl, hit, first, i, fn, k, mu, delta);
+        DEM_TANGENT_LAWS(LAW_, _)
+#undef LAW_
     default:
         return 0;
     }
 }
+#undef WALL_TANGENTIAL_ARGS
 
 void dem_each_contact(dem_scene *s, void (*visit)(const dem_contact_info *c, void *ctx),
                       void *ctx)

@@ -45,8 +45,8 @@ static void law_parameters(const dem_scene *s, int ma, int mb, double r_eff, dou
 {
     const dem_contact_def *c = &s->contact;
     const dem_material *a = &s->mats[ma], *b = &s->mats[mb];
-    *k = c->normal == DEM_NORMAL_HERTZ ? 4.0 / 3.0 * effective_modulus(a, b) * sqrt(r_eff)
-                                       : c->stiffness;
+    *k = dem_normal_from_moduli(c->normal) ? 4.0 / 3.0 * effective_modulus(a, b) * sqrt(r_eff)
+                                           : c->stiffness;
     *gamma = 0;
     const int given = c->restitution > 0; /* s:contact's restitution */
     if (c->damping == DEM_DAMPING_VISCOUS) {
@@ -148,10 +148,10 @@ static core_status reserve_pairs(dem_scene *s, size_t n, core_error *err)
             st = dem_alloc_array(&p->f[d], cap, err);
         if (!st && s->rot && (s->dim == 3 || d == 2))
             st = dem_alloc_array(&p->c[d], cap, err);
-        if (!st && s->contact.tangential == DEM_TANGENT_SPRING && d < s->dim)
+        if (!st && dem_tangent_history(s->contact.tangential) && d < s->dim)
             st = dem_alloc_array(&p->hist[d], cap, err);
     }
-    if (!st && s->contact.tangential == DEM_TANGENT_SPRING)
+    if (!st && dem_tangent_history(s->contact.tangential))
         st = dem_alloc_array(&p->hist[3], cap, err);
     /* rolling resistance: the torques (rotations are on), the EPSD spring's history */
     for (int d = s->dim == 2 ? 2 : 0; d < 3 && !st && s->contact.rolling_law; d++)
@@ -353,18 +353,12 @@ core_status dem_pairs_index(dem_scene *s, core_error *err)
     return index_j(s, err);
 }
 
-core_status dem_build_pairs(dem_scene *s, core_error *err)
+/* Particles into the cells of the list build (cell_start, cell_items). */
+static core_status bin_particles(dem_scene *s, core_error *err)
 {
     const int D = s->dim;
     const size_t n = s->n;
-    dem_pairs *p = &s->pairs;
-    s->skin = s->skin_def > 0 ? s->skin_def : 0.2 * s->r_max;
-
-    dem_wrap_positions(s);
-
-    core_status st = setup_cells(s, 2 * s->r_max + s->skin, err);
-    if (st)
-        return st;
+    core_status st;
     size_t ncells = (size_t)s->ncell[0] * (size_t)s->ncell[1] * (size_t)s->ncell[2];
     if ((st = alloc_u32(&s->cell_items, n, err)))
         return st;
@@ -393,6 +387,105 @@ core_status dem_build_pairs(dem_scene *s, core_error *err)
         free(fill);
     }
     free(cell_of);
+    return CORE_OK;
+}
+
+/* The contact history of the new list: from each first particle's bundle when distributed
+ * (domain.c), else from the old list (carry: it has one) by merging the two sorted lists. */
+static void carry_history(dem_scene *s, const dem_pairs *old_list, int carry)
+{
+    const size_t n = s->n;
+    dem_pairs *p = &s->pairs;
+    const size_t *start = p->start;
+    const dem_pairs old = *old_list;
+    const int any_hist = p->hist[0] || p->hist[DEM_HIST_ROLL];
+    if (any_hist && s->dom) {
+        /* Distributed: the history came with each first particle (its bundle, domain.c). */
+        const int hw = dem_hist_width(s);
+#pragma omp parallel for schedule(static) if (n > 4096)
+        for (size_t i = 0; i < n; i++) {
+            const uint32_t *gj;
+            const double *h;
+            size_t nb = dem_domain_bundle(s, i, &gj, &h), o = 0;
+            for (size_t q = start[i]; q < start[i + 1]; q++) {
+                const uint32_t g = s->gid[p->j[q]];
+                while (o < nb && gj[o] < g)
+                    o++;
+                int same = o < nb && gj[o] == g;
+                for (int d = 0; d < hw; d++)
+                    if (p->hist[d])
+                        p->hist[d][q] = same ? h[(size_t)hw * o + d] : 0;
+            }
+        }
+    } else if (any_hist) {
+        size_t old_np = carry ? (old.np < n ? old.np : n) : 0;
+#pragma omp parallel for schedule(static) if (n > 4096)
+        for (size_t i = 0; i < n; i++) {
+            size_t q = start[i], e = start[i + 1];
+            size_t o = i < old_np ? old.start[i] : 0, oe = i < old_np ? old.start[i + 1] : 0;
+            for (; q < e; q++) { /* merge two lists sorted by j */
+                while (o < oe && old.j[o] < p->j[q])
+                    o++;
+                int same = o < oe && old.j[o] == p->j[q];
+                for (int d = 0; d < DEM_HIST; d++)
+                    if (p->hist[d])
+                        p->hist[d][q] = same && old.hist[d] ? old.hist[d][o] : 0;
+            }
+        }
+    }
+}
+
+/* A plane's candidates: particles that can touch it before the next build (within r + skin, or
+ * already behind it so that the tunnelling check sees them). */
+static core_status plane_candidates(dem_scene *s, dem_wall *wl, core_error *err)
+{
+    const int D = s->dim;
+    const size_t n = s->n;
+    wl->ncand = 0;
+    wl->cand_par_ok = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (s->ghost && s->ghost[i])
+            continue; /* distributed: walls act on owned particles only */
+        double dist = 0;
+        for (int d = 0; d < D; d++)
+            dist += (s->x[d][i] - wl->point[d]) * wl->normal[d];
+        if (dist >= s->r[i] + s->skin)
+            continue;
+        if (wl->ncand == wl->cap_cand) {
+            size_t cap = wl->cap_cand ? 2 * wl->cap_cand : 256;
+            uint32_t *c = realloc(wl->cand, cap * sizeof *c);
+            if (!c)
+                return core_fail(err, CORE_ERR_NOMEM, "cannot allocate wall candidates");
+            wl->cand = c;
+            wl->cap_cand = cap;
+        }
+        wl->cand[wl->ncand++] = (uint32_t)i;
+    }
+    for (int d = 0; d < 3; d++)
+        wl->point_build[d] = wl->point[d];
+    if (s->dom) {
+        double *c = realloc(wl->cand_fn, (wl->cap_cand ? wl->cap_cand : 1) * sizeof *c);
+        if (!c)
+            return core_fail(err, CORE_ERR_NOMEM, "cannot allocate wall candidates");
+        wl->cand_fn = c;
+    }
+    return CORE_OK;
+}
+
+core_status dem_build_pairs(dem_scene *s, core_error *err)
+{
+    const int D = s->dim;
+    const size_t n = s->n;
+    dem_pairs *p = &s->pairs;
+    s->skin = s->skin_def > 0 ? s->skin_def : 0.2 * s->r_max;
+
+    dem_wrap_positions(s);
+
+    core_status st = setup_cells(s, 2 * s->r_max + s->skin, err);
+    if (st)
+        return st;
+    if ((st = bin_particles(s, err)))
+        return st;
 
     /* Count, then fill, the neighbours of each particle: two passes keep the list in (i, j)
      * order whatever the thread count. */
@@ -442,41 +535,7 @@ core_status dem_build_pairs(dem_scene *s, core_error *err)
             s->need_rebuild = 1;
             return bad;
         }
-    const int any_hist = p->hist[0] || p->hist[DEM_HIST_ROLL];
-    if (any_hist && s->dom) {
-        /* Distributed: the history came with each first particle (its bundle, domain.c). */
-        const int hw = dem_hist_width(s);
-#pragma omp parallel for schedule(static) if (n > 4096)
-        for (size_t i = 0; i < n; i++) {
-            const uint32_t *gj;
-            const double *h;
-            size_t nb = dem_domain_bundle(s, i, &gj, &h), o = 0;
-            for (size_t q = start[i]; q < start[i + 1]; q++) {
-                const uint32_t g = s->gid[p->j[q]];
-                while (o < nb && gj[o] < g)
-                    o++;
-                int same = o < nb && gj[o] == g;
-                for (int d = 0; d < hw; d++)
-                    if (p->hist[d])
-                        p->hist[d][q] = same ? h[(size_t)hw * o + d] : 0;
-            }
-        }
-    } else if (any_hist) {
-        size_t old_np = carry ? (old.np < n ? old.np : n) : 0;
-#pragma omp parallel for schedule(static) if (n > 4096)
-        for (size_t i = 0; i < n; i++) {
-            size_t q = start[i], e = start[i + 1];
-            size_t o = i < old_np ? old.start[i] : 0, oe = i < old_np ? old.start[i + 1] : 0;
-            for (; q < e; q++) { /* merge two lists sorted by j */
-                while (o < oe && old.j[o] < p->j[q])
-                    o++;
-                int same = o < oe && old.j[o] == p->j[q];
-                for (int d = 0; d < DEM_HIST; d++)
-                    if (p->hist[d])
-                        p->hist[d][q] = same && old.hist[d] ? old.hist[d][o] : 0;
-            }
-        }
-    }
+    carry_history(s, &old, carry);
     for (int d = 0; d < 3; d++) {
         if (p->f[d])
             memset(p->f[d], 0, (npairs ? npairs : 1) * sizeof(double));
@@ -489,8 +548,7 @@ core_status dem_build_pairs(dem_scene *s, core_error *err)
         return st;
     }
 
-    /* Wall candidates: particles that can touch the wall before the next build (within r + skin,
-     * or already behind it so that the tunnelling check sees them). */
+    /* Wall candidates */
     for (int w = 0; w < s->nwalls; w++) {
         dem_wall *wl = &s->walls[w];
         if (!wl->active)
@@ -502,37 +560,9 @@ core_status dem_build_pairs(dem_scene *s, core_error *err)
             }
             continue;
         }
-        wl->ncand = 0;
-        wl->cand_par_ok = 0;
-        for (size_t i = 0; i < n; i++) {
-            if (s->ghost && s->ghost[i])
-                continue; /* distributed: walls act on owned particles only */
-            double dist = 0;
-            for (int d = 0; d < D; d++)
-                dist += (s->x[d][i] - wl->point[d]) * wl->normal[d];
-            if (dist >= s->r[i] + s->skin)
-                continue;
-            if (wl->ncand == wl->cap_cand) {
-                size_t cap = wl->cap_cand ? 2 * wl->cap_cand : 256;
-                uint32_t *c = realloc(wl->cand, cap * sizeof *c);
-                if (!c) {
-                    dem_free_pairs(&old);
-                    return core_fail(err, CORE_ERR_NOMEM, "cannot allocate wall candidates");
-                }
-                wl->cand = c;
-                wl->cap_cand = cap;
-            }
-            wl->cand[wl->ncand++] = (uint32_t)i;
-        }
-        for (int d = 0; d < 3; d++)
-            wl->point_build[d] = wl->point[d];
-        if (s->dom) {
-            double *c = realloc(wl->cand_fn, (wl->cap_cand ? wl->cap_cand : 1) * sizeof *c);
-            if (!c) {
-                dem_free_pairs(&old);
-                return core_fail(err, CORE_ERR_NOMEM, "cannot allocate wall candidates");
-            }
-            wl->cand_fn = c;
+        if ((st = plane_candidates(s, wl, err))) {
+            dem_free_pairs(&old);
+            return st;
         }
     }
 

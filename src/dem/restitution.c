@@ -7,7 +7,9 @@
  * scene's materials, or its s:contact restitution) and scaled per pair when the list is built
  * (neighbor.c). With clip the force is never attractive: the grains part when it falls to zero
  * while they separate, and leave at that speed (for the linear law this is the closed form of
- * Schwager & Poeschel 2007, e = exp(-z (pi - 2 asin z) / sqrt(1 - z^2)), z = c/2). */
+ * Schwager & Poeschel 2007, e = exp(-z (pi - 2 asin z) / sqrt(1 - z^2)), z = c/2). At the end,
+ * Brilliantov's lambda(e) by a fixed-step RK4 (dem.h) and the damping a pair or wall contact
+ * takes (dem_pair_damping). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -172,11 +174,6 @@ core_status dem_contact_damping(double e, double beta, double a, bool clip, doub
     return CORE_OK;
 }
 
-double dem_law_beta(const dem_contact_def *c)
-{
-    return c->normal == DEM_NORMAL_LINEAR ? 1 : c->normal == DEM_NORMAL_POWER ? c->beta : 1.5;
-}
-
 int dem_damping_solved(const dem_contact_def *c)
 {
     if (c->restitution >= 0) /* s:contact's restitution: one coefficient (scene.c) */
@@ -195,7 +192,8 @@ core_status dem_damping_coefficient(const dem_contact_def *c, double e, double *
 {
     const int brill = c->damping == DEM_DAMPING_BRILLIANTOV;
     double beta = dem_law_beta(c), x;
-    core_status st = dem_contact_damping(e, beta, brill ? 0.5 : 0, c->clip, &x, err);
+    core_status st =
+        dem_contact_damping(e, beta, dem_damping_exponent(c->damping), c->clip, &x, err);
     if (st != CORE_OK)
         return st;
     *out = brill ? x * pow(c->impact_velocity, -0.2) : x;
@@ -222,5 +220,98 @@ core_status dem_damping_table(const dem_contact_def *c, const dem_material *mats
         if (st != CORE_OK)
             return st;
     }
+    return CORE_OK;
+}
+
+/* ---- Brilliantov damping time from a restitution ------------------------------------------ */
+/* x'' = -x^{3/2} - lambda x^{1/2} x', x(0) = 0, x'(0) = 1 (lengths in d* = (m v^2/K)^{2/5}, times
+ * in units of d* / v), integrated with RK4 until x returns to 0. With clip the force is never
+ * attractive, so once it vanishes the particles separate at constant speed. */
+double dem_brilliantov_restitution(double lambda, bool clip)
+{
+    const double h = 2e-4; /* of a contact lasting about 3.2 */
+    double x = 0, u = 1;
+    for (int step = 0; step < 1000000; step++) {
+        double kx[4], ku[4], xs = x, us = u;
+        for (int stage = 0; stage < 4; stage++) {
+            double xx = xs > 0 ? xs : 0;
+            double a = -xx * sqrt(xx) - lambda * sqrt(xx) * us;
+            if (clip && a > 0)
+                a = 0; /* no attraction */
+            kx[stage] = us;
+            ku[stage] = a;
+            double c = stage < 2 ? 0.5 * h : h;
+            if (stage < 3) {
+                xs = x + c * kx[stage];
+                us = u + c * ku[stage];
+            }
+        }
+        double xn = x + h / 6 * (kx[0] + 2 * kx[1] + 2 * kx[2] + kx[3]);
+        double un = u + h / 6 * (ku[0] + 2 * ku[1] + 2 * ku[2] + ku[3]);
+        if (step > 0 && xn <= 0)
+            return -un;
+        x = xn;
+        u = un;
+    }
+    return 0; /* overdamped: never came back */
+}
+
+core_status dem_brilliantov_lambda(double e, bool clip, double *lambda, core_error *err)
+{
+    if (!(e > 0 && e <= 1))
+        return core_fail(err, CORE_ERR_ARG, "restitution must be in (0, 1], got %g", e);
+    if (e == 1) {
+        *lambda = 0;
+        return CORE_OK;
+    }
+    /* e falls monotonically with lambda: bracket, then bisect. */
+    double lo = 0, hi = 1;
+    while (dem_brilliantov_restitution(hi, clip) > e) {
+        lo = hi;
+        hi *= 2;
+        if (hi > 1e6)
+            return core_fail(err, CORE_ERR_ARG,
+                             "restitution %g is below what brilliantov damping reaches", e);
+    }
+    for (int it = 0; it < 60 && hi - lo > 1e-12 * hi; it++) {
+        double mid = 0.5 * (lo + hi);
+        if (dem_brilliantov_restitution(mid, clip) > e)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    *lambda = 0.5 * (lo + hi);
+    return CORE_OK;
+}
+
+core_status dem_brilliantov_time(double e, double m_eff, double K, double v, double *T,
+                                 core_error *err)
+{
+    if (!(m_eff > 0) || !(K > 0) || !(v > 0))
+        return core_fail(err, CORE_ERR_ARG, "mass, stiffness and speed must be > 0");
+    double lambda;
+    core_status st = dem_brilliantov_lambda(e, true, &lambda, err);
+    if (st != CORE_OK)
+        return st;
+    *T = lambda * pow(m_eff / K, 0.4) * pow(v, -0.2);
+    return CORE_OK;
+}
+
+core_status dem_pair_damping(const dem_scene *s, size_t i, size_t j, int wall, double *out,
+                             core_error *err)
+{
+    if (i >= s->n || (wall < 0 && j >= s->n))
+        return core_fail(err, CORE_ERR_ARG, "particle %zu out of range (the scene has %zu)",
+                         (i >= s->n ? i : j) + 1, s->n);
+    if (wall >= s->nwalls)
+        return core_fail(err, CORE_ERR_ARG, "wall %d out of range (the scene has %d)", wall + 1,
+                         s->nwalls);
+    if (wall < 0 && i == j)
+        return core_fail(err, CORE_ERR_ARG, "particle %zu paired with itself", i + 1);
+    double k, mu;
+    if (wall >= 0)
+        dem_wall_parameters(s, &s->walls[wall], i, &k, out, &mu);
+    else
+        dem_pair_parameters((dem_scene *)s, i, j, &k, out, &mu);
     return CORE_OK;
 }

@@ -193,10 +193,14 @@ int dem_add_material(dem_scene *s, const dem_material *m, core_error *err)
 /* ---- contact law ---------------------------------------------------------------------------- */
 core_status dem_set_contact(dem_scene *s, const dem_contact_def *c, core_error *err)
 {
-    if (c->normal == DEM_NORMAL_LINEAR || c->normal == DEM_NORMAL_POWER) {
+    if ((unsigned)c->normal >= DEM_NORMAL_COUNT || (unsigned)c->damping >= DEM_DAMPING_COUNT ||
+        (unsigned)c->tangential >= DEM_TANGENT_COUNT) /* laws.h's lists */
+        return core_fail(err, CORE_ERR_ARG, "unknown contact law (normal %d, damping %d, "
+                         "tangential %d)", (int)c->normal, (int)c->damping, (int)c->tangential);
+    if (!dem_normal_from_moduli(c->normal)) {
         if (!(c->stiffness > 0) || !isfinite(c->stiffness))
             return core_fail(err, CORE_ERR_ARG, "stiffness must be > 0 for the %s law, got %g",
-                             c->normal == DEM_NORMAL_LINEAR ? "linear" : "power", c->stiffness);
+                             dem_normal_names[c->normal], c->stiffness);
     }
     if (c->normal == DEM_NORMAL_POWER && c->beta != 1 && c->beta != 1.5 && c->beta != 2)
         return core_fail(err, CORE_ERR_ARG, "beta must be 1, 1.5 or 2, got %g", c->beta);
@@ -204,7 +208,7 @@ core_status dem_set_contact(dem_scene *s, const dem_contact_def *c, core_error *
         return core_fail(err, CORE_ERR_ARG,
                          "brilliantov damping needs the hertz normal law (with the %s law, "
                          "damping 'viscous' honours a restitution)",
-                         c->normal == DEM_NORMAL_LINEAR ? "linear" : "power");
+                         dem_normal_names[c->normal]);
     if (c->damping == DEM_DAMPING_BRILLIANTOV && !(c->damping_time < 0 || isfinite(c->damping_time)))
         return core_fail(err, CORE_ERR_ARG, "damping_time must be finite, got %g", c->damping_time);
     if (c->damping == DEM_DAMPING_VISCOUS && !(c->gamma_n < 0 || isfinite(c->gamma_n)))
@@ -250,7 +254,7 @@ core_status dem_set_contact(dem_scene *s, const dem_contact_def *c, core_error *
         return core_fail(err, CORE_ERR_ARG, "gamma_t must be >= 0, got %g", c->gamma_t);
     if (c->tangential == DEM_TANGENT_SPRING && !(c->kt < 0 || (c->kt > 0 && isfinite(c->kt))))
         return core_fail(err, CORE_ERR_ARG, "kt must be > 0, got %g", c->kt);
-    if (c->rolling_law < DEM_ROLLING_NONE || c->rolling_law > DEM_ROLLING_CONSTANT)
+    if ((unsigned)c->rolling_law >= DEM_ROLLING_COUNT)
         return core_fail(err, CORE_ERR_ARG, "unknown rolling resistance law %d",
                          (int)c->rolling_law);
     if (!(c->rolling_friction < 0 || isfinite(c->rolling_friction)))
@@ -281,7 +285,7 @@ core_status dem_set_contact(dem_scene *s, const dem_contact_def *c, core_error *
             return st;
         }
     }
-    int spring_before = s->contact.tangential == DEM_TANGENT_SPRING;
+    int spring_before = dem_tangent_history(s->contact.tangential);
     int roll_before = s->contact.rolling_law;
     s->contact = *c;
     s->brill_c = brill_c;
@@ -294,7 +298,7 @@ core_status dem_set_contact(dem_scene *s, const dem_contact_def *c, core_error *
         if (st != CORE_OK)
             return st;
     }
-    if (spring_before != (c->tangential == DEM_TANGENT_SPRING)) {
+    if (spring_before != dem_tangent_history(c->tangential)) {
         for (int d = 0; d < 4; d++) { /* history is meaningless under another law */
             free(s->pairs.hist[d]);
             s->pairs.hist[d] = NULL;
