@@ -10,7 +10,7 @@
 -- Each integrator runs the same initial state for `steps` steps at the default dt ("auto":
 -- contact time of the lightest pair at the fastest speed / 50), fixed for the whole run (one
 -- s:run call; the energy is sampled by on_step). Reported: max over the run of |E(t) - E(0)|/E(0).
---   velocity_verlet  (default)           check: drift <= 1e-4 over 1e5 steps (the issue's figure).
+--   velocity_verlet  (default)           check: drift <= 1e-4 over 1e5 steps.
 --   position_verlet  (Padbidri Eq. 1.6)  its velocities are the backward differences, half a step
 --                    behind the positions, so the measured energy mixes two times: during
 --                    contacts this shows up as an apparent drift of O(dt) that is not a drift of
