@@ -112,7 +112,7 @@ grainlab.report{
     wall_s = wall,
   },
   checks = {
-    -- The issue's figure: velocity Verlet at the automatic dt keeps the total energy of an
+    -- Velocity Verlet at the automatic dt keeps the total energy of an
     -- elastic, frictionless gas to 1e-4 relative over 1e5 steps (measured ~1e-5 at n = 1000).
     { name = "energy_drift_velocity_verlet", value = vv.drift, limit = 1e-4 },
   },

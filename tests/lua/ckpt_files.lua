@@ -1,4 +1,4 @@
--- Byte-level helpers the checkpoint tests share: read and write a file whole, and forge files a
+-- Byte-level functions the checkpoint tests share: read and write a file whole, and forge files a
 -- real writer could have produced (the container's FNV-1a 64 checksum recomputed over a changed
 -- body, so that a changed field reaches the checks behind the checksum).
 local M = {}
