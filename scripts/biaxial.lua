@@ -1,4 +1,4 @@
--- grainlab issue 7: biaxial compression under three boundary conditions (Padbidri Ch. 3,
+-- grainlab DEM: biaxial compression under three boundary conditions (Padbidri Ch. 3,
 -- dem-network-cell-framework.txt Sec. 3.2-3.4, Table 3.1), on the Delaunay-cell continuum.
 --
 -- Sample (Sec. 3.3, grainlab.biax.prepared, cached in out/biax_<n>_<seed>.lua): Jodrey-Tory

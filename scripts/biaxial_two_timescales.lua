@@ -1,4 +1,4 @@
--- grainlab issue 7: Padbidri's two-timescales comparison (Sec. 2.4-2.6, Table 2.1) rerun on the
+-- grainlab DEM: Padbidri's two-timescales comparison (Sec. 2.4-2.6, Table 2.1) rerun on the
 -- biaxial sample of scripts/biaxial.lua (grainlab.biax: Jodrey-Tory deposit, 100 kPa on the
 -- Delaunay boundary, Table 3.1 materials) under the direct-pressure boundary condition (rigid
 -- plates + pressure on the lateral Delaunay edges), as in the paper's Ch. 2.

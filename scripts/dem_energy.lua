@@ -10,7 +10,7 @@
 -- Each integrator runs the same initial state for `steps` steps at the default dt ("auto":
 -- contact time of the lightest pair at the fastest speed / 50), fixed for the whole run (one
 -- s:run call; the energy is sampled by on_step). Reported: max over the run of |E(t) - E(0)|/E(0).
---   velocity_verlet  (default)           check: drift <= 1e-4 over 1e5 steps (the issue's figure).
+--   velocity_verlet  (default)           check: drift <= 1e-4 over 1e5 steps.
 --   position_verlet  (Padbidri Eq. 1.6)  its velocities are the backward differences, half a step
 --                    behind the positions, so the measured energy mixes two times: during
 --                    contacts this shows up as an apparent drift of O(dt) that is not a drift of
@@ -112,7 +112,7 @@ grainlab.report{
     wall_s = wall,
   },
   checks = {
-    -- The issue's figure: velocity Verlet at the automatic dt keeps the total energy of an
+    -- Velocity Verlet at the automatic dt keeps the total energy of an
     -- elastic, frictionless gas to 1e-4 relative over 1e5 steps (measured ~1e-5 at n = 1000).
     { name = "energy_drift_velocity_verlet", value = vv.drift, limit = 1e-4 },
   },

@@ -4,11 +4,11 @@
 -- gate that holds it is removed, and the column slumps and spreads along the floor until it
 -- comes to rest (the 2D column collapse of Lube et al. 2005 and Lajeunesse et al. 2005). The
 -- script writes frames coloured by grain, a force-chain frame, a speed frame with a colour bar
--- and two plots into images/ (README.md shows them), 156 frames for a movie into out/frames/
--- (800 px, one per 5 ms), the time series of the collapse as out/demo_series.csv (param `csv`),
--- and one report. Only the default run publishes into images/; a run
--- with any other n, seed, aspect, young, mu, frame_dt or width writes those images into out/
--- (grainlab.figures).
+-- and two plots into images/ (README.md shows them), frames for a movie into out/frames/ (800 px,
+-- one per 5 ms from the gate's opening to rest; the report's metric movie_frames counts them),
+-- the time series of the collapse as out/demo_series.csv (param `csv`), and one report. Only the
+-- default run publishes into images/; a run with any other n, seed, aspect, young, mu, frame_dt
+-- or width writes those images into out/ (grainlab.figures).
 --
 -- Choices and why:
 --  * Grains: n disks (default 1500), radii uniform in [0.5, 1] mm, density 2650 kg/m^3,

@@ -1,4 +1,4 @@
--- Haff's law by DSMC (issue 6, validation 2): homogeneous cooling of a granular gas for
+-- grainlab DSMC: Haff's law, the homogeneous cooling of a granular gas for
 -- e in {0.5, 0.8, 0.95}, in 2D and 3D, in a periodic box.
 --
 -- Kinetic theory (re-derived here, VALIDATION.md "Granular gas"): sigma = 2R, n = (N - 1)/V,

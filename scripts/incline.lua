@@ -24,6 +24,8 @@
 -- params: T (run time, s; default 1), shape ('linear' | 'bspline'), wall_gap (the friction
 -- wall's gap test, cells; default the scene's), quick=true (skip the rotated-plane runs),
 -- out (image prefix, default images/incline for the default run, out/incline for any other).
+--   grainlab scripts/incline.lua [T=1] [shape=linear|bspline] [wall_gap=0.02] [quick=true]
+--       [out=out/incline]
 local T = tonumber(params.T or 1)
 local shape = params.shape or "linear"
 local wall_gap = params.wall_gap and tonumber(params.wall_gap) or nil

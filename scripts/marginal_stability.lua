@@ -23,7 +23,7 @@
 -- Checks: theta_m > theta_r for every mu (means over the packings); both in (0, 45) deg; both
 -- rise over the mu range; every tilt found its avalanche; every pile at rest when fitted.
 --
--- Measured (default run, n = 1000, 2 packings per mu, 2026-11-26; mean of the 2):
+-- Measured (default run, n = 1000, 2 packings per mu; mean of the 2):
 --     mu     theta_m (sd)     theta_r (sd)
 --     0.05   14.27 (0.43)      9.99 (1.72)
 --     0.10   17.36 (1.00)     12.35 (1.56)

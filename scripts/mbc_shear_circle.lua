@@ -1,4 +1,4 @@
--- grainlab issue 7: the minimal boundary conditions impose any strain-rate tensor on any cell
+-- grainlab DEM: the minimal boundary conditions impose any strain-rate tensor on any cell
 -- shape (Padbidri Sec. 3.2, Fig. 3.4: a circular assembly after 20% shear strain).
 -- A circular sample (grainlab.biax.prepared{ shape = "circle" }, Table 3.1 materials, 100 kPa on
 -- the Delaunay boundary) is sheared by the MBC penalty alone, target strain rate E_xy = E_yx =

@@ -14,7 +14,7 @@
 -- Checks: theta_r rises with mu_r over the range and reaches 30 deg (real sand's 30-35) at some
 -- mu_r; theta_m >= theta_r at every mu_r; all angles in (0, 50) deg; the piles at rest.
 --
--- Measured (default run, 2026-11-26, box aspect 1, one packing per mu_r): theta_r = 21.0, 27.0,
+-- Measured (default run, box aspect 1, one packing per mu_r): theta_r = 21.0, 27.0,
 -- 28.2, 29.4, 36.5 deg and theta_m = 32.8, 38.2, 37.2, 39.8, 44.1 deg for mu_r = 0, 0.1, 0.2,
 -- 0.3, 0.5: real sand's 30-35 deg lies between mu_r = 0.3 and 0.5. Three packings (seeds=3):
 -- theta_r = 30.6 +- 1.6 deg at mu_r = 0.3 (29.4, 30.1, 32.4) and 35.8 +- 1.9 at 0.5 (36.5, 33.7,

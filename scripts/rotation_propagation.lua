@@ -1,4 +1,4 @@
--- grainlab issue 7: how far a forced rotation propagates through a confined assembly (Padbidri
+-- grainlab DEM: how far a forced rotation propagates through a confined assembly (Padbidri
 -- Ch. 4, dem-network-cell-framework.txt Sec. 4.2-4.4, Table 4.1).
 --
 -- Sample: a circular assembly of n (2827) disks, r uniform in [0.5, 1] mm, cut from the middle

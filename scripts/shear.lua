@@ -27,6 +27,8 @@
 -- (final average shear, default 0.8), mu (0.3), cfl (0.4), seed (5), models ('both' | 'noslip'
 -- | 'friction'), out (image prefix, default images/shear for the default run, out/shear for
 -- any other).
+--   grainlab scripts/shear.lua [scale=1] [shear=0.8] [mu=0.3] [cfl=0.4] [seed=5]
+--       [models=both|noslip|friction] [out=out/shear]
 local scale = tonumber(params.scale or 1)
 local shear_end = tonumber(params.shear or 0.8)
 local mu = tonumber(params.mu or 0.3)

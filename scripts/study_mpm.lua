@@ -12,7 +12,8 @@
 -- displacement amplitude of 1.7 cells, so points cross cell edges every half period: the
 -- spread (max - min) / E0 of the total energy over 4 periods, and the energy kept at the end.
 -- Output: a table, out/study_mpm.csv (csv=), images/study_mpm.png (png=): |error| against CPU
--- time, one line per knob.
+-- time, one line per knob (the figure goes to images/ from the default T only, else to out/).
+--   grainlab scripts/study_mpm.lua [T=1] [csv=out/study_mpm.csv] [png=images/study_mpm.png]
 local csv_path = params.csv or "out/study_mpm.csv"
 local T = tonumber(params.T or 1)
 -- images/ only from the default study; a shorter run writes to out/ (grainlab.figures).

@@ -1,4 +1,4 @@
--- A vibrated granular bed by DSMC (issue 6, validation 3): disks under gravity in a box periodic
+-- grainlab DSMC: a vibrated granular bed of disks under gravity in a box periodic
 -- in x, driven by a bottom wall oscillating sinusoidally (amplitude A, frequency f), a specular lid
 -- high above. The wall injects energy at the bottom; collisions (e < 1) dissipate it on the way
 -- up, so the granular temperature falls with height through the bed, while the density falls

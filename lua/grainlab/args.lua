@@ -26,8 +26,9 @@ local function describe(v)
 end
 args.describe = describe
 
--- The error is raised at the user's call: the first frame above the grainlab.* Lua modules
--- (so helpers may nest freely), and above the C functions they call (xpcall in grainlab.entry).
+-- The error is raised at the user's call: the first frame above the grainlab.* Lua modules (so
+-- the library's functions may call each other freely), and above the C functions they call
+-- (xpcall in grainlab.entry).
 -- A C caller (pcall) gets no position, as with the C bindings.
 local function library(info) return info and info.short_src:find("grainlab/[%w_]+%.lua$") end
 local function user_level()

@@ -455,7 +455,7 @@ static void set_params(lua_State *L, const cli_args *a, char *argv0)
     lua_setglobal(L, "arg");
 }
 
-/* Lets a scenario script require helpers that sit beside it. */
+/* Lets a scenario script require Lua modules that sit beside it. */
 static void add_script_dir_to_path(lua_State *L, const char *script)
 {
     const char *slash = strrchr(script, '/');

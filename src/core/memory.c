@@ -1,3 +1,4 @@
+/* The memory budget of one allocation, and arrays staggered in their blocks (see memory.h). */
 #include "core/memory.h"
 
 #include <stdlib.h>

@@ -1,4 +1,5 @@
-/* How much memory one allocation of a scene may ask for. */
+/* How much memory one allocation of a scene may ask for, and allocations staggered so that the
+ * arrays a loop walks together do not share a cache set. */
 #ifndef GRAINLAB_CORE_MEMORY_H
 #define GRAINLAB_CORE_MEMORY_H
 

@@ -1,4 +1,4 @@
-/* Small 2D/3D vector helpers for cold paths and tests; hot loops work on SoA arrays directly. */
+/* Small 2D/3D vector functions for cold paths and tests; hot loops work on SoA arrays directly. */
 #ifndef GRAINLAB_CORE_VEC_H
 #define GRAINLAB_CORE_VEC_H
 

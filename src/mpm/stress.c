@@ -85,7 +85,7 @@ static inline bool point_suspect(const check_bounds *b, double x, double y, doub
  * the trial b_e and its eigen-split; (B) the two logarithms per point; (C, lanes) the elastic
  * return, b_e and sigma, with a flag on each point a lane cannot finish (possibly plastic, or one
  * the end-of-step check must look at); (D) the flagged points, scalar, in order. Each lane does
- * material_update_zz's operations in its order through the same helpers, and IEEE arithmetic is
+ * material_update_zz's operations in its order through the same functions, and IEEE arithmetic is
  * the same per lane as scalar, so the bits are the scalar update's. (C) runs over the block's
  * runs of points of one material. A block with an inverted point takes (B)-(D) one point at a
  * time (finish_point), as material_update_zz does. With s->no_lanes, (A2)-(D) are point_scalar

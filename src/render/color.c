@@ -1,5 +1,5 @@
 /* Colour maps (viridis, lightness-linear grey), well-separated label colours, and the tick
- * helpers shared by colour bars and plots. */
+ * functions shared by colour bars and plots. */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>

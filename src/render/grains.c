@@ -1,5 +1,6 @@
-/* Frames of 2D DEM scenes: disks coloured by id, label or a scalar through a colour map,
- * rotation markers, force chains, walls, the box, a title, a stamp and a colour bar. */
+/* Frames of DEM scenes: disks (2D) or shaded spheres seen by a camera (3D), coloured by id, label
+ * or a scalar through a colour map, rotation markers, force chains, walls, the box, a title, a
+ * stamp and a colour bar. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

@@ -1,6 +1,7 @@
 /* The renderer's canvas, shared by the files of src/render/ only: a pixel canvas (origin at the
  * top-left corner, y downwards, pixel centres at +0.5) drawn by GL through three primitives —
- * anti-aliased disks, anti-aliased segments and rectangles, and FreeType text — plus tick helpers. */
+ * anti-aliased disks, anti-aliased segments and rectangles, and FreeType text — plus axis ticks
+ * and their labels. */
 #ifndef GRAINLAB_RENDER_INTERNAL_H
 #define GRAINLAB_RENDER_INTERNAL_H
 

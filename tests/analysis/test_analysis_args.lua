@@ -1,4 +1,4 @@
--- The analysis binding's contract on bad input (issue 12): every table is checked for its shape
+-- The analysis binding's contract on bad input: every table is checked for its shape
 -- (type, length, element types, finite numbers, matching lengths, ids in range and distinct)
 -- before it is indexed, and every refusal is a Lua error naming the call, the field and the
 -- value. Each case here used to crash (segfault, heap overflow) or to print lua_pushfstring's
@@ -8,7 +8,7 @@ local check = grainlab.check
 local square = { x = { 0, 1, 0, 1, 0.5 }, y = { 0, 0, 1, 1, 0.5 } }
 local nan = 0 / 0
 
--- ---- the issue's case: a square and its centre, valid input (ASan: heap-buffer-overflow) -------
+-- ---- a square and its centre, valid input (once a heap-buffer-overflow under ASan) -----------
 local m = analysis.delaunay({ x = square.x, y = square.y, radius = { 0.3, 0.3, 0.3, 0.3, 0.3 } })
 local info = m:info()
 check.eq(info.delaunay, 4, "square + centre: Delaunay triangles")

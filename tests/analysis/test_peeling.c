@@ -458,7 +458,7 @@ static void test_polygons(void **state)
     assert_true(tl.peeled > 0);
 }
 
-/* The issue's case: a square and its centre, radii 0.3 (the square's sides are long: 1 > 0.9).
+/* A square and its centre, radii 0.3 (the square's sides are long: 1 > 0.9).
  * One side triangle is peeled, then the centre is on the boundary and nothing else goes. */
 static void test_square_centre(void **state)
 {

@@ -1,7 +1,7 @@
--- Issue 7 checks on a small assembly (150 disks, Table 3.1 materials): Christoffersen stress of a
--- confined assembly at rest equals the applied pressure (2%); the minimal boundary conditions
--- hold a prescribed pure-shear strain rate (5%) with a penalty force summing to zero; the mesh
--- gives an affine strain exactly; bad input is refused with clear messages.
+-- The biaxial laboratory on a small assembly (150 disks, Table 3.1 materials): the Christoffersen
+-- stress of a confined assembly at rest equals the applied pressure (2%); the minimal boundary
+-- conditions hold a prescribed pure-shear strain rate (5%) with a penalty force summing to zero;
+-- the mesh gives an affine strain exactly; bad input is refused with clear messages.
 local check = grainlab.check
 local biax = grainlab.biax
 local c = biax.config{}

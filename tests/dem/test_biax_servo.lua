@@ -1,8 +1,8 @@
--- Issue 7, plate preload: before the biaxial compression starts, each rigid plate carries the
--- confining load p W t within 5% (grainlab.biax.start). A 300-disk sample, direct pressure and
--- membrane; the velocity servo this replaced left the top plate at 0.66 p on both. Also the
--- force-controlled wall on its own: a plate pressed onto a confined pair of disks settles on the
--- commanded force, and s:wall_servo / s:wall_force refuse bad input.
+-- The biaxial laboratory's plate preload: before the biaxial compression starts, each rigid
+-- plate carries the confining load p W t within 5% (grainlab.biax.start), on a 300-disk sample
+-- under direct pressure and under the membrane. Also the force-controlled wall on its own: a
+-- plate pressed onto a confined pair of disks settles on the commanded force, and s:wall_servo /
+-- s:wall_force refuse bad input.
 local check = grainlab.check
 local biax = grainlab.biax
 

@@ -251,8 +251,6 @@ local calls = {
 }
 fuzz.checkpoint_calls(calls, "dem", scene2, tmp .. "/state.ckpt")
 
--- Registered on dem.scene by lua_analysis.c, whose validation fixes come with the delaunay
--- helper's branch: fuzzed once that is merged.
 -- VTK output (lua_vtk.c): the files go to a scratch directory.
 local vtkdir = os.tmpname()
 os.remove(vtkdir)
@@ -262,6 +260,7 @@ calls["dem.scene:write_vtk"] = {
   args = function() return { vtkdir .. "/f.vtu", { contacts = true, walls = false } } end,
   accept = { contacts = BOOL, walls = BOOL },
 }
+-- The methods lua_analysis.c registers on dem.scene have their own fuzz test.
 local elsewhere = "boundary-condition methods of lua_analysis.c: fuzzed by test_fuzz_analysis.lua"
 local skip = { ["dem.scene:boundary"] = elsewhere, ["dem.scene:boundary_edges"] = elsewhere,
                ["dem.scene:boundary_info"] = elsewhere, ["dem.scene:spin"] = elsewhere,
@@ -273,7 +272,7 @@ fuzz.run{ modules = { dem = dem }, types = { ["dem.scene"] = scene2() }, calls =
 os.execute("rm -rf '" .. vtkdir .. "'")
 os.execute("rm -rf '" .. tmp .. "'")
 
--- Absurd sizes are refused with the limit in the message (issue 12).
+-- Absurd sizes are refused with the limit in the message.
 check.errors(function() dem.scene{ box = { { 0, 0 }, { 1e300, 1 } } } end,
   "bad field 'box' in argument #1 to 'scene' (box corners of magnitude at most 1e+100 expected", "box of 1e300 m")
 check.errors(function() scene2():add_disk{ pos = { 0.5, 0.5 }, radius = 0.6 } end,

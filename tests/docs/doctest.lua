@@ -8,6 +8,9 @@
 -- spaces), every time it prints, and at least once:
 --   print(#rec, rec:column("height")[#rec])          --> 110  0.00099937850657244
 -- (a multi-line print call carries the comment on its first line).
+-- A block whose fence is directly preceded by the line `<!-- doctest: continue -->` runs in the
+-- previous block's scratch directory and sees the files it wrote (a tutorial's second script
+-- loading the checkpoint of its first); every other block starts from an empty out/.
 --   grainlab tests/docs/doctest.lua file=README.md exe=build/grainlab [keep=true]
 -- (keep=true keeps the scratch directories)
 local file, exe = params.file, params.exe
@@ -21,7 +24,7 @@ if exe:sub(1, 1) ~= "/" and exe:find("/", 1, true) then -- relative to here; blo
 end
 
 -- Collect the blocks: a fence line ```lua opens, the next line of ``` closes.
-local blocks, open, n = {}, nil, 0
+local blocks, open, n, prev = {}, nil, 0, nil
 local fh = assert(io.open(file, "r"))
 for line in fh:lines() do
   n = n + 1
@@ -33,8 +36,14 @@ for line in fh:lines() do
       open.lines[#open.lines + 1] = line
     end
   elseif line:match("^%s*```lua%s*$") then
-    open = { line = n, lines = {} }
+    local continues = prev and prev:match("^%s*<!%-%-%s*doctest:%s*continue%s*%-%->%s*$") ~= nil
+    if continues and #blocks == 0 then
+      io.stderr:write(string.format("%s:%d: 'doctest: continue' before the first ```lua block\n", file, n))
+      os.exit(1)
+    end
+    open = { line = n, lines = {}, continues = continues }
   end
+  prev = line
 end
 fh:close()
 if open then
@@ -94,13 +103,16 @@ local function compare(dir, b, want)
   return out
 end
 
--- Scratch directory: one per block, removed afterwards (a failure prints the block's output).
+-- Scratch directory: one per block (or per run of continued blocks), removed once no later block
+-- continues in it (a failure prints the block's output).
 local base = os.tmpname()
 os.remove(base)
-local failed = 0
+local failed, dir = 0, nil
 for k, b in ipairs(blocks) do
-  local dir = string.format("%s_doc%d", base, k)
-  assert(os.execute("mkdir -p " .. quote(dir .. "/out")))
+  if not b.continues then
+    dir = string.format("%s_doc%d", base, k)
+    assert(os.execute("mkdir -p " .. quote(dir .. "/out")))
+  end
   local script = dir .. "/block.lua"
   local out = assert(io.open(script, "w"))
   out:write(table.concat(b.lines, "\n"), "\n")
@@ -130,7 +142,9 @@ for k, b in ipairs(blocks) do
     print(string.format("FAIL  %s:%d: the ```lua block starting here does not run as written:\n%s",
                         file, b.line, text))
   end
-  if params.keep then print("      scratch directory kept: " .. dir) else os.execute("rm -rf " .. quote(dir)) end
+  if not (blocks[k + 1] and blocks[k + 1].continues) then
+    if params.keep then print("      scratch directory kept: " .. dir) else os.execute("rm -rf " .. quote(dir)) end
+  end
 end
 print(string.format("%s: %d lua blocks, %d failed", file, #blocks, failed))
 if failed > 0 then os.exit(1) end

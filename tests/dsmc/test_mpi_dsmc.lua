@@ -1,4 +1,4 @@
--- DSMC distributed over MPI ranks gives the same bits as one rank (issue 14).
+-- DSMC distributed over MPI ranks gives the same bits as one rank.
 -- Four small inelastic gases: 2D with gravity, an inelastic floor and a diffuse hot ceiling
 -- (periodic sides); 2D periodic and elastic (count and momentum conserved across migrations, and
 -- a checkpoint saved under mpirun continues with the same bits); 3D with a vibrating floor and a

@@ -245,7 +245,7 @@ collectgarbage() -- the recorders write their last rows before their directory g
 os.execute("rm -rf '" .. recdir .. "'")
 if not ok then error(err, 0) end
 
--- A grainlab.material is read-only (issue 12): an assignment is refused, naming the field, and
+-- A grainlab.material is read-only: an assignment is refused, naming the field, and
 -- the value does not change -- for a field that exists as for one that does not.
 local q = grainlab.material{ density = 2650, young = 30e9 }
 check.errors(function() q.density = -5 end,

@@ -1,4 +1,4 @@
--- Helpers the checkpoint tests share: read and write a file whole, forge files a real writer
+-- Functions the checkpoint tests share: read and write a file whole, forge files a real writer
 -- could have produced (the container's FNV-1a 64 checksum recomputed over a changed body, so that
 -- a changed field reaches the checks behind the checksum), and compare two states dumped as text.
 local M = {}
