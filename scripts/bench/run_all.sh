@@ -4,10 +4,11 @@
 # (scripts/bench/table.lua). Run it from the checkout's top directory, on a machine left alone.
 #   scripts/bench/run_all.sh [quick] [out=DIR] [grainlab=build/grainlab] [page=docs/performance.md]
 #                            [readme=README.md] [table=false]
-# full (the default): the benchmarks' own sizes (about 45 minutes on 2 cores; the largest DSMC
-#   run needs 15 GiB of memory); writes the MPI scaling figure images/scaling.png.
+# full (the default): the benchmarks' own sizes (about 40 minutes on a busy 2-core machine; the
+#   largest DSMC run needs 15 GiB of memory); writes the MPI scaling figure images/scaling.png.
 # quick: the same scenes with fewer steps and repetitions, and the largest runs at a tenth of
-#   their size (about 15 minutes); the page says it was a quick run.
+#   their size (about 5 minutes); the page says it was a quick run.
+# The DEM pile they share is prepared the first time (several minutes) and kept in out/bench/.
 # table=false runs the benchmarks and leaves the docs alone (grainlab scripts/bench/table.lua
 # dir=DIR renders them later). Reports go to DIR (default out/bench/<mode>), emptied first.
 # Needs valgrind (instruction counts), mpirun (scaling) and LAMMPS's lmp (vs_lammps.sh).

@@ -181,9 +181,11 @@ bench{
              "stiffness), runs alternated; first the per-particle forces of both codes from the same " ..
              "state, as rms difference over rms force",
   scene = function(m, p)
-    return string.format("%s disks, %s → %s particle–particle contacts per particle (both codes)",
+    local g = num(m("bench_vs_lammps", "contacts_per_particle_end_grainlab"))
+    local l = num(m("bench_vs_lammps", "contacts_per_particle_end_lammps"))
+    return string.format("%s disks, %s → %s particle–particle contacts per particle (%s)",
                          count(p("bench_vs_lammps", "n")), num(m("bench_vs_lammps", "contacts_per_particle_start")),
-                         num(m("bench_vs_lammps", "contacts_per_particle_end_grainlab")))
+                         g, g == l and "both codes" or ("grainlab; LAMMPS: " .. l))
   end,
   rows = function(m)
     return {
@@ -363,7 +365,7 @@ bench{
 bench{
   name = "Shared machine", script = "contended.lua", needs = { "bench_contended" },
   measures = "each engine's step on one thread, on two fixed threads and in auto mode (the " ..
-             "default), quietly and with a busy loop on one core; ratios of particle-steps/s",
+             "default), with and without a busy loop on one core; ratios of particle-steps/s",
   scene = function(m)
     local l = m("bench_contended", "dem_load")
     local p = m("bench_contended", "mpm_load")
@@ -378,7 +380,7 @@ bench{
       rows[#rows + 1] = { e[2] .. ", one core busy: 2 fixed threads / 1 thread", "2",
                           num(m(k, e[1] .. "_contended_all_per_s") / m(k, e[1] .. "_contended_one_per_s")) }
       rows[#rows + 1] = { e[2] .. ", one core busy: auto / 1 thread", "auto", num(m(k, e[1] .. "_contended_auto_over_one")) }
-      rows[#rows + 1] = { e[2] .. ", quiet: auto / 2 fixed threads", "auto", num(m(k, e[1] .. "_quiet_auto_over_all")) }
+      rows[#rows + 1] = { e[2] .. ", no busy loop: auto / 2 fixed threads", "auto", num(m(k, e[1] .. "_quiet_auto_over_all")) }
     end
     return rows
   end,
