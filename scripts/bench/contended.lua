@@ -1,21 +1,17 @@
--- Benchmark (issue 16, "Speed on a shared machine"): each engine's step on one thread, on all
--- processors (fixed: --threads N) and in auto mode (the default: grainlab.threads("auto")), on a
--- quiet machine and with another process busy (a shell loop, `busy` of them: default 1, i.e. one
--- core of two taken).
---
--- Why: on two cores with one of them busy, a step on two threads can take several times as long
--- as on one. OpenMP's default waiting spins at each of the step's barriers (MPM: ~15 per step in
--- one parallel region; DEM: ~8 parallel loops per step; DSMC: 4), so the scheduler sees both cores
--- busy, never moves the other process off the core it shares with our second thread, and every
--- barrier waits for that thread's next time slice. Auto mode times the steps and runs them on one
--- thread while that is faster (src/core/threads.h); results do not change (every tuned step gives
--- the same bits on any count).
+-- Benchmark: each engine's step on a quiet machine and with another process busy, on one thread,
+-- on all processors (fixed: --threads N) and in auto mode (the default: grainlab.threads("auto"),
+-- which times the steps and runs them on one thread while that is faster; src/core/threads.h).
+-- The busy process is a shell loop (`busy` of them: default 1, i.e. one core of two taken). On
+-- two cores with one busy, OpenMP's spinning waits at the step's barriers keep the other process
+-- on our second thread's core, and a step on two fixed threads can take several times as long as
+-- on one; auto mode is measured against that. Results do not change with the mode (every tuned
+-- step gives the same bits on any count).
 --
 -- The scenes (prepared untimed, each measurement continuing the same run):
 --   dem  : `dem_n` disks (default 20,000) deposited in a box under gravity and settled to an rms
 --          speed below `dem_quiet` (1e-3 m/s; the pile of bench/dem_dense.lua, settled less
 --          far), Hertz + Brilliantov + Cundall-Strack, dt = 1e-7 s.
---   mpm  : the shear of bench/mpm_shear.lua (369 grains, ~74,000 points, frictional contact),
+--   mpm  : the shear of bench/mpm_shear.lua (369 grains, 74,047 points, frictional contact),
 --          `mpm_warm` warm cycles.
 --   mpm_noslip : the same with the single centre-of-mass field (noslip; not in the default list).
 --   dsmc : `dsmc_n` disks (default 10^6) of the cooling benchmark (bench/dsmc_cooling.lua).
@@ -24,9 +20,11 @@
 -- mode's first probe comes after 0.1 s, so its figure includes what it costs to find the faster
 -- count every `seconds` s (a long run pays that once).
 --   grainlab scripts/bench/contended.lua [engines=dem,mpm,dsmc] [seconds=5] [rounds=2] [busy=1]
--- Metrics: <engine>_<quiet|contended>_<one|all|auto>_per_s (particle-steps per second), the
--- ratios auto / one thread (contended: never below ~1 is the target) and auto / all (quiet: ~1),
--- the tuner's probes and steps on one thread.
+-- Report bench_contended: <engine>_<quiet|contended>_<one|all|auto>_per_s (particle-steps per
+-- second), the ratios auto / one thread and auto / all, the tuner's probes and steps on one
+-- thread, and each scene's load (<engine>_load: contacts per particle, points, collisions per
+-- particle per step).
+local bench = dofile((arg[0]:match("^(.*)/") or ".") .. "/common.lua")
 local seconds = params.seconds or 5
 local busy = math.tointeger(params.busy or 1)
 local rounds = math.tointeger(params.rounds or 2)
@@ -68,7 +66,7 @@ function scenes.dem()
   grainlab.pack.settle(s, { quiet = params.dem_quiet or 1e-3, final_steps = 200, dt_final = 1e-7 })
   local z = s:measure("coordination").z
   return function(steps) s:run{ steps = steps, dt = 1e-7, progress = false } end, n,
-         string.format("%d disks, %.2f contacts per particle", n, z)
+         string.format("%d disks, %.2f contacts per particle", n, z), { disks = n, contacts_per_particle = z }
 end
 local function mpm_shear(model)
   local L, v, cells = 1.2e-3, 100, 150
@@ -90,7 +88,8 @@ local function mpm_shear(model)
   local np = m:info().points
   return function(steps) m:run{ steps = steps, dt = dt, progress = false } end, np,
          string.format("%d points, %d grains, %s contact", np, #pk.x,
-                       model == "friction" and "frictional" or "noslip")
+                       model == "friction" and "frictional" or "noslip"),
+         { points = np, grains = #pk.x, points_per_cell = 4, contact = model }
 end
 function scenes.mpm() return mpm_shear("friction") end
 function scenes.mpm_noslip() return mpm_shear("noslip") end
@@ -104,9 +103,10 @@ function scenes.dsmc()
   s:fill{ n = n, temperature = s:info().mass * 1.0, seed = 5 }
   local dt = 0.1 / s:measure("temperature").collision_frequency
   s:run{ steps = 5, dt = dt, progress = false }
+  local cps = s:measure("stats").collisions_per_particle_per_step
   return function(steps) s:run{ steps = steps, dt = dt, progress = false } end, n,
-         string.format("%d disks, %.3f collisions per particle per step", n,
-                       s:measure("stats").collisions_per_particle_per_step)
+         string.format("%d disks, %.3f collisions per particle per step", n, cps),
+         { disks = n, collisions_per_particle_per_step = cps, particles_per_cell = n / (nc * nc) }
 end
 
 -- particle-steps per second over about `seconds` s: runs of `chunk` steps (sized from a first
@@ -129,7 +129,8 @@ local ok = true -- every rate finite and positive
 local metrics, lines = { processors = P, busy_processes = busy, seconds_per_measurement = seconds }, {}
 for _, e in ipairs(engines) do
   assert(scenes[e], "engines: dem, mpm, mpm_noslip, dsmc; got " .. e)
-  local step, n, what = scenes[e]()
+  local step, n, what, load = scenes[e]()
+  metrics[e .. "_load"] = load
   lines[#lines + 1] = string.format("%s: %s", e, what)
   for _, cond in ipairs({ "quiet", "contended" }) do
     if cond == "contended" then busy_start() end
@@ -166,7 +167,7 @@ for _, l in ipairs(lines) do io.stderr:write(l, "\n") end
 grainlab.report{
   scenario = "bench_contended",
   params = { engines = table.concat(engines, ","), seconds = seconds, rounds = rounds, busy = busy },
-  metrics = metrics,
+  metrics = bench.metrics(metrics),
   -- timings decide nothing here (a shared machine moves them by 20 % and more): they are the
   -- figures; the check is that every measurement gave a rate
   checks = { { name = "rates_finite", pass = ok } },

@@ -1,34 +1,38 @@
--- Benchmark: a dense, settled pile of 20,000 polydisperse disks (issue 3, "Performance").
---   r uniform in [0.5, 1] mm, rho = 2650 kg/m^3, E = 30 GPa, nu = 0.3, restitution 0.5 (Brilliantov
---   damping time solved per pair for e at 1 m/s), mu = 0.45, closed 0.25 m x 0.30 m box, gravity,
---   Hertz + Brilliantov + Cundall-Strack history, dt = 1e-7 s.
+-- Benchmark: DEM steps of a dense, settled pile of polydisperse disks.
+--   n disks (default 20,000), r uniform in [0.5, 1] mm, rho = 2650 kg/m^3, E = 30 GPa, nu = 0.3,
+--   restitution 0.5 (Brilliantov damping time solved per pair for e at 1 m/s), mu = 0.45, closed
+--   0.25 m x 0.30 m box, gravity, Hertz + Brilliantov + Cundall-Strack history, dt = 1e-7 s.
 -- Preparation (not timed): Jodrey-Tory style deposition (grainlab.pack.deposit, every disk resting
 -- on two supports at zero overlap), then grainlab.pack.settle at full stiffness: a background drag
 -- critical for the pile's slowest (whole-pile vertical) mode and a quasi-static dt, until the rms
 -- speed is below `quiet` m/s (or only a few creeping grains are left); then 2000 steps at the
 -- benchmark's dt without drag, which must not change the contacts. Then `steps` steps are timed
--- without drag, on 1 and 2 threads (or on `threads` only).
+-- without drag, on 1 and then 2 threads (or on `threads` only), continuing the same run.
 -- The drag holds the ~1% of grains that sit in frictionally unstable spots of the geometric
 -- packing at a creep (~1e-3 m/s); without drag they fail, in small cascades, over ~0.3 s. That
 -- leaves the contacts alone over the timed steps (20,000 disks: z changes by ~4e-4 relative), but
 -- `collapse` = t lets them fail first (pack.settle's collapse option: weak drag, at most t s of
 -- simulated time) for a truly static pile (v_max ~1e-4 m/s): ~0.1 min for 2,000 disks (the
 -- default up to 5,000), ~6 min on 1 thread for 20,000.
--- The preparation runs on prep_threads threads (default 1: on a shared, loaded machine two
--- OpenMP threads can make it many times slower).
+-- The preparation runs on prep_threads threads (default 1).
 --   grainlab scripts/bench/dem_dense.lua [n=20000] [steps=20000] [threads=N] [quiet=1e-5]
 --                                        [collapse=0|0.5] [prep_threads=1] [verbose=1]
+--   grainlab scripts/bench/dem_dense.lua n=20000 export=out/pile.data
+--       prepares the pile and stops before timing; writes it as a LAMMPS data file (atom type 1 =
+--       quartz, velocities included) and as a grainlab checkpoint PATH.ckpt (the same state with
+--       its walls: a settled pile touches its walls, which add_wall would refuse on a re-read).
+--       vs_lammps.sh and scaling.lua run that same pile.
+--   grainlab scripts/bench/dem_dense.lua pile=out/pile.data.ckpt [steps=...]
+--       times the exported pile as it is (no preparation; the checkpoint keeps the pile's laws
+--       and spring histories).
 --   valgrind --tool=callgrind --instr-atstart=no grainlab scripts/bench/dem_dense.lua \
---       steps=200 threads=1 callgrind=true   (instructions per particle-step: total / (n steps))
---   valgrind --tool=callgrind --instr-atstart=no grainlab scripts/bench/dem_dense.lua \
---       pile=out/pile.data.ckpt steps=50 threads=1 callgrind=true
---       the same on a pile prepared once by export= (below): preparing 20,000 disks under
---       callgrind takes hours. The checkpoint keeps the pile's laws and spring histories.
---   grainlab scripts/bench/dem_dense.lua n=2000 export=out/pile.data
---       writes the prepared pile as a LAMMPS data file (atom type 1 = quartz, velocities included)
---       and as a grainlab checkpoint PATH.ckpt (the same state with its walls: a settled pile
---       touches its walls, which add_wall would refuse on a re-read), and stops before timing: scripts/bench/vs_lammps.sh runs that same pile in both codes.
--- Metrics: particle_steps_per_s (per thread count), wall_s, contacts_per_particle.
+--       pile=out/pile.data.ckpt steps=50 callgrind=true
+--       counts the instructions of the timed steps on one thread (callgrind=PATTERN when valgrind
+--       was given --callgrind-out-file=PATTERN).
+-- Report bench_dem_dense: particle_steps_per_s_<k>_threads, wall_s_<k>_threads,
+-- contacts_per_particle (before the timed steps) and contacts_per_particle_after; under
+-- callgrind, bench_dem_dense_callgrind: instructions_per_particle_step.
+local bench = dofile((arg[0]:match("^(.*)/") or ".") .. "/common.lua")
 local n = params.n or 20000
 local steps = params.steps or 20000
 local quiet = params.quiet or 1e-5
@@ -87,17 +91,20 @@ if params.export and not params.pile then
   return
 end
 
--- callgrind=true: run under `valgrind --tool=callgrind --instr-atstart=no`; instrumentation is
--- switched on for the timed steps only, so the profile's total / (n * steps) is the instruction
--- count per particle-step (stable on a busy machine, unlike wall time).
-local callgrind = params.callgrind == true
+-- Under callgrind, collection is on for the timed steps alone, so the count divided by
+-- n * steps is the instructions per particle-step (which a busy machine does not move).
+local callgrind = params.callgrind
+local instructions
 local function timed(threads)
   grainlab.threads(threads)
-  if callgrind then os.execute("callgrind_control -i on $PPID >/dev/null") end
   local c0, w0 = grainlab.cpu_clock(), grainlab.clock()
-  s:run{ steps = steps, dt = dt, progress = false }
+  if callgrind then
+    instructions = bench.instructions(function() s:run{ steps = steps, dt = dt, progress = false } end,
+                                      callgrind)
+  else
+    s:run{ steps = steps, dt = dt, progress = false }
+  end
   local wall = grainlab.clock() - w0
-  if callgrind then os.execute("callgrind_control -i off $PPID >/dev/null") end
   return n * steps / wall, wall, grainlab.cpu_clock() - c0
 end
 
@@ -106,7 +113,7 @@ local metrics = { dt_s = dt, disks = n, steps = steps, damping_time_s = T,
                   prepare_s = t_prep, relaxation_steps = settle.steps, relaxation_dt_s = settle.dt,
                   relaxation_drag_per_s = settle.drag, v_rms_prepared = settle.v_rms,
                   v_max_prepared = settle.v_max }
-local list = params.threads and { params.threads } or { 1, 2 }
+local list = callgrind and { 1 } or params.threads and { params.threads } or { 1, 2 }
 local total_wall = 0
 for _, th in ipairs(list) do
   local rate, wall = timed(th)
@@ -118,18 +125,23 @@ metrics.particle_steps_per_s = metrics["particle_steps_per_s_" .. list[#list] ..
 metrics.wall_s = total_wall
 local zf = s:measure("coordination")
 metrics.contacts_per_particle_after = zf.z
+local checks = {
+  -- The timed pile must be the quiescent one: a bouncing pile has fewer contacts, runs faster.
+  { name = "pile_quiescent_contacts", value = z.z, limit = 3.3, op = ">=" },
+  { name = "pile_quiescent_speed", value = settle.v_rms, limit = 1e-4 },
+  -- Drag off: the first drag-free steps and the timed steps leave the contacts alone.
+  { name = "pile_settled_contacts_rel", value = math.abs(z.z - settle.z_settled) / settle.z_settled, limit = 0.002 },
+  { name = "pile_stayed_settled_rel", value = math.abs(zf.z - z.z) / z.z, limit = 0.002 },
+}
+if callgrind then
+  metrics.instructions_per_particle_step = instructions and instructions / (n * steps) or 0
+  checks[#checks + 1] = { name = "instructions_counted", pass = instructions ~= nil }
+end
 
 grainlab.report{
-  scenario = "bench_dem_dense",
-  params = { n = n, steps = steps, dt = dt, threads = params.threads or "1,2", quiet = quiet,
-             collapse_s = collapse },
-  metrics = metrics,
-  checks = {
-    -- The timed pile must be the quiescent one: a bouncing pile has fewer contacts, runs faster.
-    { name = "pile_quiescent_contacts", value = z.z, limit = 3.3, op = ">=" },
-    { name = "pile_quiescent_speed", value = settle.v_rms, limit = 1e-4 },
-    -- Drag off: the first drag-free steps and the timed steps leave the contacts alone.
-    { name = "pile_settled_contacts_rel", value = math.abs(z.z - settle.z_settled) / settle.z_settled, limit = 0.002 },
-    { name = "pile_stayed_settled_rel", value = math.abs(zf.z - z.z) / z.z, limit = 0.002 },
-  },
+  scenario = callgrind and "bench_dem_dense_callgrind" or "bench_dem_dense",
+  params = { n = n, steps = steps, dt = dt, threads = callgrind and 1 or params.threads or "1,2",
+             quiet = quiet, collapse_s = collapse, pile = params.pile },
+  metrics = bench.metrics(metrics),
+  checks = checks,
 }

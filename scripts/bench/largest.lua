@@ -1,17 +1,21 @@
--- The largest runs one machine holds (issue 14, "Measurements to publish"): how many particles fit
--- in this machine's memory, what each costs, and the rate at that size.
+-- The largest runs one machine holds: how much memory each particle costs at scale, and the rate
+-- at that size.
 --   grainlab scripts/bench/largest.lua engine=dsmc [n=2e8] [steps=4]
---       Herrmann Fig. 2's gas: 2D, volume fraction nu = 0.1, e = 0.9, cells one mean free path wide
---       (lambda = 1 / (2 sqrt 2 n_A 2R chi), Enskog's chi: 0.76 particles per cell at nu = 0.1), Maxwellian at T/m = 1 m^2/s^2, periodic square, dt = a tenth of the mean collision time.
+--       Herrmann & Mueller's Fig. 2 gas (fig2_gas.lua): 2D, volume fraction nu = 0.1, e = 0.9,
+--       cells one mean free path wide (0.76 particles per cell), Maxwellian at T/m = 1 m^2/s^2,
+--       periodic square, dt = a tenth of the mean collision time.
 --   grainlab scripts/bench/largest.lua engine=dem [n=5e6] [steps=200]
 --       n disks of r = 1 mm, quartz, Hertz + Brilliantov + Cundall-Strack springs (the benchmark
 --       pile's laws), on a square lattice whose pitch is 0.2 um less than a diameter (each disk
---       presses on its four neighbours with 2e-4 r of overlap: contacts per particle start at 4,
---       the pile's is 3.6), random velocities of 0.01 m/s, periodic on both axes, no gravity.
+--       presses on its four neighbours with 2e-4 r of overlap: 4 contacts per particle), random
+--       velocities of 0.01 m/s, periodic on both axes, no gravity.
 -- Add mpirun -np K in front for a distributed run (then memory is per rank; the figures printed
 -- are rank 0's resident set and the whole run's rate).
--- Metrics: particles, bytes_per_particle (the peak resident set of the process less its size
--- before the particles were made, divided by n), particle_steps_per_s, wall_s, build_s.
+-- Report largest_<engine>: particles, bytes_per_particle (the peak resident set of the process
+-- less its size before the particles were made, divided by n), peak_resident_gib,
+-- particle_steps_per_s, wall_s, build_s, and the load: contacts_per_particle (dem) or
+-- particles_per_cell and collisions_per_particle_per_step (dsmc).
+local bench = dofile((arg[0]:match("^(.*)/") or ".") .. "/common.lua")
 local engine = params.engine or "dsmc"
 local steps = params.steps
 local n
@@ -34,8 +38,10 @@ if engine == "dsmc" then
   local nc
   s, nc = fig2_gas(n)
   run_def = { steps = steps, dt = 0.1 / s:measure("temperature").collision_frequency, progress = false }
-  extra = function()
+  extra = function(metrics)
     local st = s:measure("stats")
+    metrics.particles_per_cell = n / (nc * nc)
+    metrics.collisions_per_particle_per_step = st.collisions_per_particle_per_step
     return string.format("%.2f particles per cell, collisions per particle per step %.4f", n / (nc * nc),
                          st.collisions_per_particle_per_step)
   end
@@ -66,8 +72,9 @@ elseif engine == "dem" then
     end
   end
   run_def = { steps = steps, dt = 1e-7, progress = false }
-  extra = function()
-    return string.format("contacts per particle %.3f", s:measure("coordination").z)
+  extra = function(metrics)
+    metrics.contacts_per_particle = s:measure("coordination").z
+    return string.format("contacts per particle %.3f", metrics.contacts_per_particle)
   end
 else
   error("largest.lua: engine must be 'dsmc' or 'dem', got " .. tostring(engine))
@@ -78,11 +85,15 @@ s:run(run_def)
 local wall = grainlab.clock() - w0
 local peak = rss_kib("VmHWM")
 local bpp = (peak - base) * 1024 / n
+local metrics = { particles = n, bytes_per_particle = bpp, peak_resident_gib = peak / 1048576,
+                  particle_steps_per_s = n * steps / wall, wall_s = wall, build_s = build_s,
+                  steps = steps, threads = select(1, grainlab.threads()) }
+local load = extra(metrics)
 print(string.format("%s: %d particles, %.0f bytes per particle (peak resident %.2f GiB), built in %.1f s; " ..
                     "%d steps in %.1f s: %.3g particle-steps/s; %s", engine, n, bpp, peak / 1048576,
-                    build_s, steps, wall, n * steps / wall, extra()))
+                    build_s, steps, wall, n * steps / wall, load))
 grainlab.report{
   scenario = "largest_" .. engine,
-  metrics = { particles = n, bytes_per_particle = bpp, particle_steps_per_s = n * steps / wall,
-              wall_s = wall, build_s = build_s, steps = steps },
+  params = { engine = engine, n = n, steps = steps },
+  metrics = bench.metrics(metrics),
 }

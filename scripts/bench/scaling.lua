@@ -1,17 +1,18 @@
--- Strong scaling over MPI ranks and a communication model projected to Herrmann & Mueller's 512
--- processors (issue 14; the paper's Figs. 1 and 2).
+-- Strong scaling over MPI ranks, and a communication model projected to Herrmann & Mueller's 512
+-- processors (the paper's Figs. 1 and 2).
 --
 --   grainlab scripts/bench/scaling.lua [engines=dem,dsmc] [reps=3] [dem_n=20000] [dem_steps=2000]
---                                      [dsmc_n=500000] [dsmc_steps=40] [out=DIR]
+--                                      [dsmc_n=500000] [dsmc_steps=40] [pile=PATH.ckpt] [out=DIR]
 --
 -- Cases, each run alternately (1 rank, 2 ranks, 1 rank on 2 threads, …) `reps` times; medians:
 --   dem   scripts/bench/dem_dense.lua's pile of dem_n disks (prepared once by that script's
---         export=, which leaves a checkpoint: the same state for every run), its laws (Hertz,
---         Brilliantov per pair, Cundall-Strack springs), dt = 1e-7 s, 200 warm-up steps (the
---         decomposition and the first rebuilds) then dem_steps timed.
---   dsmc  Fig. 2's gas: dsmc_n disks, 2D, volume fraction 0.1, e = 0.9, cells one mean free path
---         wide (0.76 particles per cell), Maxwellian at T/m = 1 m^2/s^2, periodic square,
---         dt = a tenth of the mean collision time; 5 warm-up steps, dsmc_steps timed.
+--         export=, which leaves a checkpoint: the same state for every run; pile= names one
+--         already made), its laws (Hertz, Brilliantov per pair, Cundall-Strack springs),
+--         dt = 1e-7 s, 200 warm-up steps (the decomposition and the first rebuilds) then
+--         dem_steps timed.
+--   dsmc  Fig. 2's gas (fig2_gas.lua): dsmc_n disks, 2D, volume fraction 0.1, e = 0.9, cells one
+--         mean free path wide (0.76 particles per cell), Maxwellian at T/m = 1 m^2/s^2, periodic
+--         square, dt = a tenth of the mean collision time; 5 warm-up steps, dsmc_steps timed.
 -- Traffic: every rank's bytes and messages per step and seconds inside communication per step
 -- (grainlab.mpi.stats over the timed steps), at 2 ranks and, as counts only (oversubscribed: their
 -- times mean nothing on 2 cores), at 4 ranks.
@@ -35,8 +36,12 @@
 -- labelled as such, an assumed cluster network (alpha = 1.5 us, beta = 0.1 ns/B: 10 GB/s). The
 -- figure plots the measured speed-ups, the ideal line and the projections (labelled so).
 --
--- Not a test: it times things. Writes scaling.png and scaling.md into images/ for the full run
--- (the defaults), into out/ otherwise.
+-- Report bench_scaling: per engine, <engine>_rate_1_rank, _rate_2_ranks, _rate_2_threads
+-- (particle-steps per second), _efficiency_2_ranks, _ranks_over_threads, traffic, the model's
+-- terms and _speedup_512 (this machine's network) and _speedup_512_cluster; alpha_s, beta_s_per_byte.
+-- Writes scaling.png into images/ for the full run (the defaults), into out/ otherwise, and prints
+-- the measured table.
+local bench = dofile((arg[0]:match("^(.*)/") or ".") .. "/common.lua")
 local figures = require("grainlab.figures")
 local mpi = grainlab.mpi
 
@@ -45,6 +50,7 @@ local P = {
   dem_n = params.dem_n or 20000, dem_steps = params.dem_steps or 2000,
   dsmc_n = params.dsmc_n or 500000, dsmc_steps = params.dsmc_steps or 40,
 }
+local metrics = {}
 
 -- ---- the cases (run by the driver below, under mpirun or not) --------------------------------
 local function result(t)
@@ -86,21 +92,23 @@ local function case_dem()
   local d = s:info().distributed or {}
   result{ n = n, steps = params.steps, wall = wall, rate = n * params.steps / wall, bytes = bytes,
           messages = msgs, comm_s = secs, rebuilds = d.rebuilds or 0,
-          imbalance = d.owned_max and d.owned_max / (n / mpi.size()) or 1 }
+          imbalance = d.owned_max and d.owned_max / (n / mpi.size()) or 1,
+          z = s:measure("coordination").z }
 end
 
 local fig2_scene = dofile((arg[0]:match("^(.*)/") or ".") .. "/fig2_gas.lua")
 
 local function case_dsmc()
   local n = params.n
-  local s = fig2_scene(n)
+  local s, nc = fig2_scene(n)
   local dt = 0.1 / s:measure("temperature").collision_frequency
   -- warn = false: at nu = 0.1 a cell one mean free path wide holds 0.7 particles, below the
   -- validity check's few per cell (the paper's case; the run is timed, not validated)
   s:run{ steps = 5, dt = dt, progress = false, warn = false }
   local wall, bytes, msgs, secs = timed(s, { steps = params.steps, dt = dt, progress = false, warn = false })
   result{ n = n, steps = params.steps, wall = wall, rate = n * params.steps / wall, bytes = bytes,
-          messages = msgs, comm_s = secs }
+          messages = msgs, comm_s = secs, per_cell = n / (nc * nc),
+          collisions = s:measure("stats").collisions_per_particle_per_step }
 end
 
 local function case_pingpong()
@@ -185,11 +193,15 @@ local rows, curves = {}, {}
 for _, eng in ipairs(engines) do
   local args
   if eng == "dem" then
-    local data = string.format("%s/pile%d.data", work, P.dem_n)
-    if not io.open(data .. ".ckpt") then
-      assert(os.execute(string.format("%s scripts/bench/dem_dense.lua n=%d export=%s", exe, P.dem_n, data)))
+    local ckpt = params.pile
+    if not ckpt then
+      local data = string.format("%s/pile%d.data", work, P.dem_n)
+      ckpt = data .. ".ckpt"
+      if not io.open(ckpt) then
+        assert(os.execute(string.format("%s scripts/bench/dem_dense.lua n=%d export=%s", exe, P.dem_n, data)))
+      end
     end
-    args = string.format("case=dem ckpt=%s steps=%d", data .. ".ckpt", P.dem_steps)
+    args = string.format("case=dem ckpt=%s steps=%d", ckpt, P.dem_steps)
   elseif eng == "dsmc" then
     args = string.format("case=dsmc n=%d steps=%d", P.dsmc_n, P.dsmc_steps)
   else
@@ -250,6 +262,31 @@ for _, eng in ipairs(engines) do
     proj_sm[#proj_sm + 1] = t_of(1, nproj, alpha, beta) / t_of(p, nproj, alpha, beta)
     proj_cl[#proj_cl + 1] = t_of(1, nproj, 1.5e-6, 1e-10) / t_of(p, nproj, 1.5e-6, 1e-10)
   end
+  local pre = eng .. "_"
+  metrics[pre .. "particles"] = N
+  metrics[pre .. "rate_1_rank"] = r1
+  metrics[pre .. "rate_2_ranks"] = r2
+  metrics[pre .. "rate_2_threads"] = rt
+  metrics[pre .. "efficiency_2_ranks"] = r2 / r1 / 2
+  metrics[pre .. "ranks_over_threads"] = r2 / rt
+  metrics[pre .. "bytes_per_step_2_ranks"] = b2
+  metrics[pre .. "bytes_per_step_4_ranks"] = b4
+  metrics[pre .. "messages_per_step_2_ranks"] = m2
+  metrics[pre .. "messages_per_step_4_ranks"] = m4
+  metrics[pre .. "step_2_ranks_s"] = t2
+  metrics[pre .. "step_2_ranks_model_s"] = model2
+  metrics[pre .. "comm_s_per_step"] = c2
+  metrics[pre .. "eps"] = eps
+  metrics[pre .. "speedup_512"] = proj_sm[#proj_sm]
+  metrics[pre .. "speedup_512_cluster"] = proj_cl[#proj_cl]
+  metrics[pre .. "projection_n"] = nproj
+  metrics[pre .. "load_min"] = math.min(table.unpack(loads))
+  metrics[pre .. "load_max"] = math.max(table.unpack(loads))
+  if eng == "dem" then metrics[pre .. "contacts_per_particle"] = runs[1][1].z end
+  if eng == "dsmc" then
+    metrics[pre .. "particles_per_cell"] = runs[1][1].per_cell
+    metrics[pre .. "collisions_per_particle_per_step"] = runs[1][1].collisions
+  end
   curves[#curves + 1] = { eng = eng, ps = ps, proj_sm = proj_sm, proj_cl = proj_cl, n = nproj,
                           meas_p = { 1, 2 }, meas_s = { 1, r2 / r1 }, s512_cl = proj_cl[#proj_cl],
                           s512_sm = proj_sm[#proj_sm] }
@@ -267,11 +304,7 @@ for _, c in ipairs(curves) do
   md[#md + 1] = string.format("projection, %s, N = %d: speed-up at 512 ranks %.0f (this machine's alpha, beta), %.0f (cluster network, assumed)",
                               c.eng, c.n, c.s512_sm, c.s512_cl)
 end
-local text = table.concat(md, "\n")
-print(text)
-local f = assert(io.open(dir .. "/scaling.md", "w"))
-f:write(text, "\n")
-f:close()
+print(table.concat(md, "\n"))
 
 local series = {}
 local ideal_x, ideal_y = {}, {}
@@ -284,4 +317,12 @@ for _, c in ipairs(curves) do
 end
 render.plot{ file = dir .. "/scaling.png", title = "Speed-up over MPI ranks: measured (1-2 ranks) and projected (model)",
              xlabel = "ranks", ylabel = "speed-up", xlog = true, ylog = true, series = series }
-print("wrote " .. dir .. "/scaling.png and scaling.md")
+print("wrote " .. dir .. "/scaling.png")
+metrics.alpha_s = alpha
+metrics.beta_s_per_byte = beta
+grainlab.report{
+  scenario = "bench_scaling",
+  params = { engines = P.engines, reps = P.reps, dem_n = P.dem_n, dem_steps = P.dem_steps,
+             dsmc_n = P.dsmc_n, dsmc_steps = P.dsmc_steps },
+  metrics = bench.metrics(metrics),
+}

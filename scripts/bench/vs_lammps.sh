@@ -1,8 +1,9 @@
 #!/bin/sh
-# grainlab against LAMMPS on the same input, in one run (issue 13).
+# grainlab against LAMMPS on the same DEM pile with the same laws: forces compared, then timed.
 #
 # 1. scripts/bench/dem_dense.lua n=N export=... prepares the benchmark pile (deposition + settle,
-#    the same as the benchmark's) and writes it as a LAMMPS data file (atom_style sphere, 2D).
+#    the same as the benchmark's) and writes it as a LAMMPS data file (atom_style sphere, 2D);
+#    pile=PATH.data uses a pile exported before (PATH.data and PATH.data.ckpt).
 # 2. Both codes start from that state (grainlab from the checkpoint written with the data file,
 #    bit for bit the same; LAMMPS from read_data) with every tangential spring at zero, and the
 #    per-particle forces are compared (grainlab: s:particles().fx/fy; LAMMPS: dump fx fy):
@@ -19,21 +20,28 @@
 #                `tangential mindlin 4/7 E*` (k_t a, the same stiffness for every contact).
 # 3. Timing: the same pile and laws (grainlab: the benchmark's per-pair Brilliantov damping;
 #    LAMMPS: viscoelastic at the mean pair; mindlin tangential in both), `steps` steps at
-#    dt = 1e-7 s; grainlab on 1 and 2 threads, LAMMPS on 1 and `mpirun -np 2`, runs alternated
-#    (A B A B ..., `reps` each), the 1-minute load average recorded with every run. Contacts per
+#    dt = 1e-7 s; grainlab on 1 and 2 threads, LAMMPS on 1 and `mpirun -np 2` (its two ranks
+#    balanced), the two codes' runs alternated (grainlab, LAMMPS, grainlab, ..., `reps` each), the
+#    1-minute load average and the hypervisor's steal time recorded with every run. Contacts per
 #    particle count particle-particle contacts only (compute contact/atom ignores wall/gran).
 #
-#   scripts/bench/vs_lammps.sh [n=2000] [steps=2000] [reps=3] [grainlab=build/grainlab] [out=out/vs_lammps]
+#   scripts/bench/vs_lammps.sh [n=20000] [steps=2000] [reps=3] [pile=PATH.data]
+#                              [grainlab=build/grainlab] [out=out/vs_lammps] [report=FILE.json]
 #
-# Not part of the test suite: it needs Debian's LAMMPS (`apt-get install lammps openmpi-bin`).
-# Prints a Markdown table (particle-steps/s, contacts per particle, load) at the end.
+# Needs Debian's LAMMPS (`apt-get install lammps openmpi-bin`). Prints the force comparison and a
+# Markdown table of the medians (particle-steps/s, contacts per particle, load, steal); report=
+# writes them as the report bench_vs_lammps (scripts/bench/shell_report.lua).
 set -eu
-N=2000 STEPS=2000 REPS=3 GL=build/grainlab OUT=out/vs_lammps
+GRAINLAB_BENCH_START="$(cut -d' ' -f1 /proc/loadavg) $(awk '/^cpu / { print $2 + $3 + $4 + $5 + $6 + $7 + $8 + $9, $9 }' /proc/stat)"
+GRAINLAB_BENCH_COMMAND="scripts/bench/vs_lammps.sh $*"
+export GRAINLAB_BENCH_START GRAINLAB_BENCH_COMMAND
+N=20000 STEPS=2000 REPS=3 GL=build/grainlab OUT=out/vs_lammps PILE= REPORT=
 for a in "$@"; do
   case $a in
     n=*) N=${a#n=} ;; steps=*) STEPS=${a#steps=} ;; reps=*) REPS=${a#reps=} ;;
-    grainlab=*) GL=${a#grainlab=} ;; out=*) OUT=${a#out=} ;;
-    *) echo "vs_lammps.sh: unknown argument '$a' (n=, steps=, reps=, grainlab=, out=)" >&2; exit 2 ;;
+    grainlab=*) GL=${a#grainlab=} ;; out=*) OUT=${a#out=} ;; pile=*) PILE=${a#pile=} ;;
+    report=*) REPORT=${a#report=} ;;
+    *) echo "vs_lammps.sh: unknown argument '$a' (n=, steps=, reps=, pile=, grainlab=, out=, report=)" >&2; exit 2 ;;
   esac
 done
 LMP=$(command -v lmp || command -v lmp_serial || command -v lmp_mpi || true)
@@ -41,15 +49,22 @@ if [ -z "$LMP" ]; then
   echo "vs_lammps.sh: LAMMPS not found: apt-get install lammps openmpi-bin" >&2; exit 1
 fi
 [ -x "$GL" ] || { echo "vs_lammps.sh: no grainlab at $GL (build first, or grainlab=PATH)" >&2; exit 1; }
-# grainlab runs with its default wait policy (OpenMP spins briefly at barriers): a passive policy
-# put its threads to sleep at each of the step's barriers and cost 40 % on 2 threads (1.1e7 against
-# 1.8e7 particle-steps/s on the 20,000-disk pile).
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 mkdir -p "$OUT"
-DATA=$OUT/pile$N.data
-if [ ! -s "$DATA" ] || [ ! -s "$DATA.ckpt" ]; then
-  "$GL" scripts/bench/dem_dense.lua n="$N" export="$DATA"
+FIG=$OUT/figures.txt
+: > "$FIG"
+if [ -n "$PILE" ]; then
+  DATA=$PILE
+  [ -s "$DATA" ] && [ -s "$DATA.ckpt" ] || { echo "vs_lammps.sh: no pile $DATA (and $DATA.ckpt)" >&2; exit 1; }
+  N=$(awk '$2 == "atoms" { print $1; exit }' "$DATA")
+else
+  DATA=$OUT/pile$N.data
+  if [ ! -s "$DATA" ] || [ ! -s "$DATA.ckpt" ]; then
+    "$GL" scripts/bench/dem_dense.lua n="$N" export="$DATA"
+  fi
 fi
+echo "param n $N" >> "$FIG"; echo "param steps $STEPS" >> "$FIG"; echo "param reps $REPS" >> "$FIG"
+echo "metric lammps_version $("$LMP" -h 2>/dev/null | awk -F' - ' '/^Large-scale Atomic/ { print $2 ($3 ? ", " $3 : ""); exit }')" >> "$FIG"
 
 # ---- the grainlab side ------------------------------------------------------------------------
 cat > "$OUT/grainlab_side.lua" <<'LUA'
@@ -159,13 +174,15 @@ dump_modify f sort id format float %.17g
 run ${4:-0}" > "$OUT/in.forces_$1"
   "$LMP" -in "$OUT/in.forces_$1" -log "$OUT/log.forces_$1" -screen none
   "$GL" "$OUT/grainlab_side.lua" mode=forces law="$1" T="$T" steps="${4:-0}" data="$DATA" forces="$OUT/grainlab_$1.txt"
-  awk -v law="$1" 'NR == FNR { gx[$1] = $2; gy[$1] = $3; w[$1] = $4; next }
+  awk -v law="$1" -v fig="$FIG" 'NR == FNR { gx[$1] = $2; gy[$1] = $3; w[$1] = $4; next }
     /^ITEM: TIMESTEP/ { getline ts; on = 0 } /^ITEM: ATOMS/ { on = ts == '"${4:-0}"'; next } /^ITEM/ { on = 0 }
     on { dx = $2 - gx[$1]; dy = $3 - gy[$1]; d = sqrt(dx*dx + dy*dy); m = sqrt($2*$2 + $3*$3)
          if (d > dmax) dmax = d; if (m > fmax) fmax = m; if (d / w[$1] > rmax) { rmax = d / w[$1]; worst = $1 }
          s2 += d * d; f2 += m * m; n++ }
     END { printf "%-8s %d particles: max |f_lammps - f_grainlab| = %.3g N (largest net force %.3g N); rms |df| / rms |f| = %.3g; worst particle %d: |df| = %.3g of its weight\n",
-          law, n, dmax, fmax, sqrt(s2 / f2), worst, rmax }' "$OUT/grainlab_$1.txt" "$OUT/lammps_$1.dump"
+          law, n, dmax, fmax, sqrt(s2 / f2), worst, rmax
+          printf "metric forces_%s_rms_rel %.4g\nmetric forces_%s_worst_of_weight %.4g\n", law, sqrt(s2 / f2), law, rmax >> fig }' \
+    "$OUT/grainlab_$1.txt" "$OUT/lammps_$1.dump"
 }
 compare elastic 0 velocity
 compare damped "$ETA" viscoelastic
@@ -175,14 +192,14 @@ compare springs 0 velocity 100
 # LAMMPS: the "Loop time" of its log (the run's steps, no setup), contacts from compute
 # contact/atom at the last step; grainlab: s:run's wall time, s:measure("coordination").
 # On several ranks LAMMPS cuts the box into equal slabs by default; the pile fills the lower part
-# of its box, so one rank held most of it (2 ranks: 8.6 s against 6.0 s balanced). `balance`
-# (shift) gives each rank an equal share of the particles, as a LAMMPS user would.
+# of its box, so one rank would hold most of it. `balance` (shift) gives each rank an equal share
+# of the particles, as a LAMMPS user would.
 lammps_input "$ETA" viscoelastic "thermo $STEPS
 run $STEPS" "balance         1.0 shift xy 10 1.05" > "$OUT/in.time"
 load() { uptime | sed 's/.*load average: //; s/,.*//'; }
 # CPU time the hypervisor gave to other guests ("steal", /proc/stat) during a run, as a percentage
 # of the machine's CPU time: on a virtual machine a quiet load average can hide a host that runs
-# this guest's 2 cores at half speed, and then the 2-core figures mean little.
+# this guest's cores at half speed.
 cpustat() { awk '/^cpu / { print $2 + $3 + $4 + $5 + $6 + $7 + $8 + $9, $9 }' /proc/stat; }
 steal() { echo "$1 $2" | awk '{ d = $3 - $1; printf "%.0f", (d > 0 ? 100 * ($4 - $2) / d : 0) }'; }
 run_gl() { OMP_NUM_THREADS=$1 "$GL" "$OUT/grainlab_side.lua" mode=time threads="$1" steps="$STEPS" data="$DATA" | awk '/^RATE/'; }
@@ -216,4 +233,17 @@ for cores in 1 2; do
   ld=$(awk -v c="$cores" '$2 == c { printf "%s%s", s, $12; s = " " }' "$OUT/times.txt")
   st=$(awk -v c="$cores" '$2 == c { printf "%s%s", s, $14; s = " " }' "$OUT/times.txt")
   echo "| $cores | $g | $zg | $l | $zl | $(awk -v a="$g" -v b="$l" 'BEGIN { printf "%.2f", a / b }') | $ld | $st |"
+  {
+    echo "metric grainlab_rate_${cores}_cores $g"
+    echo "metric lammps_rate_${cores}_cores $l"
+    echo "metric ratio_${cores}_cores $(awk -v a="$g" -v b="$l" 'BEGIN { printf "%.6g", a / b }')"
+    echo "metric loads_${cores}_cores $ld"
+    echo "metric steal_percent_${cores}_cores $st"
+  } >> "$FIG"
 done
+awk '$1 == "grainlab" { zs = $10; zg = $8 } $1 == "lammps" { zl = $8 }
+  END { print "metric contacts_per_particle_start", zs; print "metric contacts_per_particle_end_grainlab", zg
+        print "metric contacts_per_particle_end_lammps", zl }' "$OUT/times.txt" >> "$FIG"
+if [ -n "$REPORT" ]; then
+  "$GL" --quiet --report "$REPORT" scripts/bench/shell_report.lua scenario=bench_vs_lammps figures="$FIG" >/dev/null
+fi
