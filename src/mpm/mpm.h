@@ -388,10 +388,11 @@ core_status mpm_load(const char *path, mpm_scene **out, core_error *err);
 /* VTK XML for ParaView, written whole. Points (.vtu): one vertex per material point with point
  * data id (1-based), grain, material (1-based), mass, volume (V0 det F), velocity, displacement
  * (3-vectors, z = 0), stress and deformation_gradient (3 x 3 row-major, plane strain: the zz
- * stress, F_zz = 1), pressure (-(xx + yy)/2, as mpm_field), eps_p. Grid (.vti, nodes as points):
- * point data mass and velocity from a linear-shape transfer of the current points, cell data the
- * mpm_field kinds named as the Lua m:field names them (vx, vy, speed, ux, uy, displacement, sxx,
- * syy, sxy, pressure, psd, eps_p, grain, mass). */
+ * stress, F_zz = 1), pressure (-(xx + yy)/2, as mpm_field), eps_p, and with drucker_prager or
+ * mu_i materials rate and mean_pressure. Grid (.vti, nodes as points): point data mass and
+ * velocity from a linear-shape transfer of the current points, cell data the mpm_field kinds named
+ * as the Lua m:field names them (vx, vy, speed, ux, uy, displacement, sxx, syy, sxy, pressure,
+ * psd, eps_p, grain, mass; rate, inertial, mean_pressure with those materials). */
 core_status mpm_vtk_points(const mpm_scene *s, const char *path, core_error *err);
 core_status mpm_vtk_grid(const mpm_scene *s, const char *path, core_error *err);
 
