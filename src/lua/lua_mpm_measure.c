@@ -7,7 +7,8 @@ static int l_field(lua_State *L)
 {
     static const char *const names[] = {"vx",           "vy",    "speed", "ux",   "uy",
                                         "displacement", "sxx",   "syy",   "sxy",  "pressure",
-                                        "psd",          "eps_p", "grain", "mass", NULL};
+                                        "psd",          "eps_p", "grain", "mass", "rate",
+                                        "inertial",     "mean_pressure", NULL};
     mpm_scene *s = bind_mpm_check(L, 1);
     int kind = bind_check_option(L, 2, NULL, names);
     const mpm_scene_def *d = mpm_def(s);
@@ -117,6 +118,8 @@ static int l_points(lua_State *L)
         bind_push_array(L, p.F[k], n, F[k]);
     }
     bind_push_array(L, p.eps_p, n, "eps_p");
+    if (p.rate)
+        bind_push_array(L, p.rate, n, "rate");
     bind_push_array(L, p.ux, n, "ux");
     bind_push_array(L, p.uy, n, "uy");
     lua_createtable(L, (int)n, 0);
@@ -159,9 +162,12 @@ void bind_open_mpm_measure(lua_State *L)
     static const bind_fn methods[] = {
         {"field", l_field,
          "m:field('vx'|'vy'|'speed'|'ux'|'uy'|'displacement'|'sxx'|'syy'|'sxy'|'pressure'|'psd'|"
-         "'eps_p'|'grain'|'mass')",
+         "'eps_p'|'grain'|'mass'|'rate'|'inertial'|'mean_pressure')",
          "A cell field: the mass-weighted mean over the points in each cell (nan in empty "
-         "cells; 'mass' sums). psd is the principal stress difference sigma_1 - sigma_2. "
+         "cells; 'mass' sums). psd is the principal stress difference sigma_1 - sigma_2, "
+         "pressure the in-plane -(sxx + syy)/2, mean_pressure -(sxx + syy + szz)/3 (the "
+         "continuum models' p); rate the plastic shear rate of the last step (1/s, "
+         "drucker_prager and mu_i, 0 elsewhere), inertial mu_i's inertial number I of it. "
          "Returns {nx, ny, origin, size, values} (row-major, x fastest), ready for "
          "render.field."},
         {"measure", l_measure, "m:measure('energy'|'momentum'|'columns'|'shear')",
@@ -176,7 +182,8 @@ void bind_open_mpm_measure(lua_State *L)
         {"points", l_points, "m:points()",
          "Arrays over the material points: x, y, vx, vy, ux, uy (displacement), mass, volume, "
          "grain, sxx, syy, sxy, szz (Cauchy stress, tension positive), Fxx, Fxy, Fyx, Fyy, "
-         "eps_p; and count."},
+         "eps_p; rate (plastic shear rate of the last step) in scenes with drucker_prager or "
+         "mu_i materials; and count."},
         {"timings", l_timings, "m:timings()",
          "Wall seconds spent in each stage of the step, summed over the steps run since the "
          "scene was created or loaded: stencil (0 with friction: p2g takes it), p2g (particle to "

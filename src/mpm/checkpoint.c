@@ -6,7 +6,10 @@
  * into the wall), the grains (point ranges, shapes for the overlap warning, prescribed
  * velocities), every material point (position, velocity, mass, reference volume, deformation
  * gradient, elastic left Cauchy-Green tensor, stress, plastic strain, displacement, grain,
- * material), the light-node threshold m_min, the time and the step count. Everything else is
+ * material), with drucker_prager or mu_i materials their parameters and each point's plastic
+ * shear rate of the last step ("mpm.continuum", written only then: a grainlab without these
+ * models refuses the file), the light-node threshold m_min, the time and the step count.
+ * Everything else is
  * rebuilt: the grid's nodal fields, the stencil and the per-grain contact fields are recomputed
  * from the points at the start of every step, the wall flags of the nodes and the gap-test
  * references from the definition and the planes, the thread ranges at each run, and the
@@ -48,6 +51,12 @@ static void put_plane(ckpt_writer *w, const mpm_plane *p)
     ckpt_put_f64(w, p->point[0]);
     ckpt_put_f64(w, p->point[1]);
 }
+
+/* The continuum models' parameters per material in "mpm.continuum" (mpm_material's order). */
+enum { NCONT = 8 };
+static const char *const CONT_NAMES[NCONT] = {"friction", "dilatancy", "cohesion",
+                                              "mu_s",     "mu_2",      "i0",
+                                              "grain_diameter", "grain_density"};
 
 /* The point arrays of the scene, in the order of the file. */
 static void point_arrays(const mpm_scene *s, double *a[21])
@@ -155,6 +164,21 @@ core_status mpm_save(const mpm_scene *s, const char *path, const char *version, 
     put_ints(w, s->grain, np, tmp);
     put_ints(w, s->mat, np, tmp);
     TRY(ckpt_section_end(w, err));
+
+    if (s->rate) {
+        TRY(ckpt_section_begin(w, "mpm.continuum", CKPT_REQUIRED, err));
+        ckpt_put_u64(w, (uint64_t)s->nmat);
+        for (int k = 0; k < s->nmat; k++) {
+            const mpm_material *m = &s->mats[k];
+            const double v[NCONT] = {m->friction, m->dilatancy,      m->cohesion,
+                                     m->mu_s,     m->mu_2,           m->i0,
+                                     m->grain_diameter, m->grain_density};
+            for (int c = 0; c < NCONT; c++)
+                ckpt_put_f64(w, v[c]);
+        }
+        ckpt_put_f64s(w, s->rate, np);
+        TRY(ckpt_section_end(w, err));
+    }
 
     TRY(ckpt_section_begin(w, "mpm.clock", CKPT_REQUIRED, err));
     ckpt_put_f64(w, s->time);
@@ -285,26 +309,79 @@ done:
     return st;
 }
 
-static core_status read_materials(reader *rd, mpm_scene *s)
+static bool continuum_model(mpm_model m) { return m == MPM_DRUCKER_PRAGER || m == MPM_MU_I; }
+
+/* The materials, with the continuum models' parameters from "mpm.continuum" when a material
+ * needs them; *cont is then that section with its cursor at the point rates (read_rates), and
+ * cont->data NULL otherwise. */
+static core_status read_materials(ckpt_reader *r, reader *rd, mpm_scene *s, ckpt_section *cont)
 {
     core_status st;
     uint64_t n;
+    mpm_material *mats = NULL;
+    cont->data = NULL;
     TRY(ckpt_get_u64(&rd->sec, &n, rd->err));
-    if (n > 1u << 20)
+    if (n > 1u << 20 || n > rd->sec.size / 48)
         return corrupt(rd, "too many materials");
+    mats = malloc((n ? n : 1) * sizeof *mats);
+    if (!mats)
+        return core_fail(rd->err, CORE_ERR_NOMEM, "out of memory for %llu materials",
+                         (unsigned long long)n);
+    bool any = false;
     for (uint64_t k = 0; k < n; k++) {
-        mpm_material m = mpm_default_material();
+        mpm_material *m = &mats[k];
+        *m = mpm_default_material();
         long v;
-        TRY(get_int(rd, MPM_ELASTIC, MPM_VONMISES, "material model", &v));
-        m.model = (mpm_model)v;
-        TRY(get_num(rd, "density", &m.density));
-        TRY(get_num(rd, "shear", &m.shear));
-        TRY(get_num(rd, "bulk", &m.bulk));
-        TRY(get_num(rd, "yield", &m.yield));
-        TRY(get_num(rd, "hardening", &m.hardening));
-        if (mpm_add_material(s, &m, rd->err) < 0)
-            return named(rd, CORE_ERR_ARG);
+        TRY(get_int(rd, MPM_ELASTIC, MPM_MU_I, "material model", &v));
+        m->model = (mpm_model)v;
+        any |= continuum_model(m->model);
+        TRY(get_num(rd, "density", &m->density));
+        TRY(get_num(rd, "shear", &m->shear));
+        TRY(get_num(rd, "bulk", &m->bulk));
+        TRY(get_num(rd, "yield", &m->yield));
+        TRY(get_num(rd, "hardening", &m->hardening));
     }
+    TRY(ckpt_section_done(&rd->sec, rd->err));
+    if (any) {
+        TRY(ckpt_find(r, "mpm.continuum", &rd->sec, rd->err));
+        uint64_t nc;
+        TRY(ckpt_get_u64(&rd->sec, &nc, rd->err));
+        if (nc != n) {
+            st = corrupt(rd, "the continuum parameters do not match the materials");
+            goto done;
+        }
+        for (uint64_t k = 0; k < n; k++) {
+            mpm_material *m = &mats[k];
+            double *v[NCONT] = {&m->friction, &m->dilatancy,      &m->cohesion,
+                                &m->mu_s,     &m->mu_2,           &m->i0,
+                                &m->grain_diameter, &m->grain_density};
+            for (int c = 0; c < NCONT; c++)
+                TRY(get_num(rd, CONT_NAMES[c], v[c]));
+        }
+        *cont = rd->sec;
+    } else if (ckpt_has(r, "mpm.continuum")) {
+        st = corrupt(rd, "continuum parameters without a drucker_prager or mu_i material");
+        goto done;
+    }
+    for (uint64_t k = 0; k < n; k++)
+        if (mpm_add_material(s, &mats[k], rd->err) < 0) {
+            st = named(rd, CORE_ERR_ARG);
+            goto done;
+        }
+done:
+    free(mats);
+    return st;
+}
+
+/* The points' plastic shear rates at the end of "mpm.continuum" (finite, >= 0). */
+static core_status read_rates(reader *rd, mpm_scene *s, const ckpt_section *cont)
+{
+    core_status st;
+    rd->sec = *cont;
+    TRY(ckpt_get_f64s(&rd->sec, s->rate, s->np, rd->err));
+    for (size_t p = 0; p < s->np; p++)
+        if (!(s->rate[p] >= 0) || !isfinite(s->rate[p]))
+            return corrupt(rd, "a point's plastic shear rate is negative or not finite");
     st = ckpt_section_done(&rd->sec, rd->err);
 done:
     return st;
@@ -492,8 +569,9 @@ static core_status read_scene(ckpt_reader *r, reader *rd, mpm_scene **out)
     TRY(read_def(rd, &def));
     TRY(check_cells(r, rd, &def));
     TRY(named(rd, mpm_create(&def, &s, rd->err)));
+    ckpt_section cont;
     TRY(ckpt_find(r, "mpm.materials", &rd->sec, rd->err));
-    TRY(read_materials(rd, s));
+    TRY(read_materials(r, rd, s, &cont));
     TRY(ckpt_find(r, "mpm.contact", &rd->sec, rd->err));
     TRY(read_contact(rd, s));
     TRY(ckpt_find(r, "mpm.planes", &rd->sec, rd->err));
@@ -502,6 +580,8 @@ static core_status read_scene(ckpt_reader *r, reader *rd, mpm_scene **out)
     TRY(read_grains(rd, s, &pres));
     TRY(ckpt_find(r, "mpm.points", &rd->sec, rd->err));
     TRY(read_points(rd, s));
+    if (cont.data)
+        TRY(read_rates(rd, s, &cont));
     /* prescriptions after the points: mpm_prescribe sets the grain's point velocities, which
      * the saved points already hold (the same values) */
     for (size_t g = 0; g < s->ngrains; g++)

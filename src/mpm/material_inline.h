@@ -138,14 +138,33 @@ static inline bool material_return(const mpm_material *m, const double tr[3], co
     return plastic;
 }
 
-/* mpm_material_update (mpm.h) with the out-of-plane stretch split off: be holds the in-plane
+/* The granular continuum models' update (src/mpm/continuum.c), from the trial state on as
+ * material_return, over a step of dt seconds (dt = 0: mu_i's quasi-static limit); *rate (may
+ * be NULL) receives the plastic shear rate. Returns whether the update was plastic. */
+bool mpm_continuum_return(const mpm_material *m, double dt, const double tr[3],
+                          const double eps[3], const double dir[3], double J, double be[3],
+                          double *bzz, double *lz, double *eps_p, double *rate, double sigma[4]);
+
+/* material_return for every model: elastic and von Mises inline, the continuum models through
+ * mpm_continuum_return. */
+static inline bool material_point(const mpm_material *m, double dt, const double tr[3],
+                                  const double eps[3], const double dir[3], double J, double be[3],
+                                  double *bzz, double *lz, double *eps_p, double *rate,
+                                  double sigma[4])
+{
+    if (m->model == MPM_ELASTIC || m->model == MPM_VONMISES)
+        return material_return(m, tr, eps, dir, J, be, bzz, lz, eps_p, sigma);
+    return mpm_continuum_return(m, dt, tr, eps, dir, J, be, bzz, lz, eps_p, rate, sigma);
+}
+
+/* mpm_material_step (mpm.h) with the out-of-plane stretch split off: be holds the in-plane
  * b_e (xx, xy, yy); *lz is ln(b_e,zz) / 2, which only a plastic update changes (the zz stretch
  * of plane strain is elastic-constant otherwise), so the caller caches it instead of taking a
  * logarithm of b_e,zz every step; a plastic update sets *bzz and *lz (material_return), an
  * elastic one leaves both. Returns -1 (inverted), 0 (elastic) or 1 (plastic). */
-static inline int material_update_zz(const mpm_material *m, const double f[4], double be[3],
-                                     double *bzz, double *lz, double *eps_p, double J,
-                                     double sigma[4])
+static inline int material_update_zz(const mpm_material *m, const double f[4], double dt,
+                                     double be[3], double *bzz, double *lz, double *eps_p,
+                                     double *rate, double J, double sigma[4])
 {
     if (!(f[0] * f[3] - f[1] * f[2] > 0) || !(J > 0))
         return -1;
@@ -153,15 +172,16 @@ static inline int material_update_zz(const mpm_material *m, const double f[4], d
     trial_be(f, be, tr);
     if (!log_strains(tr, *lz, eps, dir))
         return -1;
-    return material_return(m, tr, eps, dir, J, be, bzz, lz, eps_p, sigma);
+    return material_point(m, dt, tr, eps, dir, J, be, bzz, lz, eps_p, rate, sigma);
 }
 
-/* mpm_material_update (mpm.h). */
-static inline bool material_update(const mpm_material *m, const double f[4], double be[4],
-                                   double *eps_p, double J, double sigma[4])
+/* mpm_material_step (mpm.h). */
+static inline bool material_update(const mpm_material *m, const double f[4], double dt,
+                                   double be[4], double *eps_p, double *rate, double J,
+                                   double sigma[4])
 {
     double lz = 0.5 * log(be[3]);
-    return material_update_zz(m, f, be, &be[3], &lz, eps_p, J, sigma) >= 0;
+    return material_update_zz(m, f, dt, be, &be[3], &lz, eps_p, rate, J, sigma) >= 0;
 }
 
 #endif

@@ -14,7 +14,7 @@ void mpm_measure_energy(const mpm_scene *s, mpm_energy *e)
         double be[4] = {s->be[0][p], s->be[1][p], s->be[2][p], s->be[3][p]};
         el += s->v0[p] * mpm_elastic_energy_density(m, be);
         double ep = s->eps_p[p];
-        if (m->model == MPM_VONMISES)
+        if (m->model == MPM_VONMISES) /* the continuum models' dissipation is not tracked */
             pl += s->v0[p] * (m->yield * ep + 0.5 * m->hardening * ep * ep);
         pot -= s->m[p] * (g0 * s->x[p] + g1 * s->y[p]);
     }
@@ -91,6 +91,17 @@ core_status mpm_grain(const mpm_scene *s, size_t id, mpm_grain_info *out, core_e
     return CORE_OK;
 }
 
+/* A mu_i point's inertial number over its last step, gdot_p d / sqrt(p / rho_s) (0 where the
+ * point is disconnected or unloaded, and for the other models). */
+static double inertial_number(const mpm_scene *s, size_t p)
+{
+    const mpm_material *m = &s->mats[s->mat[p]];
+    const double pr = -(s->sig[0][p] + s->sig[1][p] + s->sig[3][p]) / 3;
+    if (m->model != MPM_MU_I || !s->rate || !(pr > 0))
+        return 0;
+    return s->rate[p] * m->grain_diameter / sqrt(pr / m->grain_density);
+}
+
 static double field_value(const mpm_scene *s, mpm_field_kind kind, size_t p)
 {
     const double sxx = s->sig[0][p], syy = s->sig[1][p], sxy = s->sig[2][p];
@@ -109,6 +120,9 @@ static double field_value(const mpm_scene *s, mpm_field_kind kind, size_t p)
     case MPM_FIELD_EPS_P: return s->eps_p[p];
     case MPM_FIELD_GRAIN: return s->grain[p] + 1;
     case MPM_FIELD_MASS: return 1;
+    case MPM_FIELD_RATE: return s->rate ? s->rate[p] : 0;
+    case MPM_FIELD_INERTIAL: return inertial_number(s, p);
+    case MPM_FIELD_MEAN_PRESSURE: return -(sxx + syy + s->sig[3][p]) / 3;
     }
     return 0;
 }

@@ -84,28 +84,67 @@ const mpm_scene_def *mpm_def(const mpm_scene *s);
 void mpm_cell_size(const mpm_scene *s, double h[2]);
 
 /* ---- materials ------------------------------------------------------------------------------
- * Both models are Hencky (logarithmic-strain) hyperelastic in plane strain: Kirchhoff stress
+ * Every model is Hencky (logarithmic-strain) hyperelastic in plane strain: Kirchhoff stress
  * tau = K ln(J) I + 2 G dev(ln V_e), with V_e the elastic left stretch carried as b_e = V_e^2.
  * It is objective under the large rotations of rolling and spinning grains (a small-strain rate
  * form is not, and Jaumann-rate hypoelasticity creates or loses energy in closed cycles), it has
  * a stored energy for the energy balance, and von Mises radial return is exact in log-strain
- * space (Simo 1992) with the small-strain formula. */
+ * space (Simo 1992) with the small-strain formula. The plastic models return in the principal
+ * log strains of the trial b_e (the zz stretch the third, plane strain); the two granular
+ * continuum models (src/mpm/continuum.c) model the granular material itself rather than a grain:
+ * - Drucker-Prager: sqrt(J2) <= eta p + xi c (p = -tr(tau)/3 compression positive), plastic
+ *   potential sqrt(J2) - etabar p (non-associated: dilatancy angle psi <= friction angle phi),
+ *   eta, xi, etabar matched to Mohr-Coulomb in plane strain at the limit state: a plane-strain
+ *   element flowing plastically carries exactly t = P sin phi + c cos phi (t = (s1 - s3) / 2,
+ *   P = -(s1 + s3) / 2 in plane) with the dilation rate of Mohr-Coulomb's psi (mpm_dp_match).
+ *   A trial state beyond the cone's apex (tension beyond p = -xi c / eta, any tension for c = 0)
+ *   returns to the apex: the tension cut-off.
+ * - mu(I) (Jop, Forterre & Pouliquen 2006, in MPM after Dunatunga & Kamrin 2015): sqrt(J2) =
+ *   mu(I) p while flowing, mu(I) = mu_s + (mu_2 - mu_s) / (I_0 / I + 1), I = gdot_p d /
+ *   sqrt(p / rho_s) with gdot_p the plastic shear rate, found per step in closed form (a
+ *   quadratic); elastic below mu_s p. The plastic flow is isochoric and the pressure follows the
+ *   density, p = -K ln J (density = the close-packed density rho_c at J = 1); a point dilated to
+ *   J >= 1 (rho <= rho_c) is disconnected: stress-free, its elastic strain reset. */
 typedef enum mpm_model {
     MPM_ELASTIC,
-    MPM_VONMISES  /* J2 plasticity, linear isotropic hardening: q = yield + hardening eps_p */
+    MPM_VONMISES,       /* J2 plasticity, linear isotropic hardening: q = yield + hardening eps_p */
+    MPM_DRUCKER_PRAGER, /* pressure-dependent yield, non-associated, tension cut-off */
+    MPM_MU_I            /* the mu(I) rheology with a disconnected (stress-free) state */
 } mpm_model;
 
 typedef struct mpm_material {
     mpm_model model;
-    double density;    /* kg/m^3 */
+    double density;    /* kg/m^3 (mu_i: the close-packed bulk density rho_c) */
     double shear;      /* G, Pa */
     double bulk;       /* K, Pa */
     double yield;      /* von Mises yield stress (equivalent, q = sqrt(3/2)|s|), Pa */
     double hardening;  /* H = d q / d eps_p, Pa (>= 0) */
+    /* drucker_prager */
+    double friction;   /* phi, degrees in (0, 90) */
+    double dilatancy;  /* psi, degrees in [0, phi] */
+    double cohesion;   /* c, Pa >= 0 */
+    /* mu_i */
+    double mu_s, mu_2; /* 0 < mu_s < mu_2 */
+    double i0;         /* I_0 > 0 */
+    double grain_diameter; /* d, m */
+    double grain_density;  /* rho_s >= density, kg/m^3 */
+    /* derived by mpm_add_material (mpm_material_prepare), not input: drucker_prager's eta, xi
+     * and etabar */
+    double dp[3];
 } mpm_material;
 
+/* Drucker-Prager's eta, xi and etabar for friction angle phi and dilatancy psi (degrees): the
+ * plane-strain match at the limit state, etabar = sqrt(3) sin psi / sqrt(3 + sin^2 psi),
+ * A = sqrt(1 - etabar^2 / 3), eta = sin phi / (A + etabar sin phi / 3), xi = cos phi (1 - eta
+ * etabar / 3) / A. For psi = phi it is the usual associated match eta = 3 tan phi / sqrt(9 + 12
+ * tan^2 phi), xi = 3 / sqrt(9 + 12 tan^2 phi); for psi = 0, eta = sin phi and xi = cos phi. */
+void mpm_dp_match(double phi, double psi, double *eta, double *xi, double *etabar);
+/* Fills the derived fields (dp) of a material from its inputs. */
+void mpm_material_prepare(mpm_material *m);
+
 mpm_material mpm_default_material(void); /* elastic, the paper's incline disk: 3000, 2.5 MPa, 10 MPa */
-/* Checks a material (positive density and moduli, yield > 0 for von Mises). */
+/* Checks a material (positive density and moduli, yield > 0 for von Mises, the angles and
+ * friction coefficients of the continuum models). */
 core_status mpm_check_material(const mpm_material *m, core_error *err);
 /* Returns the material index (>= 0) or -1 with err filled. */
 int mpm_add_material(mpm_scene *s, const mpm_material *m, core_error *err);
@@ -115,9 +154,15 @@ double mpm_wave_speed(const mpm_material *m);
 /* One constitutive update of a point (step 3 of Sec. 2): the incremental deformation gradient
  * f = I + dt L (row-major xx, xy, yx, yy) updates b_e (xx, xy, yy, zz) and eps_p; J is the total
  * det F after the step. Writes the Cauchy stress (xx, yy, xy, zz). Returns false when the step
- * inverts the point (det f <= 0). Public so that C tests can drive a single point. */
+ * inverts the point (det f <= 0). Public so that C tests can drive a single point. The rate
+ * dependent mu_i model takes the step's duration from mpm_material_step; here (dt = 0) it is
+ * the quasi-static limit I -> 0, a yield cone at mu_s. */
 bool mpm_material_update(const mpm_material *m, const double f[4], double be[4], double *eps_p,
                          double J, double sigma[4]);
+/* The same over a step of dt seconds; *rate (may be NULL) receives the plastic shear rate
+ * gdot_p = dgamma_p / dt of the continuum models (0 for the others). */
+bool mpm_material_step(const mpm_material *m, const double f[4], double dt, double be[4],
+                       double *eps_p, double *rate, double J, double sigma[4]);
 /* Stored (Hencky) energy per reference volume of b_e, J/m^3. */
 double mpm_elastic_energy_density(const mpm_material *m, const double be[4]);
 
@@ -241,6 +286,9 @@ typedef struct mpm_points {
     const double *eps_p;     /* equivalent plastic strain */
     const double *ux, *uy;   /* displacement since the grain was added (not wrapped) */
     const int *grain, *material;
+    /* the plastic shear rate gdot_p of each point's last step (1/s; 0 for elastic and von Mises
+     * materials), NULL when the scene has no drucker_prager or mu_i material */
+    const double *rate;
 } mpm_points;
 void mpm_get_points(const mpm_scene *s, mpm_points *p);
 /* Sets every point's velocity (arrays of mpm_point_count values, all finite). */
@@ -310,7 +358,12 @@ typedef enum mpm_field_kind {
     MPM_FIELD_VX, MPM_FIELD_VY, MPM_FIELD_SPEED, MPM_FIELD_UX, MPM_FIELD_UY, MPM_FIELD_UMAG,
     MPM_FIELD_SXX, MPM_FIELD_SYY, MPM_FIELD_SXY, MPM_FIELD_PRESSURE,
     MPM_FIELD_PSD,   /* principal stress difference sigma_1 - sigma_2 (in-plane) */
-    MPM_FIELD_EPS_P, MPM_FIELD_GRAIN, MPM_FIELD_MASS
+    MPM_FIELD_EPS_P, MPM_FIELD_GRAIN, MPM_FIELD_MASS,
+    MPM_FIELD_RATE,     /* plastic shear rate gdot_p of the continuum models (0 elsewhere) */
+    MPM_FIELD_INERTIAL, /* mu_i: the inertial number gdot_p d / sqrt(p / rho_s) of the last step
+                         * (p = -tr(sigma) / 3; 0 where disconnected and for other models) */
+    MPM_FIELD_MEAN_PRESSURE /* -(sxx + syy + szz) / 3: the continuum models' p (PRESSURE is the
+                             * in-plane mean) */
 } mpm_field_kind;
 void mpm_field(const mpm_scene *s, mpm_field_kind kind, double *out);
 /* Mass-weighted mean vertical displacement per column of cells (nx values; NAN if empty). */
@@ -335,10 +388,11 @@ core_status mpm_load(const char *path, mpm_scene **out, core_error *err);
 /* VTK XML for ParaView, written whole. Points (.vtu): one vertex per material point with point
  * data id (1-based), grain, material (1-based), mass, volume (V0 det F), velocity, displacement
  * (3-vectors, z = 0), stress and deformation_gradient (3 x 3 row-major, plane strain: the zz
- * stress, F_zz = 1), pressure (-(xx + yy)/2, as mpm_field), eps_p. Grid (.vti, nodes as points):
- * point data mass and velocity from a linear-shape transfer of the current points, cell data the
- * mpm_field kinds named as the Lua m:field names them (vx, vy, speed, ux, uy, displacement, sxx,
- * syy, sxy, pressure, psd, eps_p, grain, mass). */
+ * stress, F_zz = 1), pressure (-(xx + yy)/2, as mpm_field), eps_p, and with drucker_prager or
+ * mu_i materials rate and mean_pressure. Grid (.vti, nodes as points): point data mass and
+ * velocity from a linear-shape transfer of the current points, cell data the mpm_field kinds named
+ * as the Lua m:field names them (vx, vy, speed, ux, uy, displacement, sxx, syy, sxy, pressure,
+ * psd, eps_p, grain, mass; rate, inertial, mean_pressure with those materials). */
 core_status mpm_vtk_points(const mpm_scene *s, const char *path, core_error *err);
 core_status mpm_vtk_grid(const mpm_scene *s, const char *path, core_error *err);
 

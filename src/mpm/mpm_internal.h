@@ -61,6 +61,9 @@ struct mpm_scene {
     double *sig[4];         /* Cauchy stress: xx, yy, xy, zz */
     double *eps_p;
     double *ux, *uy;        /* displacement */
+    /* plastic shear rate of the last step (continuum models), cap entries; allocated when the
+     * first drucker_prager or mu_i material is added, else NULL */
+    double *rate;
     /* ln(b_e,zz) / 2 per point, a cache the step keeps (material_update_zz), not saved: built
      * from b_e,zz at the start of a run unless lzz_ok (cleared wherever points or b_e are set
      * outside the step) */

@@ -248,6 +248,7 @@ void mpm_destroy(mpm_scene *s)
         core_free_staggered(stencil[k], STAGGER_STENCIL + k);
     for (int k = 0; point_doubles(s, k); k++)
         core_free_staggered(*point_doubles(s, k), STAGGER_POINT + k);
+    free(s->rate);
     free(s->nwall);
     free(s->nwin);
     free(s->nmx);
@@ -288,9 +289,24 @@ void mpm_cell_size(const mpm_scene *s, double h[2])
     h[1] = s->hy;
 }
 
+/* The point rates of the continuum models, for cap points (zero), once. */
+static core_status reserve_rate(mpm_scene *s, core_error *err)
+{
+    double *r = realloc(s->rate, (s->cap ? s->cap : 1) * sizeof *r);
+    if (!r)
+        return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu points", s->cap);
+    if (!s->rate)
+        memset(r, 0, (s->cap ? s->cap : 1) * sizeof *r);
+    s->rate = r;
+    return CORE_OK;
+}
+
 int mpm_add_material(mpm_scene *s, const mpm_material *m, core_error *err)
 {
     if (mpm_check_material(m, err))
+        return -1;
+    if ((m->model == MPM_DRUCKER_PRAGER || m->model == MPM_MU_I) && !s->rate &&
+        reserve_rate(s, err))
         return -1;
     if (s->nmat == s->matcap) {
         int cap = s->matcap ? 2 * s->matcap : 4;
@@ -303,6 +319,7 @@ int mpm_add_material(mpm_scene *s, const mpm_material *m, core_error *err)
         s->matcap = cap;
     }
     s->mats[s->nmat] = *m;
+    mpm_material_prepare(&s->mats[s->nmat]);
     return s->nmat++;
 }
 
@@ -341,7 +358,14 @@ static core_status reserve_points(mpm_scene *s, size_t n, core_error *err)
             return core_fail(err, CORE_ERR_NOMEM, "out of memory for %zu points", cap);
         *st[k] = p;
     }
+    const size_t old = s->cap;
     s->cap = cap;
+    if (s->rate) {
+        core_status rs = reserve_rate(s, err);
+        if (rs)
+            return rs;
+        memset(s->rate + old, 0, (cap - old) * sizeof *s->rate);
+    }
     return CORE_OK;
 }
 
@@ -530,6 +554,8 @@ static double fill_grain(mpm_scene *s, const mpm_grain_def *g, const grain_cells
             for (int k = 0; k < 4; k++)
                 s->sig[k][p] = 0;
             s->eps_p[p] = 0;
+            if (s->rate)
+                s->rate[p] = 0;
             s->ux[p] = s->uy[p] = 0;
             s->grain[p] = (int)s->ngrains;
             s->mat[p] = g->material;
@@ -692,6 +718,7 @@ void mpm_get_points(const mpm_scene *s, mpm_points *p)
     p->uy = s->uy;
     p->grain = s->grain;
     p->material = s->mat;
+    p->rate = s->rate;
 }
 
 double mpm_time(const mpm_scene *s) { return s->time; }

@@ -113,16 +113,16 @@ static inline void store_point(mpm_scene *s, const check_bounds *cb, bool chk, s
         *first = p;
 }
 
-/* Point j (p) of a block, scalar, from its log strains eps: material_return, the stores, and
+/* Point j (p) of a block, scalar, from its log strains eps: material_point, the stores, and
  * with chk the end-of-step check (*first: the first bad point). */
 static inline void finish_point(mpm_scene *s, const check_bounds *cb, bool chk, const cblock *T,
-                                int j, size_t p, const double eps[3], size_t *first)
+                                int j, size_t p, const double eps[3], double dt, size_t *first)
 {
     const double tr[3] = {T->tr[0][j], T->tr[1][j], T->tr[2][j]};
     const double dir[3] = {T->dir[0][j], T->dir[1][j], T->dir[2][j]};
     double be[3], sig[4];
-    material_return(&s->mats[s->mat[p]], tr, eps, dir, T->J[j], be, &s->be[3][p], &s->lzz[p],
-                    &s->eps_p[p], sig);
+    material_point(&s->mats[s->mat[p]], dt, tr, eps, dir, T->J[j], be, &s->be[3][p], &s->lzz[p],
+                   &s->eps_p[p], s->rate ? &s->rate[p] : NULL, sig);
     store_point(s, cb, chk, p, be, sig, first);
 }
 
@@ -130,7 +130,7 @@ static inline void finish_point(mpm_scene *s, const check_bounds *cb, bool chk, 
  * end-of-step check; *bad: the first inverted point, *first: the first bad one. The stress
  * update's reference (s->no_lanes). */
 static void point_scalar(mpm_scene *s, const check_bounds *cb, bool chk, const double f[4],
-                         size_t p, size_t *bad, size_t *first)
+                         double dt, size_t p, size_t *bad, size_t *first)
 {
     const double Fa = s->F[0][p], Fb = s->F[1][p], Fc = s->F[2][p], Fd = s->F[3][p];
     const double G0 = f[0] * Fa + f[1] * Fc, G1 = f[0] * Fb + f[1] * Fd;
@@ -141,8 +141,8 @@ static void point_scalar(mpm_scene *s, const check_bounds *cb, bool chk, const d
     s->F[3][p] = G3;
     const double J = G0 * G3 - G1 * G2;
     double be[3] = {s->be[0][p], s->be[1][p], s->be[2][p]}, sig[4];
-    if (material_update_zz(&s->mats[s->mat[p]], f, be, &s->be[3][p], &s->lzz[p], &s->eps_p[p], J,
-                           sig) < 0) {
+    if (material_update_zz(&s->mats[s->mat[p]], f, dt, be, &s->be[3][p], &s->lzz[p],
+                           &s->eps_p[p], s->rate ? &s->rate[p] : NULL, J, sig) < 0) {
         if (*bad == (size_t)-1)
             *bad = p;
         return;
@@ -299,7 +299,7 @@ constitutive_with(mpm_scene *s, double dt, size_t pa, size_t pb, const double *v
         if (s->no_lanes) {
             for (int j = 0; j < nb; j++) {
                 const double f[4] = {T.f[0][j], T.f[1][j], T.f[2][j], T.f[3][j]};
-                point_scalar(s, &cb, chk, f, p0 + (size_t)j, &bad, &first);
+                point_scalar(s, &cb, chk, f, dt, p0 + (size_t)j, &bad, &first);
             }
             continue;
         }
@@ -319,7 +319,7 @@ constitutive_with(mpm_scene *s, double dt, size_t pa, size_t pb, const double *v
                     continue;
                 }
                 const double eps[3] = {0.5 * log(T.lg[0][j]), 0.5 * log(T.lg[1][j]), lzz[p]};
-                finish_point(s, &cb, chk, &T, j, p, eps, &first);
+                finish_point(s, &cb, chk, &T, j, p, eps, dt, &first);
             }
             continue;
         }
@@ -341,6 +341,13 @@ constitutive_with(mpm_scene *s, double dt, size_t pa, size_t pb, const double *v
                 for (jb = ja + 1; jb < nb && mat[p0 + (size_t)jb] == mk; jb++)
                     ;
             const mpm_material *const m = &mats[mk];
+            if (m->model != MPM_ELASTIC && m->model != MPM_VONMISES) {
+                /* the granular continuum models: every point in (D) */
+                for (int j = ja; j < jb; j++)
+                    T.flag[j] = 1;
+                any += jb - ja;
+                continue;
+            }
             const bool vm = m->model == MPM_VONMISES;
             any += vm ? (chk ? pass_elastic(&T, ja, jb, p0, m, &cb, &E, true, true)
                              : pass_elastic(&T, ja, jb, p0, m, &cb, &E, true, false))
@@ -353,7 +360,7 @@ constitutive_with(mpm_scene *s, double dt, size_t pa, size_t pb, const double *v
                 if (T.flag[j]) {
                     const size_t p = p0 + (size_t)j;
                     const double eps[3] = {0.5 * T.lg[0][j], 0.5 * T.lg[1][j], lzz[p]};
-                    finish_point(s, &cb, chk, &T, j, p, eps, &first);
+                    finish_point(s, &cb, chk, &T, j, p, eps, dt, &first);
                 }
     }
     if (check)

@@ -1,6 +1,7 @@
 /* MPM scenes as VTK XML for ParaView: the material points as vertices (.vtu) and the grid as an
- * image (.vti) with nodal mass and velocity and the cell fields of mpm_field. Public accessors of
- * mpm.h only. */
+ * image (.vti) with nodal mass and velocity and the cell fields of mpm_field (the continuum
+ * models' rate, inertial number and mean pressure only in scenes that have such a material).
+ * Public accessors of mpm.h only. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -30,7 +31,10 @@ core_status mpm_vtk_points(const mpm_scene *s, const char *path, core_error *err
     double *F = sig ? vtk_f64(f, VTK_POINT_DATA, "deformation_gradient", 9, n, err) : NULL;
     double *pr = F ? vtk_f64(f, VTK_POINT_DATA, "pressure", 1, n, err) : NULL;
     double *ep = pr ? vtk_f64(f, VTK_POINT_DATA, "eps_p", 1, n, err) : NULL;
-    if (!ep)
+    /* the continuum models' plastic shear rate and mean pressure -tr(sigma) / 3 */
+    double *rate = ep && p.rate ? vtk_f64(f, VTK_POINT_DATA, "rate", 1, n, err) : NULL;
+    double *pm = rate ? vtk_f64(f, VTK_POINT_DATA, "mean_pressure", 1, n, err) : NULL;
+    if (!ep || (p.rate && !pm))
         return vtk_file_finish(f, path, err ? err->status : CORE_ERR_NOMEM, err);
     for (size_t i = 0; i < n; i++) {
         conn[i] = (int64_t)i;
@@ -54,6 +58,10 @@ core_status mpm_vtk_points(const mpm_scene *s, const char *path, core_error *err
         memcpy(F + 9 * i, F9, sizeof F9);
         pr[i] = -(sxx + syy) / 2; /* as m:field('pressure') */
         ep[i] = p.eps_p[i];
+        if (rate) {
+            rate[i] = p.rate[i];
+            pm[i] = -(sxx + syy + szz) / 3; /* as m:field('mean_pressure') */
+        }
     }
     st = vtk_set_time(f, mpm_time(s), mpm_steps_done(s), err);
     if (!st)
@@ -75,7 +83,11 @@ static const struct {
     {"sxy", MPM_FIELD_SXY},     {"pressure", MPM_FIELD_PRESSURE},
     {"psd", MPM_FIELD_PSD},     {"eps_p", MPM_FIELD_EPS_P},
     {"grain", MPM_FIELD_GRAIN}, {"mass", MPM_FIELD_MASS},
+    /* scenes with drucker_prager or mu_i materials only (NCELL_CONTINUUM) */
+    {"rate", MPM_FIELD_RATE},   {"inertial", MPM_FIELD_INERTIAL},
+    {"mean_pressure", MPM_FIELD_MEAN_PRESSURE},
 };
+enum { NCELL_CONTINUUM = 3 };
 
 core_status mpm_vtk_grid(const mpm_scene *s, const char *path, core_error *err)
 {
@@ -94,7 +106,11 @@ core_status mpm_vtk_grid(const mpm_scene *s, const char *path, core_error *err)
     double *nv = nm ? vtk_f64(f, VTK_POINT_DATA, "velocity", 3, nn, err) : NULL;
     if (!nv)
         return vtk_file_finish(f, path, err ? err->status : CORE_ERR_NOMEM, err);
-    for (size_t k = 0; k < sizeof CELL_FIELDS / sizeof CELL_FIELDS[0]; k++) {
+    mpm_points p;
+    mpm_get_points(s, &p);
+    const size_t nfields =
+        sizeof CELL_FIELDS / sizeof CELL_FIELDS[0] - (p.rate ? 0 : NCELL_CONTINUUM);
+    for (size_t k = 0; k < nfields; k++) {
         double *c = vtk_f64(f, VTK_CELL_DATA, CELL_FIELDS[k].name, 1, nc, err);
         if (!c)
             return vtk_file_finish(f, path, err ? err->status : CORE_ERR_NOMEM, err);
@@ -104,8 +120,6 @@ core_status mpm_vtk_grid(const mpm_scene *s, const char *path, core_error *err)
      * tensor-product shape functions (Eqs. 5-6): the solver's own nodal arrays are scratch of
      * its last step (and have ghost layers with B-splines). A periodic axis wraps its last node
      * onto the first, which the image repeats. */
-    mpm_points p;
-    mpm_get_points(s, &p);
     const size_t np = mpm_point_count(s);
     const int W = nx + 1;
     for (size_t q = 0; q < np; q++) {

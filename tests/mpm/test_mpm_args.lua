@@ -11,7 +11,7 @@ check.errors(function() mpm.material{ density = 3000, shear = 1e6, bulk = -1 } e
 check.errors(function() mpm.material{ shear = 1e6, bulk = 1e6 } end,
   "bad field 'density' in argument #1 to 'material' (positive number expected, got nil)", "missing density")
 check.errors(function() mpm.material{ model = "mohr", density = 1, shear = 1, bulk = 1 } end,
-  "bad field 'model' in argument #1 to 'material' (one of 'elastic', 'vonmises' expected, got 'mohr')", "unknown model")
+  "bad field 'model' in argument #1 to 'material' (one of 'elastic', 'vonmises', 'drucker_prager', 'mu_i' expected, got 'mohr')", "unknown model")
 check.errors(function() mpm.material{ model = "vonmises", density = 1, shear = 1, bulk = 1 } end,
   "bad field 'yield' in argument #1 to 'material' (positive number expected, got nil)", "von Mises needs a yield stress")
 check.errors(function() mpm.material{ density = 1, shear = 1, bulk = 1, yield = 5 } end,
