@@ -154,10 +154,10 @@ void analysis_cg_layout_of(int dim, const analysis_cg_particles *p, const analys
 {
     const int D = dim, T = dim * dim;
     int has[ANALYSIS_CG_NCHANNELS] = {0}, ncomp[ANALYSIS_CG_NCHANNELS] = {0};
-    const int contacts = c && c->n > 0;
+    const int contacts = c != NULL;
     has[ANALYSIS_CG_DENSITY] = has[ANALYSIS_CG_MOMENTUM] = has[ANALYSIS_CG_FLUX] = 1;
     has[ANALYSIS_CG_CONTACT] = contacts;
-    has[ANALYSIS_CG_TRACTION] = contacts && c->wall;
+    has[ANALYSIS_CG_TRACTION] = contacts && c->wall != NULL;
     has[ANALYSIS_CG_VOLUME] = p->volume != NULL;
     has[ANALYSIS_CG_FABRIC] = p->fabric != NULL && p->volume != NULL;
     has[ANALYSIS_CG_DISP] = p->disp[0] != NULL;

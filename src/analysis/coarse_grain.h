@@ -96,7 +96,9 @@ typedef struct analysis_cg_layout {
     int stride;                        /* doubles per evaluation point */
 } analysis_cg_layout;
 
-/* The channels the given inputs fill (contacts may be NULL or empty: no contact channels). */
+/* The channels the given inputs fill: those of the particles' non-NULL arrays; the contact
+ * stress whenever c is given (even with no contacts: a layout fixed for time averages), the
+ * traction when c->wall is given. */
 void analysis_cg_layout_of(int dim, const analysis_cg_particles *p, const analysis_cg_contacts *c,
                            analysis_cg_layout *out);
 

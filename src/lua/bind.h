@@ -214,6 +214,8 @@ void bind_open_dsmc(lua_State *L);
 /* Registers the global `analysis` module and the boundary-condition methods of dem.scene
  * (lua_analysis.c); after bind_open_dem. */
 void bind_open_analysis(lua_State *L);
+/* analysis.coarse_grain and analysis.cg_average (lua_coarse_grain.c); after bind_open_analysis. */
+void bind_open_coarse_grain(lua_State *L);
 /* dem.load's restorer of the Delaunay boundary update s:boundary installs (lua_analysis.c). */
 const struct dem_boundary_restorer *bind_dem_boundary_restorer(void);
 /* s:save and dem.load (lua_checkpoint.c); after bind_open_dem. */

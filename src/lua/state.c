@@ -66,6 +66,7 @@ static int open_grainlab(lua_State *L)
     lua_setglobal(L, "params");
     bind_open_dem(L);
     bind_open_analysis(L);
+    bind_open_coarse_grain(L); /* analysis.coarse_grain (lua_coarse_grain.c) */
     bind_open_checkpoint(L);
     bind_open_mpm(L);
     bind_open_dsmc(L);
