@@ -16,9 +16,13 @@
 enum { CG_MAX_POINTS = 1 << 22 }; /* 4,194,304 evaluation points */
 enum { KIND_NONE, KIND_DEM, KIND_MPM };
 
-static const char *const CG_FIELDS[] = {"kernel", "width",   "cutoff",       "cells", "region",
-                                        "points", "depth",   "contacts",     "displacement",
-                                        "vtk",    "csv",     NULL};
+static const char *const CG_FIELDS[] = {"kernel", "width",    "cutoff",       "cells", "region",
+                                        "points", "depth",    "contacts",     "displacement",
+                                        "vtk",    "csv",      NULL};
+/* cg_average: the same without the files (avg:fields writes them) */
+static const char *const AVG_FIELDS[] = {"kernel", "width",    "cutoff",       "cells", "region",
+                                         "points", "depth",    "contacts",     "displacement",
+                                         NULL};
 static const char *const POINTS_FIELDS[] = {"x", "y", "z", NULL};
 static const char *const OUT_FIELDS[] = {"vtk", "csv", NULL};
 static const char *const KERNELS[] = {"gauss", "lucy", NULL};
@@ -100,11 +104,11 @@ static void *grow(void *p, size_t n, size_t size, int *oom)
 /* Reads field `key` of the table at tab (field `label` of argument arg in messages) as an array of
  * finite numbers into a malloc'd buffer; the length goes to *n (checked against *n when > 0). */
 static double *read_numbers(lua_State *L, int tab, const char *key, int arg, const char *call,
-                            const char *label, size_t *n)
+                            const char *label, size_t *n, const char *first)
 {
-    char what[96];
+    char what[128];
     if (*n)
-        snprintf(what, sizeof what, "array of %zu finite numbers", *n);
+        snprintf(what, sizeof what, "array of %zu finite numbers (the length of '%s')", *n, first);
     else
         snprintf(what, sizeof what, "non-empty array of finite numbers");
     if (lua_getfield(L, tab, key) != LUA_TTABLE)
@@ -138,11 +142,11 @@ static double *read_numbers(lua_State *L, int tab, const char *key, int arg, con
  * w->set. The points are malloc'd into the state (freed with it). */
 static void read_setup(lua_State *L, int arg, const char *call, int kind, int dim,
                        const double box_lo[3], const double box_hi[3], const bool periodic[3],
-                       double thickness, cg_state *w)
+                       double thickness, int files, cg_state *w)
 {
     cg_setup *st = &w->set;
     bind_check_table(L, arg, call);
-    bind_check_fields(L, arg, call, CG_FIELDS);
+    bind_check_fields(L, arg, call, files ? CG_FIELDS : AVG_FIELDS);
     st->kind = kind;
     st->def = analysis_cg_default_def();
     st->def.dim = dim;
@@ -179,8 +183,10 @@ static void read_setup(lua_State *L, int arg, const char *call, int kind, int di
     }
     st->contacts = kind == KIND_DEM && bind_field_boolean(L, arg, call, "contacts", 1);
     st->displacement = kind == KIND_DEM && bind_field_boolean(L, arg, call, "displacement", 0);
-    bind_field_path(L, arg, call, "vtk", 0); /* checked here, written by the caller */
-    bind_field_path(L, arg, call, "csv", 0);
+    if (files) { /* checked here, written by the caller */
+        bind_field_path(L, arg, call, "vtk", 0);
+        bind_field_path(L, arg, call, "csv", 0);
+    }
 
     const int has_cells = lua_getfield(L, arg, "cells") != LUA_TNIL;
     const int has_region = lua_getfield(L, arg, "region") != LUA_TNIL;
@@ -188,12 +194,13 @@ static void read_setup(lua_State *L, int arg, const char *call, int kind, int di
     lua_pop(L, 3);
     if (has_points && (has_cells || has_region)) {
         lua_getfield(L, arg, "points");
-        bind_field_error(L, arg, call, "points", "nil with cells or region (a grid or points)");
+        bind_field_error(L, arg, call, "points",
+                         "nil when 'cells' or 'region' is given (a grid or points)");
     }
     if (!has_points && !has_cells) {
         lua_pushnil(L);
         bind_field_error(L, arg, call, "cells",
-                         "{nx, ny[, nz]} (or points = {x =, y =}: where the fields are wanted)");
+                         "{nx, ny[, nz]} (or 'points' = {x =, y =}: where the fields are wanted)");
     }
     if (has_points) {
         st->grid = 0;
@@ -210,7 +217,7 @@ static void read_setup(lua_State *L, int arg, const char *call, int kind, int di
         static const char *const labels[3] = {"points.x", "points.y", "points.z"};
         size_t n = 0;
         for (int a = 0; a < dim; a++)
-            w->set.pts[a] = read_numbers(L, tab, keys[a], arg, call, labels[a], &n);
+            w->set.pts[a] = read_numbers(L, tab, keys[a], arg, call, labels[a], &n, labels[0]);
         for (int a = dim; a < 3; a++) {
             w->set.pts[a] = calloc(n, sizeof(double));
             if (!w->set.pts[a])
@@ -656,7 +663,7 @@ static int scene_kind(lua_State *L, int idx)
 }
 
 /* The setup of the options at arg for the scene at idx, into a new state pushed on the stack. */
-static cg_state *setup_for(lua_State *L, int idx, int arg, const char *call)
+static cg_state *setup_for(lua_State *L, int idx, int arg, const char *call, int files)
 {
     const int kind = scene_kind(L, idx);
     if (kind == KIND_NONE)
@@ -682,7 +689,7 @@ static cg_state *setup_for(lua_State *L, int idx, int arg, const char *call)
         }
     }
     cg_state *w = new_state(L);
-    read_setup(L, arg, call, kind, dim, lo, hi, periodic, thickness, w);
+    read_setup(L, arg, call, kind, dim, lo, hi, periodic, thickness, files, w);
     return w;
 }
 
@@ -721,7 +728,7 @@ static analysis_cg_fields *new_fields(lua_State *L, const cg_state *w, const cha
 static int l_coarse_grain(lua_State *L)
 {
     const char *call = "coarse_grain";
-    cg_state *w = setup_for(L, 1, 2, call); /* [3] the state */
+    cg_state *w = setup_for(L, 1, 2, call, 1); /* [3] the state */
     sample(L, 1, call, w);
     const double time = scene_time(L, 1, w->set.kind);
     analysis_cg_fields *f = new_fields(L, w, call); /* [4] */
@@ -744,7 +751,7 @@ static cg_state *check_average(lua_State *L, int idx)
 static int l_cg_average(lua_State *L)
 {
     const char *call = "cg_average";
-    cg_state *w = setup_for(L, 1, 2, call);
+    cg_state *w = setup_for(L, 1, 2, call, 0);
     w->acc = calloc(w->set.n * (size_t)w->set.layout.stride, sizeof(double));
     if (!w->acc)
         return luaL_error(L, "%s: out of memory for %d points", call, (int)w->set.n);
@@ -785,6 +792,7 @@ static int l_avg_fields(lua_State *L)
 {
     const char *call = "fields";
     cg_state *w = check_average(L, 1);
+    lua_settop(L, 2); /* the options (or nil) stay at 2 */
     if (!lua_isnoneornil(L, 2)) {
         bind_check_table(L, 2, call);
         bind_check_fields(L, 2, call, OUT_FIELDS);
@@ -911,7 +919,7 @@ void bind_open_coarse_grain(lua_State *L)
          "sampled). Add samples with avg:add(scene) (from on_step), read avg:fields()."},
         {NULL, NULL, NULL, NULL}};
     static const bind_fields fn_fields[] = {
-        {"coarse_grain", NULL, CG_FIELDS}, {"cg_average", NULL, CG_FIELDS}, {NULL, NULL, NULL}};
+        {"coarse_grain", NULL, CG_FIELDS}, {"cg_average", NULL, AVG_FIELDS}, {NULL, NULL, NULL}};
     lua_getglobal(L, "analysis");
     bind_register(L, -1, fns);
     bind_register_fields(L, -1, fn_fields);
