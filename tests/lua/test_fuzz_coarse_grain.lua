@@ -69,5 +69,21 @@ calls["analysis.cg_average:info"] = { setup = average, self = the_avg }
 local skip = { ["analysis.delaunay"] = "fuzzed by test_fuzz_analysis.lua" }
 local ok, err = pcall(fuzz.run, { modules = { analysis = analysis },
   types = { ["analysis.cg_average"] = average().avg }, calls = calls, skip = skip })
+-- render.coarse_grain draws a fields table (the rest of render: test_fuzz_render.lua)
+local png = dir .. "/f.png"
+local fields = analysis.coarse_grain(scene(), { width = 0.1, cells = { 6, 5 } })
+local BOOL, TEXT = { "nil", "boolean" }, { "nil", "string" }
+if ok then
+  ok, err = pcall(fuzz.run, { modules = { render = { coarse_grain = render.coarse_grain } }, calls = {
+    ["render.coarse_grain"] = {
+      args = function() return { fields, { file = png, show = "psd", tensor = "stress", glyphs = true,
+        glyph_every = 1, arrows = "velocity", arrow_every = 1, colormap = "gray", interpolation = "bilinear",
+        range = { 0, 1 }, width = 128, height = 128, title = "t", label = "l", colorbar = true, box = true } } end,
+      opts = 2, pos = { {} }, strings = { file = png },
+      accept = { file = { "string" }, show = OPT, tensor = OPT, glyphs = BOOL, glyph_every = { "nil", "zero" },
+                 arrows = OPT, arrow_every = { "nil", "zero" }, colormap = OPT, interpolation = OPT,
+                 range = OPT, width = OPT, height = OPT, title = TEXT, label = TEXT, colorbar = BOOL, box = BOOL },
+    } } })
+end
 os.execute("rm -rf '" .. dir .. "'")
 if not ok then error(err, 0) end
