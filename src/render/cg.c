@@ -59,7 +59,7 @@ core_status render_cg(render_context *rc, const render_cg_def *def, render_image
     canvas_pixels(rc, 0, 0, base.width, base.height, base.rgba);
     render_image_free(&base);
     const double spacing = every * fmin(dx, dy) * v.scale; /* pixels between glyphs */
-    const double lw = fmax(1.0, 0.12 * spacing);
+    const double lw = fmax(1.0, 0.07 * spacing);
     const rgba8 c = rgba(def->glyph_rgb[0], def->glyph_rgb[1], def->glyph_rgb[2], 255);
     for (int j0 = 0; vmax > 0 && j0 + every <= ny; j0 += every)
         for (int i0 = 0; i0 + every <= nx; i0 += every) {
