@@ -1,7 +1,7 @@
--- analysis.coarse_grain and analysis.cg_average: the fields integrate to the scene's totals (mass,
--- momentum, and stress + rho V V = the virial sum of branch (x) force plus sum m v (x) v) to
--- round-off with the Gaussian cut at 8 w, in 2D and 3D, DEM and MPM; points give the grid's bits;
--- 1 and 2 threads the same bits; averages of samples; the files; refusals by name.
+-- The binding contract of analysis.coarse_grain and analysis.cg_average: the grid's layout, points
+-- give the grid's bits, 1 and 2 threads the same bits, the invariants, averages of samples, the
+-- files, 3D and MPM fields, refusals by name. (The fields' exactness is scripts/cg_exactness.lua,
+-- run by the ctest analysis_cg_exactness.)
 local check = grainlab.check
 local depth = 1e-3
 
@@ -20,62 +20,6 @@ local function bed2(n, seed)
   return s, W, H
 end
 
--- sum over the grid of f(i) times the cell volume
-local function integral(F, f)
-  local t = 0
-  for i = 1, F.n do t = t + f(i) end
-  return t * F.cell_volume
-end
-
-local function totals(s)
-  local P, dim = s:particles(), s:info().dim
-  local ax = dim == 2 and { "x", "y" } or { "x", "y", "z" }
-  local mass, mom, flux = 0, {}, {}
-  for a = 1, dim do mom[a] = 0; flux[a] = {}; for b = 1, dim do flux[a][b] = 0 end end
-  for i = 1, P.count do
-    mass = mass + P.mass[i]
-    for a = 1, dim do
-      local va = P["v" .. ax[a]][i]
-      mom[a] = mom[a] + P.mass[i] * va
-      for b = 1, dim do flux[a][b] = flux[a][b] + P.mass[i] * va * P["v" .. ax[b]][i] end
-    end
-  end
-  -- pairs: the DEM's own virial (s:measure, volume 1); walls: r_i fn n (x) n (no wall friction)
-  local sig = s:measure("stress", { volume = 1 })
-  local vir = {}
-  for a = 1, dim do vir[a] = {}; for b = 1, dim do vir[a][b] = sig[ax[a] .. ax[b]] end end
-  local C = s:measure("contacts")
-  local nk = { C.nx, C.ny, C.nz }
-  for k = 1, #C.i do
-    if C.j[k] < 0 then
-      local r = P.radius[C.i[k]]
-      for a = 1, dim do for b = 1, dim do vir[a][b] = vir[a][b] + r * C.fn[k] * nk[a][k] * nk[b][k] end end
-    end
-  end
-  return mass, mom, flux, vir, ax
-end
-
-local function exactness(s, F, scale, what)
-  local mass, mom, flux, vir, ax = totals(s)
-  local dim = #ax
-  check.near(integral(F, function(i) return F.density[i] end) * scale, mass, 1e-12, what .. ": mass")
-  for a = 1, dim do
-    local V = F.velocity[ax[a]]
-    check.near_abs(integral(F, function(i) return F.density[i] > 0 and F.density[i] * V[i] or 0 end) * scale,
-                   mom[a], 1e-12 * math.abs(mass), what .. ": momentum " .. ax[a])
-    for b = 1, dim do
-      local c = ax[a] .. ax[b]
-      local S, Vb = F.stress[c], F.velocity[ax[b]]
-      local got = integral(F, function(i)
-        return S[i] + (F.density[i] > 0 and F.density[i] * V[i] * Vb[i] or 0)
-      end) * scale
-      local want = vir[a][b] + flux[a][b]
-      local ref = math.abs(vir[1][1]) + math.abs(vir[dim][dim]) + math.abs(flux[1][1])
-      check.near_abs(got, want, 1e-11 * ref, what .. ": stress " .. c .. " + rho V V")
-    end
-  end
-end
-
 -- ---- 2D: a grid over one period in x and beyond every support in y -----------------------------
 local s, W, H = bed2(70, 5)
 local P = s:particles()
@@ -89,13 +33,6 @@ local F = analysis.coarse_grain(s, { width = w, cutoff = 8 * w, cells = { 50, 90
 check.eq(F.n, 50 * 90, "grid points")
 check.near(F.depth, depth, 0, "depth: the scene's thickness")
 check.is_true(F.cell_volume > 0 and F.x[1] > 0 and F.x[2] > F.x[1] and F.y[51] > F.y[1], "cell centres, x fastest")
-exactness(s, F, depth, "2D")
--- the traction integrates to the floor's force
-local fl = integral(F, function(i) return F.traction.y[i] end) * depth
-local floor_fn = 0
-local C = s:measure("contacts")
-for k = 1, #C.i do if C.j[k] < 0 then floor_fn = floor_fn + C.fn[k] end end
-check.near(fl, floor_fn, 1e-11, "2D: the floor's force density integrates to its force")
 
 -- points: the same bits as the grid at the same places
 local idx = { 1, 77, 2000, 4500 }
@@ -227,7 +164,7 @@ do
                                          region = { { 0, 0, -5e-3 }, { L, L, L + 5e-3 } } })
   check.eq(F3.depth, nil, "3D: no depth")
   check.is_true(F3.stress.zz and F3.stress.xz and F3.stress.dz and not F3.stress.angle, "3D tensor fields")
-  exactness(s3, F3, 1, "3D")
+  check.is_true(F3.velocity.z and F3.traction.z and #F3.fabric.zz == 20 * 20 * 40, "3D vectors and fabric")
 end
 
 -- ---- MPM: points' mass, momentum and stress -------------------------------------------------------
@@ -238,18 +175,6 @@ do
   mm:run{ steps = 50, cfl = 0.2, progress = false }
   local Fm = analysis.coarse_grain(mm, { width = 1e-3, cutoff = 8e-3, cells = { 96, 96 },
                                          region = { { -0.012, -0.012 }, { 0.036, 0.036 } } })
-  local pts = mm:points()
-  local mass, px, sxx = 0, 0, 0
-  for i = 1, #pts.x do
-    mass = mass + pts.mass[i]
-    px = px + pts.mass[i] * pts.vx[i]
-    sxx = sxx - pts.volume[i] * pts.sxx[i] + pts.mass[i] * pts.vx[i] ^ 2
-  end
-  check.near(integral(Fm, function(i) return Fm.density[i] end), mass, 1e-12, "MPM mass")
-  check.near(integral(Fm, function(i) return Fm.density[i] > 0 and Fm.density[i] * Fm.velocity.x[i] or 0 end), px, 1e-11, "MPM momentum")
-  check.near(integral(Fm, function(i)
-    return Fm.stress.xx[i] + (Fm.density[i] > 0 and Fm.density[i] * Fm.velocity.x[i] ^ 2 or 0)
-  end), sxx, 1e-11, "MPM stress + rho V V")
   check.is_true(Fm.internal and not Fm.contact and not Fm.fabric, "MPM fields: internal stress, no contacts")
   check.errors(function() analysis.coarse_grain(mm, { width = 1e-3, cells = { 4, 4 }, contacts = false }) end,
     "bad field 'contacts' in argument #2 to 'coarse_grain' (nil for an mpm.scene (a DEM option) expected, got false)",
