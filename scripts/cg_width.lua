@@ -10,7 +10,9 @@
 -- below the floor's contact points, where the stress is 0 (the floor's force enters as the
 -- boundary force density there); the Gaussian reaches 3 w, so the bias at y0 sets in once 3 w
 -- approaches y0. The plateau is the range of w where both are small: the local fluctuation
--- below 10 % and the floor bias at y0 = 6 d below 1 %: the fields there no longer depend on w.
+-- below 20 % and the floor bias at y0 = 6 d below 1 %: the fields there no longer depend on w
+-- beyond the grain-scale scatter that remains (force chains: in a static bed nothing averages it
+-- but the kernel; a flow would add time averages).
 -- Kernel: the Gaussian cut at 3 w (MercuryCG's default).
 --   grainlab scripts/cg_width.lua [n=1200] [width=30] [seed=1] [widths=0.5,0.75,1,1.5,2,3,4] [y0=6]
 --                                 [cache=out/cg_bed_...ckpt]
@@ -77,10 +79,10 @@ for _, wrel in ipairs(widths) do
   rows[#rows + 1] = r
 end
 
--- the plateau: fluctuation below 10 % and floor bias below 1 %
+-- the plateau: fluctuation below 20 % and floor bias below 1 %
 local plateau = {}
 for _, r in ipairs(rows) do
-  if r.fluct < 0.10 and math.abs(r.bias) < 0.01 then plateau[#plateau + 1] = r.w end
+  if r.fluct < 0.20 and math.abs(r.bias) < 0.01 then plateau[#plateau + 1] = r.w end
 end
 
 local checks = {}
