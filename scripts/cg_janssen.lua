@@ -33,16 +33,20 @@
 local n, wd, seed = params.n or 2400, params.width or 20, params.seed or 1
 local mu_w = params.mu_wall or 0.5
 local stages, stage_s = params.stages or 10, params.stage_s or 0.02
+local figures = require("grainlab.figures")
+local fig = { published = figures.published({ n = n, width = wd, seed = seed, mu_wall = mu_w, stages = stages,
+                                              stage_s = stage_s },
+                                            { n = 2400, width = 20, seed = 1, mu_wall = 0.5, stages = 10,
+                                              stage_s = 0.02 }) }
 local d, rho_s, g, depth = 1e-3, 2650, 9.81, 1e-3
 local D = wd * d
-local figures = require("grainlab.figures")
-local fig = { published = figures.published({ n = n, width = wd, seed = seed, mu_wall = mu_w },
-                                            { n = 2400, width = 20, seed = 1, mu_wall = 0.5 }) }
 local png_profile = params.png or figures.path("cg_janssen.png", fig)
 local png_map = params.png_map or figures.path("cg_janssen_psd.png", fig)
 
 local path = params.cache
-if path == nil then path = string.format("out/cg_silo_%d_%d_%d_%g.ckpt", n, wd, seed, mu_w) end
+if path == nil then
+  path = string.format("out/cg_silo_%d_%d_%d_%g_%d_%g.ckpt", n, wd, seed, mu_w, stages, stage_s)
+end
 local s, prep_s
 local f = path and io.open(path, "rb")
 if f then

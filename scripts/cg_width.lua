@@ -5,7 +5,7 @@
 -- point jumps with w, and along a row at mid-depth it fluctuates about its mean by as much as the
 -- mean. As w grows the fluctuations shrink (about as 1 / w: a Gaussian of width w averages some
 -- (w / d)^2 grains) and the stress at a point settles on the continuum value, the weight above per
--- unit area; but a wide kernel also smears the boundaries: at a height y0 = 2 d above the floor
+-- unit area; but a wide kernel also smears the boundaries: at a height y0 above the floor
 -- the x-averaged sigma_yy falls short of the weight above, because part of the kernel reaches
 -- below the floor's contact points, where the stress is 0 (the floor's force enters as the
 -- boundary force density there); the Gaussian reaches 3 w, so the bias at y0 sets in once 3 w
@@ -22,8 +22,10 @@ local cg_bed = dofile((arg[0]:match("^(.*)/") or ".") .. "/cg_bed.lua")
 local n, wd, seed = params.n or 1200, params.width or 30, params.seed or 1
 local widths = {}
 for v in tostring(params.widths or "0.5,0.75,1,1.5,2,3,4"):gmatch("[^,]+") do widths[#widths + 1] = assert(tonumber(v)) end
+local y0 = params.y0 or 6 -- diameters above the floor where the bias is measured
 local figures = require("grainlab.figures")
-local fig = { published = figures.published({ n = n, width = wd, seed = seed, widths = params.widths, y0 = y0 },
+local fig = { published = params.widths == nil and
+                          figures.published({ n = n, width = wd, seed = seed, y0 = y0 },
                                             { n = 1200, width = 30, seed = 1, y0 = 6 }) }
 local png_points = params.png or figures.path("cg_width_points.png", fig)
 local png_study = params.png_study or figures.path("cg_width_study.png", fig)
@@ -40,7 +42,6 @@ local function weight_above(y)
   return m * g / (W * cg_bed.depth)
 end
 
-local y0 = params.y0 or 6 -- diameters above the floor where the bias is measured
 local y_mid, y_floor = 0.5 * top, y0 * d
 local nrow = math.floor(W / (0.1 * d))
 local xs, ym, yf = {}, {}, {}
