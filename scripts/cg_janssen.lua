@@ -172,10 +172,20 @@ local mu_m = th / tn
 local K_dir = kd / nk
 local K_fit = D / (2 * mu_m * best.lam)
 local zmax = best.ys - fit[1].y
+-- the fill's vertical balance: the walls' force density integrates to the weight (the floor's
+-- normal force and the side walls' friction, which carries most of it: a wall force without its
+-- friction, or with the wrong sign, would miss by twice that). Within 5e-3: the grains' residual
+-- net forces (static_fill) and the grid sums' 1e-4 with the cut at 3 w.
+local weight, up = 0, 0
+for i = 1, P.count do weight = weight + P.mass[i] * g end
+for k = 1, F.n do up = up + F.traction.y[k] end
+up = up * F.cell_volume * depth
+local floor_share = s:wall_force(1) / weight
 local fnet = 0 -- the largest net force on a grain over its weight
 for i = 1, P.count do fnet = math.max(fnet, math.sqrt(P.fx[i] ^ 2 + P.fy[i] ^ 2) / (P.mass[i] * g)) end
 local metrics = {
-  largest_net_force_over_weight = fnet,
+  largest_net_force_over_weight = fnet, weight_n = weight, walls_up_over_weight = up / weight,
+  floor_share_of_weight = floor_share,
   particles = P.count, silo_width_m = D, fill_height_m = top, prep_seconds = prep_s,
   bulk_density = rb, lambda_m = best.lam, lambda_over_width = best.lam / D, sigma_inf_pa = best.sinf,
   surface_m = best.ys, fit_r2 = r2, mu_mobilised = mu_m, k_fit = K_fit, k_direct = K_dir,
@@ -186,6 +196,7 @@ local checks = {
   { name = "janssen_fit_r2", value = r2, limit = 0.98, op = ">=" },
   { name = "saturates", value = zmax / best.lam, limit = 1.5, op = ">=" },
   { name = "static_fill", value = fnet, limit = 0.05 },
+  { name = "walls_carry_the_weight", value = math.abs(up / weight - 1), limit = 5e-3 },
   -- Janssen's law takes K mu constant; in the fill the mobilised friction varies with depth
   -- (0.3-0.4), so sigma_inf and rho_b g lambda, and K from the fit and directly, agree to 15-20 %
   { name = "sigma_inf_is_rho_g_lambda", value = math.abs(best.sinf / (rb * g * best.lam) - 1), limit = 0.2 },

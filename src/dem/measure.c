@@ -388,7 +388,7 @@ static void visit_pair(const dem_contact_info *c, void *ctx)
  * spring's stored force (capped at mu f_n), or the viscous or regularised law against the slip
  * of the contact point (2D: along t = (-n_y, n_x)). */
 static void wall_tangential_vector(const dem_scene *s, const dem_wall *wl, const dem_wall_hit *hit,
-                                   int first, size_t i, double fn, double ft, double out[3])
+                                   int first, size_t i, double ft, double out[3])
 {
     const int D = s->dim;
     const double *n = hit->n;
@@ -439,7 +439,6 @@ static void wall_tangential_vector(const dem_scene *s, const dem_wall *wl, const
     else
         for (int d = 0; d < 3; d++)
             out[d] = k * sl[d];
-    (void)fn;
 }
 
 void dem_each_contact_full(dem_scene *s, void (*visit)(const dem_contact_info *c, void *ctx),
@@ -468,7 +467,7 @@ void dem_each_contact_full(dem_scene *s, void (*visit)(const dem_contact_info *c
                     vn += (s->v[d][i] - hit[h].vel[d]) * hit[h].n[d];
                 c.fn = dem_normal_force(&s->contact, k, gamma, delta, -vn);
                 c.ft = wall_tangential(s, wl, &hit[h], h == 0, i, c.fn, k, mu, delta);
-                wall_tangential_vector(s, wl, &hit[h], h == 0, i, c.fn, c.ft, ftv);
+                wall_tangential_vector(s, wl, &hit[h], h == 0, i, c.ft, ftv);
                 for (int d = 0; d < D; d++)
                     c.force[d] = c.fn * hit[h].n[d] + ftv[d];
                 visit(&c, ctx);

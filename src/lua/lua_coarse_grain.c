@@ -14,7 +14,8 @@
 
 #define CG_PI 3.14159265358979323846
 #define AVERAGE "analysis.cg_average"
-enum { CG_MAX_POINTS = 1 << 22 }; /* 4,194,304 evaluation points */
+/* evaluation points: a 100^3 or 1000^2 grid (the fields' Lua tables take ~1 kB per point) */
+enum { CG_MAX_POINTS = 1 << 20 };
 enum { KIND_NONE, KIND_DEM, KIND_MPM };
 
 static const char *const CG_FIELDS[] = {"kernel", "width",    "cutoff",       "cells", "region",
@@ -117,7 +118,7 @@ static double *read_numbers(lua_State *L, int tab, const char *key, int arg, con
     size_t len = lua_rawlen(L, -1);
     if ((*n && len != *n) || len == 0 || len > CG_MAX_POINTS)
         luaL_error(L, "bad field '%s' in argument #%d to '%s' (%s%s expected, got %d values)",
-                   label, arg, call, what, len > CG_MAX_POINTS ? " (at most 4194304)" : "",
+                   label, arg, call, what, len > CG_MAX_POINTS ? " (at most 1048576)" : "",
                    (int)len);
     double *v = malloc(len * sizeof *v);
     if (!v)
@@ -247,7 +248,7 @@ static void read_setup(lua_State *L, int arg, const char *call, int kind, int di
             total *= (double)v;
         }
         if (total > CG_MAX_POINTS)
-            bind_field_error(L, arg, call, "cells", "at most 4194304 cells in all");
+            bind_field_error(L, arg, call, "cells", "at most 1048576 cells in all");
         lua_pop(L, 1);
         for (int a = 0; a < 3; a++) {
             st->lo[a] = box_lo[a];

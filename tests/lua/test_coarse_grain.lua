@@ -195,7 +195,7 @@ refused({ width = w, cells = { 4, 4 }, kernel = "lucy", cutoff = 1e-3 },
 refused({ width = w, cells = { 4, 4 }, cutoff = 11 * w }, "bad field 'cutoff' in argument #2 to 'coarse_grain' (cutoff at most 10 widths", "cutoff cap")
 refused({ width = w, cells = { 4, 0 } }, "bad field 'cells' in argument #2 to 'coarse_grain' (positive integers of at most 100000", "cells 0")
 refused({ width = w, cells = { 4, 4, 4 } }, "bad field 'cells' in argument #2 to 'coarse_grain' (array of 2 positive integers", "cells of 3D")
-refused({ width = w, cells = { 4096, 4096 } }, "at most 4194304 cells in all", "too many cells")
+refused({ width = w, cells = { 1025, 1024 } }, "at most 1048576 cells in all", "too many cells")
 refused({ width = w, cells = { 4, 4 }, points = { x = { 0 }, y = { 0 } } }, "bad field 'points' in argument #2 to 'coarse_grain' (nil when 'cells' or 'region' is given", "cells and points")
 refused({ width = w, points = { x = { 0, 1 }, y = { 0 } } }, "bad field 'points.y' in argument #2 to 'coarse_grain' (array of 2 finite numbers (the length of 'points.x') expected, got 1 values)", "points lengths")
 refused({ width = w, points = { x = { 0, 0 / 0 }, y = { 0, 0 } } }, "bad field 'points.x' in argument #2 to 'coarse_grain' (non-empty array of finite numbers expected, got ", "points NaN")
