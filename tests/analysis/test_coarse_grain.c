@@ -210,7 +210,7 @@ static void make_cluster(cluster *k, int dim, unsigned long long seed)
     }
     k->nc = nc;
     k->p.n = NP;
-    for (int a = 0; a < dim; a++) {
+    for (int a = 0; a < dim && a < 3; a++) {
         k->p.x[a] = k->x[a];
         k->p.v[a] = k->v[a];
     }
@@ -219,7 +219,7 @@ static void make_cluster(cluster *k, int dim, unsigned long long seed)
     k->p.fabric = k->fab;
     k->c.n = nc;
     k->c.i = k->ci;
-    for (int a = 0; a < dim; a++) {
+    for (int a = 0; a < dim && a < 3; a++) {
         k->c.b[a] = k->b[a];
         k->c.f[a] = k->f[a];
     }
