@@ -36,9 +36,9 @@ double analysis_cg_reach(const analysis_cg_def *def)
 typedef struct kernel {
     int lucy;
     double w, c, c2, P;
-    double inv2w2;    /* Gauss: 1 / (2 w^2) */
-    double gline;     /* Gauss: P sqrt(pi / 2) w, the line integral's factor */
-    double isq2w;     /* Gauss: 1 / (sqrt 2 w) */
+    double inv2w2;     /* Gauss: 1 / (2 w^2) */
+    double gline;      /* Gauss: P sqrt(pi / 2) w, the line integral's factor */
+    double isq2w;      /* Gauss: 1 / (sqrt 2 w) */
     double k2, k3, k4; /* Lucy: 6 / c^2, 8 / c^3, 3 / c^4 */
 } kernel;
 
@@ -148,7 +148,8 @@ double analysis_cg_psi(const analysis_cg_def *def, const double *d, const double
     return psi_line(&k, a0, fmax(0, d2 - a0 * a0), L);
 }
 
-/* ---- layout ------------------------------------------------------------------------------------ */
+/* ---- layout ------------------------------------------------------------------------------------
+ */
 void analysis_cg_layout_of(int dim, const analysis_cg_particles *p, const analysis_cg_contacts *c,
                            analysis_cg_layout *out)
 {
@@ -203,8 +204,8 @@ static int bin_of(const bins *b, int a, double x)
 }
 
 /* The support box of item q (without image shift). */
-static void item_box(int D, const analysis_cg_particles *p, const analysis_cg_contacts *c,
-                     size_t q, double reach, double lo[3], double hi[3])
+static void item_box(int D, const analysis_cg_particles *p, const analysis_cg_contacts *c, size_t q,
+                     double reach, double lo[3], double hi[3])
 {
     if (q < p->n) {
         for (int a = 0; a < D; a++) {
@@ -252,9 +253,9 @@ static size_t item_entries(const bins *b, int D, const double period[3], const b
                 for (int z = b0[2]; z <= b1[2]; z++)
                     for (int y = b0[1]; y <= b1[1]; y++)
                         for (int x = b0[0]; x <= b1[0]; x++) {
-                            const size_t bin = ((size_t)z * (size_t)b->nb[1] + (size_t)y) *
-                                                   (size_t)b->nb[0] +
-                                               (size_t)x;
+                            const size_t bin =
+                                ((size_t)z * (size_t)b->nb[1] + (size_t)y) * (size_t)b->nb[0] +
+                                (size_t)x;
                             if (out) {
                                 entry *e = &out[cursor[bin]++];
                                 e->item = q;
@@ -315,8 +316,8 @@ static core_status bins_build(bins *b, int D, const analysis_cg_def *def,
     size_t total = 0;
     for (size_t q = 0; q < nitems; q++) {
         item_box(D, p, c, q, reach, lo, hi);
-        total += item_entries(b, D, period, def->periodic, qlo, qhi, lo, hi, (uint32_t)q,
-                              cursor, NULL);
+        total +=
+            item_entries(b, D, period, def->periodic, qlo, qhi, lo, hi, (uint32_t)q, cursor, NULL);
     }
     for (size_t k = 0; k < nbins; k++)
         b->start[k + 1] = b->start[k] + cursor[k];
@@ -335,7 +336,8 @@ static core_status bins_build(bins *b, int D, const analysis_cg_def *def,
     return CORE_OK;
 }
 
-/* ---- the sums ------------------------------------------------------------------------------------ */
+/* ---- the sums
+ * ------------------------------------------------------------------------------------ */
 typedef struct ctx {
     kernel k;
     const analysis_cg_particles *p;
@@ -343,13 +345,13 @@ typedef struct ctx {
     const analysis_cg_layout *l;
     const bins *b;
     double period[3];
-    double *cl;       /* per contact: L, then the unit vector e from x_i towards the other end */
+    double *cl; /* per contact: L, then the unit vector e from x_i towards the other end */
     double scale[ANALYSIS_CG_NCHANNELS]; /* 1 / depth for the per-area channels in 2D */
 } ctx;
 
 /* The sums at point r (D a constant after inlining). */
 static inline __attribute__((always_inline)) void eval_point(const ctx *x, int D, const double *r,
-                                                            double *out)
+                                                             double *out)
 {
     const analysis_cg_particles *p = x->p;
     const analysis_cg_contacts *c = x->c;
@@ -479,8 +481,7 @@ static core_status check_def(const analysis_cg_def *def, core_error *err)
 
 core_status analysis_cg_sums(const analysis_cg_def *def, const analysis_cg_particles *p,
                              const analysis_cg_contacts *c, const analysis_cg_layout *layout,
-                             size_t npts, const double *const pts[3], double *out,
-                             core_error *err)
+                             size_t npts, const double *const pts[3], double *out, core_error *err)
 {
     core_status st = check_def(def, err);
     if (st)
@@ -496,17 +497,17 @@ core_status analysis_cg_sums(const analysis_cg_def *def, const analysis_cg_parti
         return core_fail(err, CORE_ERR_ARG, "%zu particles and %zu contacts: too many", p->n, nc);
     for (int a = 0; a < D; a++) {
         if (!finite_all(p->x[a], p->n, &bad))
-            return core_fail(err, CORE_ERR_ARG, "particle %zu: position %c is not finite",
-                             bad + 1, axis[a]);
+            return core_fail(err, CORE_ERR_ARG, "particle %zu: position %c is not finite", bad + 1,
+                             axis[a]);
         if (p->v[0] && !finite_all(p->v[a], p->n, &bad))
-            return core_fail(err, CORE_ERR_ARG, "particle %zu: velocity %c is not finite",
-                             bad + 1, axis[a]);
+            return core_fail(err, CORE_ERR_ARG, "particle %zu: velocity %c is not finite", bad + 1,
+                             axis[a]);
         if (p->disp[0] && !finite_all(p->disp[a], p->n, &bad))
             return core_fail(err, CORE_ERR_ARG, "particle %zu: displacement %c is not finite",
                              bad + 1, axis[a]);
         if (!finite_all(pts[a], npts, &bad))
-            return core_fail(err, CORE_ERR_ARG, "point %zu: coordinate %c is not finite",
-                             bad + 1, axis[a]);
+            return core_fail(err, CORE_ERR_ARG, "point %zu: coordinate %c is not finite", bad + 1,
+                             axis[a]);
     }
     if (!finite_all(p->mass, p->n, &bad))
         return core_fail(err, CORE_ERR_ARG, "particle %zu: mass is not finite", bad + 1);
@@ -542,9 +543,8 @@ core_status analysis_cg_sums(const analysis_cg_def *def, const analysis_cg_parti
     for (int ch = 0; ch < ANALYSIS_CG_NCHANNELS; ch++)
         x.scale[ch] = 1;
     if (D == 2) { /* the per-area sums become per volume */
-        static const int per_area[] = {ANALYSIS_CG_DENSITY,  ANALYSIS_CG_MOMENTUM,
-                                       ANALYSIS_CG_FLUX,     ANALYSIS_CG_CONTACT,
-                                       ANALYSIS_CG_TRACTION, ANALYSIS_CG_DISP,
+        static const int per_area[] = {ANALYSIS_CG_DENSITY, ANALYSIS_CG_MOMENTUM, ANALYSIS_CG_FLUX,
+                                       ANALYSIS_CG_CONTACT, ANALYSIS_CG_TRACTION, ANALYSIS_CG_DISP,
                                        ANALYSIS_CG_STRESS};
         for (size_t q = 0; q < sizeof per_area / sizeof *per_area; q++)
             x.scale[per_area[q]] = 1 / def->depth;
@@ -586,7 +586,8 @@ core_status analysis_cg_sums(const analysis_cg_def *def, const analysis_cg_parti
     return CORE_OK;
 }
 
-/* ---- grids --------------------------------------------------------------------------------------- */
+/* ---- grids
+ * --------------------------------------------------------------------------------------- */
 size_t analysis_cg_grid_count(int dim, const int cells[3])
 {
     size_t n = 1;
@@ -609,9 +610,10 @@ void analysis_cg_grid_points(int dim, const int cells[3], const double lo[3], co
             }
 }
 
-/* ---- derived fields --------------------------------------------------------------------------- */
-core_status analysis_cg_fields_alloc(const analysis_cg_layout *l, size_t n,
-                                     analysis_cg_fields *f, core_error *err)
+/* ---- derived fields ---------------------------------------------------------------------------
+ */
+core_status analysis_cg_fields_alloc(const analysis_cg_layout *l, size_t n, analysis_cg_fields *f,
+                                     core_error *err)
 {
     memset(f, 0, sizeof *f);
     const int D = l->dim;
@@ -619,10 +621,10 @@ core_status analysis_cg_fields_alloc(const analysis_cg_layout *l, size_t n,
     f->n = n;
     f->dim = D;
     int ok = 1;
-#define CG_ALLOC(p, count)                                                                        \
-    do {                                                                                          \
-        (p) = malloc((count) * sizeof(double));                                                  \
-        ok = ok && (p) != NULL;                                                                   \
+#define CG_ALLOC(p, count)                                                                         \
+    do {                                                                                           \
+        (p) = malloc((count) * sizeof(double));                                                    \
+        ok = ok && (p) != NULL;                                                                    \
     } while (0)
     CG_ALLOC(f->density, m);
     for (int a = 0; a < D; a++)
@@ -811,7 +813,8 @@ void analysis_cg_invariants_of(int dim, const double *t, analysis_cg_invariants 
     out->angle = atan2(out->direction[1], out->direction[0]);
 }
 
-/* ---- output ----------------------------------------------------------------------------------- */
+/* ---- output -----------------------------------------------------------------------------------
+ */
 /* ParaView's layout of a column: scalars as they are, vectors with 3 components, tensors 3 x 3. */
 static int vtk_ncomp(int dim, int ncomp) { return ncomp == 1 ? 1 : ncomp == dim ? 3 : 9; }
 
@@ -829,9 +832,9 @@ static void vtk_fill(int dim, int ncomp, const double *src, double *dst)
     }
 }
 
-core_status analysis_cg_write_vti(const char *path, int dim, const int cells[3],
-                                  const double lo[3], const double hi[3], size_t ncol,
-                                  const analysis_cg_column *cols, double time, core_error *err)
+core_status analysis_cg_write_vti(const char *path, int dim, const int cells[3], const double lo[3],
+                                  const double hi[3], size_t ncol, const analysis_cg_column *cols,
+                                  double time, core_error *err)
 {
     int n[3] = {1, 1, 1};
     double origin[3] = {0, 0, 0}, spacing[3] = {1, 1, 1};

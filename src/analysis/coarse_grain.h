@@ -36,13 +36,13 @@ typedef enum analysis_cg_kernel {
 } analysis_cg_kernel;
 
 typedef struct analysis_cg_def {
-    int dim;                     /* 2 or 3 */
+    int dim; /* 2 or 3 */
     analysis_cg_kernel kernel;
-    double width;                /* w > 0 */
-    double cutoff;               /* Gauss: where phi is cut, in (0, 10 w]; 0 = 3 w. Lucy: unused */
-    bool periodic[3];            /* periodic axes wrap the kernel across [lo, hi] */
-    double lo[3], hi[3];         /* the period on periodic axes */
-    double depth;                /* 2D: the fields per area are divided by it (> 0; 1 = per m) */
+    double width;        /* w > 0 */
+    double cutoff;       /* Gauss: where phi is cut, in (0, 10 w]; 0 = 3 w. Lucy: unused */
+    bool periodic[3];    /* periodic axes wrap the kernel across [lo, hi] */
+    double lo[3], hi[3]; /* the period on periodic axes */
+    double depth;        /* 2D: the fields per area are divided by it (> 0; 1 = per m) */
 } analysis_cg_def;
 
 analysis_cg_def analysis_cg_default_def(void); /* 2D Gauss, w 1, cutoff 3 w, depth 1 */
@@ -55,37 +55,37 @@ double analysis_cg_psi(const analysis_cg_def *def, const double *d, const double
 /* What the particles bring; NULL arrays leave their channels out (zeros). */
 typedef struct analysis_cg_particles {
     size_t n;
-    const double *x[3];          /* positions (dim of them) */
-    const double *v[3];          /* velocities (NULL: at rest) */
+    const double *x[3]; /* positions (dim of them) */
+    const double *v[3]; /* velocities (NULL: at rest) */
     const double *mass;
-    const double *volume;        /* particle volume (2D: area): the volume fraction */
-    const double *fabric;        /* dim x dim per particle: sum over its contacts of n (x) n */
-    const double *disp[3];       /* displacements: the mass-weighted displacement field */
-    const double *stress;        /* dim x dim per particle, row-major: a point's own stress times
-                                  * its volume (MPM points), compression positive */
+    const double *volume;  /* particle volume (2D: area): the volume fraction */
+    const double *fabric;  /* dim x dim per particle: sum over its contacts of n (x) n */
+    const double *disp[3]; /* displacements: the mass-weighted displacement field */
+    const double *stress;  /* dim x dim per particle, row-major: a point's own stress times
+                            * its volume (MPM points), compression positive */
 } analysis_cg_particles;
 
 /* Contacts: line from x_i (the particle's position) to x_i - b. */
 typedef struct analysis_cg_contacts {
     size_t n;
-    const long *i;               /* the particle that feels f (0-based) */
-    const double *b[3];          /* branch vector, m */
-    const double *f[3];          /* force on i, N */
-    const unsigned char *wall;   /* 1: a wall contact (its contact point x_i - b carries the
-                                  * boundary force density); NULL: none is */
+    const long *i;             /* the particle that feels f (0-based) */
+    const double *b[3];        /* branch vector, m */
+    const double *f[3];        /* force on i, N */
+    const unsigned char *wall; /* 1: a wall contact (its contact point x_i - b carries the
+                                * boundary force density); NULL: none is */
 } analysis_cg_contacts;
 
 /* Channels of the sums at each evaluation point (analysis_cg_layout gives their offsets). */
 enum {
-    ANALYSIS_CG_DENSITY,   /* 1 */
-    ANALYSIS_CG_MOMENTUM,  /* dim */
-    ANALYSIS_CG_FLUX,      /* dim x dim, row-major */
-    ANALYSIS_CG_CONTACT,   /* dim x dim: sum_c b_a f_b psi_c */
-    ANALYSIS_CG_TRACTION,  /* dim: boundary force density of wall contacts */
-    ANALYSIS_CG_VOLUME,    /* 1: volume (area) fraction */
-    ANALYSIS_CG_FABRIC,    /* dim x dim: sum_i V_i F_i phi (divided by the volume fraction later) */
-    ANALYSIS_CG_DISP,      /* dim: sum_i m_i u_i phi */
-    ANALYSIS_CG_STRESS,    /* dim x dim: sum_i S_i phi (MPM points' own stress) */
+    ANALYSIS_CG_DENSITY,  /* 1 */
+    ANALYSIS_CG_MOMENTUM, /* dim */
+    ANALYSIS_CG_FLUX,     /* dim x dim, row-major */
+    ANALYSIS_CG_CONTACT,  /* dim x dim: sum_c b_a f_b psi_c */
+    ANALYSIS_CG_TRACTION, /* dim: boundary force density of wall contacts */
+    ANALYSIS_CG_VOLUME,   /* 1: volume (area) fraction */
+    ANALYSIS_CG_FABRIC,   /* dim x dim: sum_i V_i F_i phi (divided by the volume fraction later) */
+    ANALYSIS_CG_DISP,     /* dim: sum_i m_i u_i phi */
+    ANALYSIS_CG_STRESS,   /* dim x dim: sum_i S_i phi (MPM points' own stress) */
     ANALYSIS_CG_NCHANNELS
 };
 
@@ -93,7 +93,7 @@ typedef struct analysis_cg_layout {
     int dim;
     int offset[ANALYSIS_CG_NCHANNELS]; /* -1: channel absent */
     int ncomp[ANALYSIS_CG_NCHANNELS];
-    int stride;                        /* doubles per evaluation point */
+    int stride; /* doubles per evaluation point */
 } analysis_cg_layout;
 
 /* The channels the given inputs fill: those of the particles' non-NULL arrays; the contact
@@ -107,8 +107,7 @@ void analysis_cg_layout_of(int dim, const analysis_cg_particles *p, const analys
  * a bad definition, non-finite input, and a periodic axis shorter than the kernel's reach. */
 core_status analysis_cg_sums(const analysis_cg_def *def, const analysis_cg_particles *p,
                              const analysis_cg_contacts *c, const analysis_cg_layout *layout,
-                             size_t npts, const double *const pts[3], double *out,
-                             core_error *err);
+                             size_t npts, const double *const pts[3], double *out, core_error *err);
 
 /* The cell centres of a regular grid of cells[0] x cells[1] (x cells[2]) cells over [lo, hi],
  * x fastest (row-major from the bottom row, as render_field takes them). pts[d] hold npts each. */
@@ -124,21 +123,21 @@ void analysis_cg_grid_points(int dim, const int cells[3], const double lo[3], co
 typedef struct analysis_cg_fields {
     size_t n;
     int dim;
-    double *density;             /* n */
-    double *velocity[3];         /* n each */
-    double *kinetic;             /* n x dim x dim */
-    double *contact;             /* n x dim x dim, NULL without contacts */
-    double *internal;            /* n x dim x dim, NULL without point stresses */
-    double *stress;              /* total */
-    double *temperature;         /* n: tr(kinetic) / (dim rho) */
-    double *traction;            /* n x dim, NULL without wall contacts channel */
-    double *volume_fraction;     /* n, NULL without volumes */
-    double *fabric;              /* n x dim x dim, NULL without fabric: sum V F phi / sum V phi */
-    double *displacement;        /* n x dim, NULL without displacements */
+    double *density;         /* n */
+    double *velocity[3];     /* n each */
+    double *kinetic;         /* n x dim x dim */
+    double *contact;         /* n x dim x dim, NULL without contacts */
+    double *internal;        /* n x dim x dim, NULL without point stresses */
+    double *stress;          /* total */
+    double *temperature;     /* n: tr(kinetic) / (dim rho) */
+    double *traction;        /* n x dim, NULL without wall contacts channel */
+    double *volume_fraction; /* n, NULL without volumes */
+    double *fabric;          /* n x dim x dim, NULL without fabric: sum V F phi / sum V phi */
+    double *displacement;    /* n x dim, NULL without displacements */
 } analysis_cg_fields;
 
-core_status analysis_cg_fields_alloc(const analysis_cg_layout *l, size_t n,
-                                     analysis_cg_fields *f, core_error *err);
+core_status analysis_cg_fields_alloc(const analysis_cg_layout *l, size_t n, analysis_cg_fields *f,
+                                     core_error *err);
 void analysis_cg_fields_free(analysis_cg_fields *f);
 void analysis_cg_derive(const analysis_cg_layout *l, size_t n, const double *sums,
                         analysis_cg_fields *f);
@@ -163,9 +162,9 @@ typedef struct analysis_cg_column {
 
 /* VTK ImageData (.vti) of the cell-centred grid: points at the cell centres, the columns as point
  * data, TimeValue; written whole. */
-core_status analysis_cg_write_vti(const char *path, int dim, const int cells[3],
-                                  const double lo[3], const double hi[3], size_t ncol,
-                                  const analysis_cg_column *cols, double time, core_error *err);
+core_status analysis_cg_write_vti(const char *path, int dim, const int cells[3], const double lo[3],
+                                  const double hi[3], size_t ncol, const analysis_cg_column *cols,
+                                  double time, core_error *err);
 /* CSV: a header line (x,y[,z], then name or name_xx, name_xy, ... per column) and one line per
  * point, numbers with 17 significant digits; written whole. */
 core_status analysis_cg_write_csv(const char *path, int dim, size_t n, const double *const pts[3],

@@ -18,13 +18,12 @@
 enum { CG_MAX_POINTS = 1 << 20 };
 enum { KIND_NONE, KIND_DEM, KIND_MPM };
 
-static const char *const CG_FIELDS[] = {"kernel", "width",    "cutoff",       "cells", "region",
-                                        "points", "depth",    "contacts",     "displacement",
-                                        "vtk",    "csv",      NULL};
+static const char *const CG_FIELDS[] = {"kernel",       "width",  "cutoff", "cells",
+                                        "region",       "points", "depth",  "contacts",
+                                        "displacement", "vtk",    "csv",    NULL};
 /* cg_average: the same without the files (avg:fields writes them) */
-static const char *const AVG_FIELDS[] = {"kernel", "width",    "cutoff",       "cells", "region",
-                                         "points", "depth",    "contacts",     "displacement",
-                                         NULL};
+static const char *const AVG_FIELDS[] = {"kernel", "width", "cutoff",   "cells",        "region",
+                                         "points", "depth", "contacts", "displacement", NULL};
 static const char *const POINTS_FIELDS[] = {"x", "y", "z", NULL};
 static const char *const OUT_FIELDS[] = {"vtk", "csv", NULL};
 static const char *const KERNELS[] = {"gauss", "lucy", NULL};
@@ -32,11 +31,11 @@ static const char *const KERNELS[] = {"gauss", "lucy", NULL};
 /* What the fields are computed on: the kernel, the evaluation points and the options. */
 typedef struct cg_setup {
     analysis_cg_def def;
-    int kind;                /* KIND_DEM or KIND_MPM */
-    int grid;                /* 1: cells over region; 0: given points */
+    int kind; /* KIND_DEM or KIND_MPM */
+    int grid; /* 1: cells over region; 0: given points */
     int cells[3];
     double lo[3], hi[3];
-    size_t n;                /* evaluation points */
+    size_t n; /* evaluation points */
     double *pts[3];
     int contacts, displacement;
     analysis_cg_layout layout;
@@ -45,19 +44,19 @@ typedef struct cg_setup {
 /* Scratch a sample reuses (grown as needed), and the running sums of an average. */
 typedef struct cg_state {
     cg_setup set;
-    size_t cap_c, nc;        /* contacts */
+    size_t cap_c, nc; /* contacts */
     long *ci;
     double *cb[3], *cf[3];
     unsigned char *cw;
     int oom;
-    size_t cap_p;            /* per-particle scratch */
+    size_t cap_p; /* per-particle scratch */
     double *vol, *fab, *disp[3], *stress;
-    double *sums;            /* n x stride: the last sample */
-    double *acc;             /* n x stride: the sum of the samples (averages) */
+    double *sums; /* n x stride: the last sample */
+    double *acc;  /* n x stride: the sum of the samples (averages) */
     long samples;
-    double t_first, t_last;  /* scene times of the first and last sample */
-    double seconds;          /* wall time of the samples (gathering and sums) */
-    double cpu_seconds;      /* their CPU time (all threads) */
+    double t_first, t_last; /* scene times of the first and last sample */
+    double seconds;         /* wall time of the samples (gathering and sums) */
+    double cpu_seconds;     /* their CPU time (all threads) */
 } cg_state;
 
 static void state_free(cg_state *w)
@@ -130,7 +129,8 @@ static double *read_numbers(lua_State *L, int tab, const char *key, int arg, con
             free(v);
             char val[48];
             bind_describe(L, -1, val, sizeof val);
-            luaL_error(L, "bad field '%s' in argument #%d to '%s' (%s expected, got %s at entry %d)",
+            luaL_error(L,
+                       "bad field '%s' in argument #%d to '%s' (%s expected, got %s at entry %d)",
                        label, arg, call, what, val, (int)(i + 1));
         }
         lua_pop(L, 1);
@@ -152,11 +152,12 @@ static void read_setup(lua_State *L, int arg, const char *call, int kind, int di
     st->kind = kind;
     st->def = analysis_cg_default_def();
     st->def.dim = dim;
-    st->def.kernel =
-        bind_field_option(L, arg, call, "kernel", KERNELS, 0, 0) ? ANALYSIS_CG_LUCY : ANALYSIS_CG_GAUSS;
+    st->def.kernel = bind_field_option(L, arg, call, "kernel", KERNELS, 0, 0) ? ANALYSIS_CG_LUCY
+                                                                              : ANALYSIS_CG_GAUSS;
     st->def.width = bind_field_number(L, arg, call, "width", 0, BIND_REQUIRED | BIND_POSITIVE);
     if (lua_getfield(L, arg, "cutoff") != LUA_TNIL && st->def.kernel == ANALYSIS_CG_LUCY)
-        bind_field_error(L, arg, call, "cutoff", "nil with kernel 'lucy' (its cutoff is its width)");
+        bind_field_error(L, arg, call, "cutoff",
+                         "nil with kernel 'lucy' (its cutoff is its width)");
     lua_pop(L, 1);
     st->def.cutoff = bind_field_number(L, arg, call, "cutoff", 0, BIND_POSITIVE);
     if (st->def.cutoff > 10 * st->def.width) {
@@ -173,8 +174,8 @@ static void read_setup(lua_State *L, int arg, const char *call, int kind, int di
     if (lua_getfield(L, arg, "depth") != LUA_TNIL && dim == 3)
         bind_field_error(L, arg, call, "depth", "nil in 3D (depth divides 2D fields)");
     lua_pop(L, 1);
-    st->def.depth = bind_field_number(L, arg, call, "depth", thickness > 0 ? thickness : 1,
-                                      BIND_POSITIVE);
+    st->def.depth =
+        bind_field_number(L, arg, call, "depth", thickness > 0 ? thickness : 1, BIND_POSITIVE);
     if (kind == KIND_MPM) {
         static const char *const dem_only[] = {"contacts", "displacement", NULL};
         for (int q = 0; dem_only[q]; q++) {
@@ -284,7 +285,8 @@ static void read_setup(lua_State *L, int arg, const char *call, int kind, int di
     analysis_cg_layout_of(dim, &p, st->contacts ? &c : NULL, &st->layout);
 }
 
-/* ---- a sample ----------------------------------------------------------------------------------- */
+/* ---- a sample -----------------------------------------------------------------------------------
+ */
 typedef struct collect_ctx {
     cg_state *w;
     int dim;
@@ -440,7 +442,8 @@ static void sample(lua_State *L, int idx, const char *call, cg_state *w)
     w->cpu_seconds += clock_cpu() - c0;
 }
 
-/* ---- results ---------------------------------------------------------------------------------- */
+/* ---- results ----------------------------------------------------------------------------------
+ */
 static const char *const AXES[3] = {"x", "y", "z"};
 
 /* Sets field `name` of the table on top to the array base[k * stride] of n values. */
@@ -487,8 +490,8 @@ static void push_tensor(lua_State *L, int D, const double *t, size_t n, const ch
         for (int a = 0; a < 3; a++)
             o[5 + a] = iv.direction[a];
     }
-    static const char *const inv[8] = {"pressure", "psd", "major", "minor", "angle",
-                                       "dx",       "dy",  "dz"};
+    static const char *const inv[8] = {"pressure", "psd", "major", "minor",
+                                       "angle",    "dx",  "dy",    "dz"};
     for (int q = 0; q < 5 + D; q++)
         if (q != 4 || D == 2)
             push_strided(L, scratch + q, 8, n, inv[q]);
@@ -585,14 +588,14 @@ static size_t file_columns(const cg_state *w, const analysis_cg_fields *f, doubl
             o[2 + a] = iv.direction[a];
     }
     size_t m = 0;
-#define COL(nm, nc, v)                                                                            \
-    do {                                                                                          \
-        if (v) {                                                                                  \
-            cols[m].name = nm;                                                                    \
-            cols[m].ncomp = nc;                                                                   \
-            cols[m].values = v;                                                                   \
-            m++;                                                                                  \
-        }                                                                                         \
+#define COL(nm, nc, v)                                                                             \
+    do {                                                                                           \
+        if (v) {                                                                                   \
+            cols[m].name = nm;                                                                     \
+            cols[m].ncomp = nc;                                                                    \
+            cols[m].values = v;                                                                    \
+            m++;                                                                                   \
+        }                                                                                          \
     } while (0)
     COL("density", 1, f->density);
     COL("temperature", 1, f->temperature);
@@ -654,7 +657,8 @@ static void write_files(lua_State *L, int arg, const char *call, const cg_state 
     lua_pop(L, 4);
 }
 
-/* ---- analysis.coarse_grain -------------------------------------------------------------------- */
+/* ---- analysis.coarse_grain --------------------------------------------------------------------
+ */
 static int scene_kind(lua_State *L, int idx)
 {
     if (luaL_testudata(L, idx, "dem.scene"))
@@ -744,7 +748,8 @@ static int l_coarse_grain(lua_State *L)
     return 1;
 }
 
-/* ---- analysis.cg_average ---------------------------------------------------------------------- */
+/* ---- analysis.cg_average ----------------------------------------------------------------------
+ */
 static cg_state *check_average(lua_State *L, int idx)
 {
     return bind_check_self(L, idx, AVERAGE, "cg_average");
@@ -859,15 +864,15 @@ static int l_avg_tostring(lua_State *L)
     return 1;
 }
 
-/* ---- render.coarse_grain ----------------------------------------------------------------------- */
+/* ---- render.coarse_grain -----------------------------------------------------------------------
+ */
 static const char *const RCG_FIELDS[] = {
-    "file",     "show",          "tensor", "glyphs", "glyph_every", "arrows", "arrow_every",
-    "colormap", "interpolation", "range",  "width",  "height",      "title",  "label",
-    "colorbar", "box",           NULL};
-static const char *const SHOWS[] = {"psd",         "pressure",        "major", "minor",
-                                    "xx",          "xy",              "yx",    "yy",
-                                    "density",     "speed",           "temperature",
-                                    "volume_fraction", "displacement", "none", NULL};
+    "file",        "show",     "tensor",        "glyphs", "glyph_every", "arrows",
+    "arrow_every", "colormap", "interpolation", "range",  "width",       "height",
+    "title",       "label",    "colorbar",      "box",    NULL};
+static const char *const SHOWS[] = {
+    "psd",     "pressure", "major",       "minor",           "xx",           "xy",   "yx", "yy",
+    "density", "speed",    "temperature", "volume_fraction", "displacement", "none", NULL};
 static const char *const TENSORS[] = {"stress", "contact", "kinetic", "internal", "fabric", NULL};
 static const char *const ARROWS[] = {"velocity", "displacement", NULL};
 static const char *const CMAPS[] = {"viridis", "gray", NULL};
@@ -882,8 +887,10 @@ static int l_image_gc(lua_State *L)
 /* "bad argument #1 to 'coarse_grain' (fields of analysis.coarse_grain expected, WHY)" */
 static int fields_error(lua_State *L, const char *call, const char *why)
 {
-    return luaL_error(L, "bad argument #1 to '%s' (the fields of analysis.coarse_grain (a grid) "
-                         "expected, %s)", call, why);
+    return luaL_error(L,
+                      "bad argument #1 to '%s' (the fields of analysis.coarse_grain (a grid) "
+                      "expected, %s)",
+                      call, why);
 }
 
 /* The array t[key] (t at tab, or t[key1][key2] when key2) of exactly n numbers or NaN, as a
@@ -939,10 +946,10 @@ static int l_render_cg(lua_State *L)
     const int arrows = bind_field_option(L, 2, call, "arrows", ARROWS, -1, 0);
     render_cg_def d = render_default_cg_def();
     d.field.arrow_every = (int)bind_field_integer(L, 2, call, "arrow_every", 0, 0, 100000, 0);
-    d.field.colormap = (render_colormap)bind_field_option(L, 2, call, "colormap", CMAPS,
-                                                          RENDER_VIRIDIS, 0);
-    d.field.interp = (render_interp)bind_field_option(L, 2, call, "interpolation", INTERP,
-                                                      RENDER_NEAREST, 0);
+    d.field.colormap =
+        (render_colormap)bind_field_option(L, 2, call, "colormap", CMAPS, RENDER_VIRIDIS, 0);
+    d.field.interp =
+        (render_interp)bind_field_option(L, 2, call, "interpolation", INTERP, RENDER_NEAREST, 0);
     if (lua_getfield(L, 2, "range") != LUA_TNIL) {
         int ok = lua_type(L, -1) == LUA_TTABLE && lua_rawlen(L, -1) == 2;
         for (int k = 0; ok && k < 2; k++) {
@@ -956,10 +963,10 @@ static int l_render_cg(lua_State *L)
             bind_field_error(L, 2, call, "range", "{lo, hi} with lo < hi");
     }
     lua_pop(L, 1);
-    d.field.width = (int)bind_field_integer(L, 2, call, "width", 0, RENDER_MIN_SIZE,
-                                            RENDER_MAX_SIZE, 0);
-    d.field.height = (int)bind_field_integer(L, 2, call, "height", 0, RENDER_MIN_SIZE,
-                                             RENDER_MAX_SIZE, 0);
+    d.field.width =
+        (int)bind_field_integer(L, 2, call, "width", 0, RENDER_MIN_SIZE, RENDER_MAX_SIZE, 0);
+    d.field.height =
+        (int)bind_field_integer(L, 2, call, "height", 0, RENDER_MIN_SIZE, RENDER_MAX_SIZE, 0);
     d.field.title = bind_field_string(L, 2, call, "title", NULL, 0);
     const char *label = bind_field_string(L, 2, call, "label", NULL, 0);
     d.field.colorbar = bind_field_boolean(L, 2, call, "colorbar", 1);
@@ -1012,11 +1019,20 @@ static int l_render_cg(lua_State *L)
     d.field.extent[0][1] = lo[1];
     d.field.extent[1][0] = hi[0];
     d.field.extent[1][1] = hi[1];
-    static const char *const names[14] = {"principal difference", "pressure", "major principal value",
-                                          "minor principal value", "xx", "xy", "yx", "yy",
-                                          "density (kg/m^3)", "speed (m/s)",
-                                          "granular temperature (m^2/s^2)", "volume fraction",
-                                          "displacement (m)", ""};
+    static const char *const names[14] = {"principal difference",
+                                          "pressure",
+                                          "major principal value",
+                                          "minor principal value",
+                                          "xx",
+                                          "xy",
+                                          "yx",
+                                          "yy",
+                                          "density (kg/m^3)",
+                                          "speed (m/s)",
+                                          "granular temperature (m^2/s^2)",
+                                          "volume fraction",
+                                          "displacement (m)",
+                                          ""};
     char autolabel[96];
     if (show <= 7) {
         d.field.values = fields_array(L, 1, TENSORS[tensor], SHOWS[show], n, call);
@@ -1088,13 +1104,13 @@ static int l_render_cg(lua_State *L)
     return 1;
 }
 
-#define OPTIONS_DOC                                                                               \
+#define OPTIONS_DOC                                                                                \
     "kernel 'gauss' (exp(-r^2/2w^2) cut at `cutoff`, default 3 w, normalised over the cut "        \
-    "support) or 'lucy' (the polynomial 1 - 6x^2 + 8x^3 - 3x^4 of x = r/w: its cutoff is w); "    \
-    "cells = {nx, ny[, nz]} over region (default: the scene's box), fields at the cell centres, " \
-    "x fastest from the bottom row; or points = {x =, y =[, z =]}; depth (2D: the fields per "    \
-    "area divided by it; default the scene's thickness, else 1: per metre); contacts = true "     \
-    "(DEM: contact stress, fabric, wall traction); displacement = false (DEM, since "             \
+    "support) or 'lucy' (the polynomial 1 - 6x^2 + 8x^3 - 3x^4 of x = r/w: its cutoff is w); "     \
+    "cells = {nx, ny[, nz]} over region (default: the scene's box), fields at the cell centres, "  \
+    "x fastest from the bottom row; or points = {x =, y =[, z =]}; depth (2D: the fields per "     \
+    "area divided by it; default the scene's thickness, else 1: per metre); contacts = true "      \
+    "(DEM: contact stress, fabric, wall traction); displacement = false (DEM, since "              \
     "s:set_reference); vtk = 'f.vti' (grids) and csv = 'f.csv' write the fields whole."
 
 void bind_open_coarse_grain(lua_State *L)
@@ -1114,8 +1130,10 @@ void bind_open_coarse_grain(lua_State *L)
          "samples, points, seconds (wall) and cpu_seconds spent sampling, time_first, "
          "time_last, contacts (of the last sample)."},
         {NULL, NULL, NULL, NULL}};
-    static const luaL_Reg meta[] = {
-        {"__gc", l_state_gc}, {"__close", l_state_gc}, {"__tostring", l_avg_tostring}, {NULL, NULL}};
+    static const luaL_Reg meta[] = {{"__gc", l_state_gc},
+                                    {"__close", l_state_gc},
+                                    {"__tostring", l_avg_tostring},
+                                    {NULL, NULL}};
     bind_new_type(L, AVERAGE, methods, meta,
                   "A time average of coarse-grained fields from analysis.cg_average: add samples "
                   "with avg:add(scene), read them with avg:fields().");
@@ -1128,8 +1146,8 @@ void bind_open_coarse_grain(lua_State *L)
          "{nx, ny}, region = {{x0, y0}, {x1, y1}}, points = {x =, y =}, depth =, contacts = "
          "true, displacement = false, vtk =, csv = })",
          "Continuum fields of a DEM scene (particles and contacts) or an MPM scene (points) by "
-         "kernel coarse-graining (Weinhart et al. 2012, Goldhirsch 2010; MercuryCG's kernels). "
-         OPTIONS_DOC
+         "kernel coarse-graining (Weinhart et al. 2012, Goldhirsch 2010; MercuryCG's "
+         "kernels). " OPTIONS_DOC
          " Returns a table: dim, kernel, width, cutoff, depth (2D), n, time, cells, region, "
          "cell_volume (grids), x, y(, z) (the points), density, velocity = {x =, y =}, "
          "temperature (tr kinetic / (dim rho)), volume_fraction, and tensors (compression "
@@ -1143,8 +1161,8 @@ void bind_open_coarse_grain(lua_State *L)
          "points) and displacement. Fields are NaN where the density is 0. seconds: time "
          "spent."},
         {"cg_average", l_cg_average,
-         "analysis.cg_average(scene, { kernel =, width =, cells =, region =, points =, depth "
-         "=, contacts =, displacement = })",
+         "analysis.cg_average(scene, { kernel =, width =, cutoff =, cells =, region =, points =, "
+         "depth =, contacts =, displacement = })",
          "A time average of coarse-grained fields over a run, with the options of "
          "analysis.coarse_grain (scene fixes the kind, dimension, box and defaults; it is not "
          "sampled). Add samples with avg:add(scene) (from on_step), read avg:fields()."},

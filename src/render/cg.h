@@ -7,15 +7,15 @@
 #include "render/render.h"
 
 typedef struct render_cg_def {
-    render_field_def field;      /* the colours (and arrows): as render_field takes them */
+    render_field_def field; /* the colours (and arrows): as render_field takes them */
     /* Glyphs: a segment at the centre of each block of glyph_every x glyph_every cells, along the
      * major principal direction angle[k] (rad from x) of the cell there, of length (value[k] / max
      * value) x 0.9 x the glyph spacing; NULL angle: none. Cells without a finite angle or
      * value, or masked, get none. */
     const double *glyph_angle;
-    const double *glyph_value;   /* e.g. the principal stress difference; NULL: all full length */
-    int glyph_every;             /* a glyph every k-th cell along x and y; 0: about 28 across */
-    unsigned char glyph_rgb[3];  /* their colour */
+    const double *glyph_value;  /* e.g. the principal stress difference; NULL: all full length */
+    int glyph_every;            /* a glyph every k-th cell along x and y; 0: about 28 across */
+    unsigned char glyph_rgb[3]; /* their colour */
 } render_cg_def;
 
 render_cg_def render_default_cg_def(void); /* render_default_field_def, dark red glyphs */

@@ -117,8 +117,7 @@ static void test_line_integral(void **state)
                 double c = analysis_cg_reach(&q.def);
                 for (int a = 0; a < 3; a++) {
                     q.d[a] = a < dim ? (rng_uniform(&g) * 2 - 1) * 1.2 * c : 0;
-                    q.b[a] = a < dim ? (rng_uniform(&g) * 2 - 1) * (trial % 3 ? 0.5 : 2.5) * c
-                                     : 0;
+                    q.b[a] = a < dim ? (rng_uniform(&g) * 2 - 1) * (trial % 3 ? 0.5 : 2.5) * c : 0;
                 }
                 if (trial == 7) /* the point on the line */
                     for (int a = 0; a < 3; a++)
@@ -240,9 +239,8 @@ static void grid_integrals(const analysis_cg_def *def, const cluster *k, double 
     analysis_cg_grid_points(D, nc, glo, ghi, pts);
     double *out = malloc(n * (size_t)l->stride * sizeof(double));
     core_error err;
-    assert_int_equal(analysis_cg_sums(def, &k->p, &k->c, l, n, (const double *const *)pts, out,
-                                      &err),
-                     CORE_OK);
+    assert_int_equal(
+        analysis_cg_sums(def, &k->p, &k->c, l, n, (const double *const *)pts, out, &err), CORE_OK);
     double cell = pow((hi - lo) / cells, D);
     for (int q = 0; q < l->stride; q++) {
         double s = 0;
@@ -276,10 +274,10 @@ static void check_totals(const analysis_cg_def *def, const cluster *k, const ana
             if (k->wall[q])
                 tr[a] += k->f[a][q];
         }
-#define NEAR(got, want, scale)                                                                    \
-    do {                                                                                          \
-        if (fabs((got) - (want)) > tol * (scale))                                                 \
-            fail_msg("%s: grid %.17g, total %.17g (tol %g)", #want, (got), (want), tol);          \
+#define NEAR(got, want, scale)                                                                     \
+    do {                                                                                           \
+        if (fabs((got) - (want)) > tol * (scale))                                                  \
+            fail_msg("%s: grid %.17g, total %.17g (tol %g)", #want, (got), (want), tol);           \
     } while (0)
     NEAR(tot[l->offset[ANALYSIS_CG_DENSITY]], mass, mass);
     NEAR(tot[l->offset[ANALYSIS_CG_VOLUME]], vol, vol);
@@ -548,10 +546,10 @@ static void test_bad_input(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_normalised),    cmocka_unit_test(test_line_integral),
-        cmocka_unit_test(test_exact_totals),  cmocka_unit_test(test_divergence),
-        cmocka_unit_test(test_periodic),      cmocka_unit_test(test_threads_same_bits),
-        cmocka_unit_test(test_invariants),    cmocka_unit_test(test_bad_input),
+        cmocka_unit_test(test_normalised),   cmocka_unit_test(test_line_integral),
+        cmocka_unit_test(test_exact_totals), cmocka_unit_test(test_divergence),
+        cmocka_unit_test(test_periodic),     cmocka_unit_test(test_threads_same_bits),
+        cmocka_unit_test(test_invariants),   cmocka_unit_test(test_bad_input),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
