@@ -314,6 +314,13 @@ typedef struct dem_contact_info {
 /* Calls fn for each contact (pairs and walls) in a fixed order. */
 void dem_each_contact(dem_scene *s, void (*visit)(const dem_contact_info *c, void *ctx),
                       void *ctx);
+/* The same contacts in the same order, with force the whole force on i for wall contacts too:
+ * the normal part plus the friction, rebuilt as the force loop makes it (the spring's stored
+ * force, or the viscous or regularised law against the slip now). */
+void dem_each_contact_full(dem_scene *s, void (*visit)(const dem_contact_info *c, void *ctx),
+                           void *ctx);
+/* The periodic axes given at creation. */
+void dem_periodic(const dem_scene *s, bool periodic[3]);
 
 /* Assembly stress sigma_ab = (1/V) sum_c branch_a f_b over particle pairs (V = domain volume,
  * or area in 2D unless given). Returns the number of contacts. */

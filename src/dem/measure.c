@@ -396,3 +396,114 @@ core_status dem_measure_displacement(const dem_scene *s, const double grad_u[3][
         }
     return CORE_OK;
 }
+
+/* ---- contacts with the walls' friction (coarse-graining) ------------------------------------ */
+typedef struct pairs_only {
+    void (*visit)(const dem_contact_info *c, void *ctx);
+    void *ctx;
+} pairs_only;
+
+static void visit_pair(const dem_contact_info *c, void *ctx)
+{
+    const pairs_only *p = ctx;
+    if (c->j >= 0)
+        p->visit(c, p->ctx);
+}
+
+/* The tangential force vector of a wall contact now, as wall_tangential gives its length: the
+ * spring's stored force (capped at mu f_n), or the viscous or regularised law against the slip
+ * of the contact point (2D: along t = (-n_y, n_x)). */
+static void wall_tangential_vector(const dem_scene *s, const dem_wall *wl, const dem_wall_hit *hit,
+                                   int first, size_t i, double ft, double out[3])
+{
+    const int D = s->dim;
+    const double *n = hit->n;
+    double vr[3] = {0, 0, 0}, vn = 0, sl[3] = {0, 0, 0}, t[3] = {-n[1], n[0], 0};
+    for (int d = 0; d < 3; d++)
+        out[d] = 0;
+    for (int d = 0; d < D; d++) {
+        vr[d] = s->v[d][i] - hit->vel[d];
+        vn += vr[d] * n[d];
+    }
+    if (D == 2) {
+        sl[0] = -vr[0] * n[1] + vr[1] * n[0] - (s->rot ? s->r[i] * s->w[2][i] : 0);
+    } else {
+        double om[3] = {0, 0, 0};
+        for (int d = 0; s->rot && d < 3; d++)
+            om[d] = s->r[i] * s->w[d][i];
+        const double oxn[3] = {om[1] * n[2] - om[2] * n[1], om[2] * n[0] - om[0] * n[2],
+                               om[0] * n[1] - om[1] * n[0]};
+        for (int d = 0; d < 3; d++)
+            sl[d] = vr[d] - vn * n[d] - oxn[d];
+    }
+    if (s->contact.tangential == DEM_TANGENT_SPRING) {
+        if (!wl->hist[0] || !first)
+            return;
+        if (D == 2) {
+            const double f = fmax(-ft, fmin(ft, wl->hist[0][i]));
+            for (int d = 0; d < 2; d++)
+                out[d] = f * t[d];
+            return;
+        }
+        double h2 = 0;
+        for (int d = 0; d < 3; d++)
+            h2 += wl->hist[d][i] * wl->hist[d][i];
+        const double scale = h2 > 0 ? ft / sqrt(h2) : 0;
+        for (int d = 0; d < 3; d++)
+            out[d] = scale * wl->hist[d][i];
+        return;
+    }
+    double s2 = 0;
+    for (int d = 0; d < (D == 2 ? 1 : 3); d++)
+        s2 += sl[d] * sl[d];
+    if (!(s2 > 0))
+        return;
+    const double k = -ft / sqrt(s2); /* against the slip, of length ft */
+    if (D == 2)
+        for (int d = 0; d < 2; d++)
+            out[d] = k * sl[0] * t[d];
+    else
+        for (int d = 0; d < 3; d++)
+            out[d] = k * sl[d];
+}
+
+void dem_each_contact_full(dem_scene *s, void (*visit)(const dem_contact_info *c, void *ctx),
+                           void *ctx)
+{
+    const int D = s->dim;
+    pairs_only po = {visit, ctx};
+    dem_each_contact(s, visit_pair, &po);
+    for (int w = 0; w < s->nwalls; w++) {
+        const dem_wall *wl = &s->walls[w];
+        if (!wl->active)
+            continue;
+        for (size_t i = 0; i < s->n; i++) {
+            dem_wall_hit hit[DEM_WALL_MAXHIT];
+            const int nh = wall_hits(s, wl, i, hit);
+            for (int h = 0; h < nh; h++) {
+                double delta = s->r[i] - hit[h].dist;
+                dem_contact_info c = {.i = (long)i, .j = -(long)w - 1, .overlap = delta};
+                double k, gamma, mu, vn = 0, ftv[3];
+                dem_wall_parameters(s, wl, i, &k, &gamma, &mu);
+                for (int d = 0; d < 3; d++) {
+                    c.normal[d] = hit[h].n[d];
+                    c.point[d] = hit[h].point[d];
+                }
+                for (int d = 0; d < D; d++)
+                    vn += (s->v[d][i] - hit[h].vel[d]) * hit[h].n[d];
+                c.fn = dem_normal_force(&s->contact, k, gamma, delta, -vn);
+                c.ft = wall_tangential(s, wl, &hit[h], h == 0, i, c.fn, k, mu, delta);
+                wall_tangential_vector(s, wl, &hit[h], h == 0, i, c.ft, ftv);
+                for (int d = 0; d < D; d++)
+                    c.force[d] = c.fn * hit[h].n[d] + ftv[d];
+                visit(&c, ctx);
+            }
+        }
+    }
+}
+
+void dem_periodic(const dem_scene *s, bool periodic[3])
+{
+    for (int d = 0; d < 3; d++)
+        periodic[d] = s->periodic[d];
+}

@@ -214,6 +214,9 @@ void bind_open_dsmc(lua_State *L);
 /* Registers the global `analysis` module and the boundary-condition methods of dem.scene
  * (lua_analysis.c); after bind_open_dem. */
 void bind_open_analysis(lua_State *L);
+/* analysis.coarse_grain, analysis.cg_average and render.coarse_grain (lua_coarse_grain.c); after
+ * bind_open_analysis and bind_open_render. */
+void bind_open_coarse_grain(lua_State *L);
 /* dem.load's restorer of the Delaunay boundary update s:boundary installs (lua_analysis.c). */
 const struct dem_boundary_restorer *bind_dem_boundary_restorer(void);
 /* s:save and dem.load (lua_checkpoint.c); after bind_open_dem. */
@@ -221,6 +224,8 @@ void bind_open_checkpoint(lua_State *L);
 
 /* Registers the global `render` module (lua_render.c). */
 void bind_open_render(lua_State *L);
+/* The renderer's context, created on first use and closed with the state (lua_render.c). */
+struct render_context *bind_render_context(lua_State *L, const char *call);
 
 /* luaL_checkoption that helps: the error lists the valid names and suggests the closest one
  * ("invalid option 'stres'; did you mean 'stress'? Valid options: 'energy', 'stress', ...").

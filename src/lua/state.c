@@ -71,6 +71,7 @@ static int open_grainlab(lua_State *L)
     bind_open_dsmc(L);
     bind_open_checkpoint_mpm(L);
     bind_open_render(L);
+    bind_open_coarse_grain(L); /* analysis.coarse_grain, render.coarse_grain (lua_coarse_grain.c) */
     bind_open_vtk(L); /* after the engines: adds write_vtk to their scene types */
     bind_open_lammps(L); /* LAMMPS files for dem (lua_lammps.c) */
 

@@ -113,6 +113,8 @@ calls["analysis.mesh:write_vtk"] = {
   args = function(ctx) return { vtkdir .. "/m.vtu", ctx.s, { depth = 2e-3, stress = true, cells = { q = { 1, 2, 3 } } } } end,
   accept = { depth = OPT, stress = { "nil", "boolean" }, cells = { "nil", "empty" } } }
 local skip = {}
+skip["analysis.coarse_grain"] = "fuzzed by test_fuzz_coarse_grain.lua"
+skip["analysis.cg_average"] = "fuzzed by test_fuzz_coarse_grain.lua"
 -- The methods dem.scene has from lua_dem.c are fuzzed by test_fuzz_dem.lua.
 for _, k in ipairs{ "contact", "add_disk", "add_sphere", "add_wall", "remove_wall", "wall_velocity",
                     "wall_point", "wall_force", "wall_servo", "set_velocity", "timestep", "run", "measure",

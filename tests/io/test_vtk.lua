@@ -369,6 +369,41 @@ do
   expect("cell shapes3_walls.vtu kind 3 0 3")
 end
 
+-- ---- coarse-grained fields (analysis.coarse_grain's vtk =): ImageData with the cell centres as
+-- points, scalars, vectors (3 components) and tensors (3 x 3) as point data -------------------------
+do
+  local s = dem.scene{ dim = 2, box = { { 0, 0 }, { 0.01, 0.01 } }, gravity = { 0, -9.81 }, thickness = 1e-3 }
+  s:add_wall{ point = { 0, 0 }, normal = { 0, 1 } }
+  for k, p in ipairs{ { 0.002, 0.0005 }, { 0.0029, 0.0005 }, { 0.0025, 0.0012 } } do
+    s:add_disk{ pos = p, radius = 0.0005, vel = { 0.01 * k, 0 } }
+  end
+  local F = analysis.coarse_grain(s, { width = 1e-3, cells = { 5, 4 }, region = { { 0, 0 }, { 0.01, 0.008 } },
+                                       vtk = P("cg.vti") })
+  expect("open cg.vti vti 20 12")
+  expect("image cg.vti 5 4 1 %s %s 0 %s %s 1", g17(0.001), g17(0.001), g17(0.002), g17(0.002))
+  expect("ncomp point cg.vti density 1")
+  expect("ncomp point cg.vti velocity 3")
+  expect("ncomp point cg.vti stress 9")
+  expect("type point cg.vti stress Float64")
+  for _, k in ipairs{ 1, 7, 12 } do
+    expect("point cg.vti density %d 0 %s", k - 1, g17(F.density[k]))
+    expect("point cg.vti stress %d 1 %s", k - 1, g17(F.stress.xy[k]))
+    expect("point cg.vti stress %d 4 %s", k - 1, g17(F.stress.yy[k]))
+    expect("point cg.vti stress %d 8 0", k - 1)
+    expect("point cg.vti traction %d 1 %s", k - 1, g17(F.traction.y[k]))
+    local vx = F.velocity.x[k]
+    expect("point cg.vti velocity %d 0 %s", k - 1, vx ~= vx and "nan" or g17(vx))
+    expect("point cg.vti psd %d 0 %s", k - 1, g17(F.stress.psd[k]))
+  end
+  local s3 = dem.scene{ dim = 3, box = { { 0, 0, 0 }, { 0.01, 0.01, 0.01 } } }
+  s3:add_sphere{ pos = { 0.005, 0.005, 0.005 }, radius = 0.001 }
+  s3:add_sphere{ pos = { 0.0069, 0.005, 0.005 }, radius = 0.001 }
+  local F3 = analysis.coarse_grain(s3, { width = 1e-3, cells = { 4, 3, 2 }, vtk = P("cg3.vti") })
+  expect("open cg3.vti vti 24 6")
+  expect("point cg3.vti density 9 0 %s", g17(F3.density[10]))
+  expect("point cg3.vti fabric 9 0 %s", g17(F3.fabric.xx[10]))
+end
+
 -- ---- VTK reads it all --------------------------------------------------------------------------
 local ef = assert(io.open(P("expect.txt"), "w"))
 ef:write(table.concat(lines, "\n"), "\n")

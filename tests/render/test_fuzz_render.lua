@@ -83,7 +83,8 @@ local calls = {
 }
 
 local ok, err = pcall(fuzz.run, { modules = { render = render },
-  types = { ["render.image"] = render.image(scene(), { width = 128, height = 128 }) }, calls = calls })
+  types = { ["render.image"] = render.image(scene(), { width = 128, height = 128 }) }, calls = calls,
+  skip = { ["render.coarse_grain"] = "fuzzed by test_fuzz_coarse_grain.lua" } })
 os.remove(tmp)
 os.remove(png)
 if not ok then error(err, 0) end
