@@ -7,8 +7,9 @@
  * of 0s and 1s (or of zeros), minima, maxima. A floating-point sum as an omp simd reduction would
  * break that (its order follows the vector width): tests/cli/isa_same_bits.sh compares the two
  * clones' runs of every engine. Where the hot kernels are: the MPM step's stages (STAGE in
- * src/mpm/step.c) and DEM's pair kernel, force gather, walls and integration passes. DSMC has
- * none: its clones run no faster (a step of scattered memory accesses).
+ * src/mpm/transfer.c, contact.c and stress.c) and DEM's pair kernel, force gather, walls and
+ * integration passes. DSMC has none: its clones run no faster (a step of scattered memory
+ * accesses).
  *
  * Empty (one compilation) elsewhere: another compiler or architecture, a build whose -march
  * already has AVX2 (GRAINLAB_MARCH), or GRAINLAB_NO_CLONES (CMake GRAINLAB_CLONES=OFF, which the

@@ -21,13 +21,9 @@
  * particles in identity order through a small permutation (dsmc_cell_perm) instead, and the
  * arrays are put in that order only between runs (dsmc_order_cells), for everything that reads
  * them.
- * The price of that independence, one process, one thread, against the code before identities
- * (callgrind instructions; speed from 3 alternating runs each on a quiet machine): the cooling
- * benchmark (20 per cell) +18% (642 M against 542 M for 10^5 particles x 20 steps: the ranks
- * 68 M, the indirection in the collisions 18 M, the identities carried by the sort 6 M) and
- * 0.87x the speed; Herrmann's Fig. 2 gas (0.7 per cell) +8% and 0.87x (the identities add a
- * tenth to the bytes the sort moves). Ranks by an insertion sort cost +28% and 0.70-0.80x on
- * the former (3 times the mispredicted branches), ordering the arrays every step +33%. */
+ * What that independence costs one process: the ranks, the indirection in the collisions and
+ * the identities the sort carries, most of it the ranks (callgrind). Ranks by an insertion sort
+ * (three times the mispredicted branches) and ordering the arrays every step both cost more. */
 
 static inline __attribute__((always_inline)) void swap_particles(dsmc_scene *s, size_t i, size_t j)
 {

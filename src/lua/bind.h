@@ -224,8 +224,6 @@ void bind_open_checkpoint(lua_State *L);
 
 /* Registers the global `render` module (lua_render.c). */
 void bind_open_render(lua_State *L);
-/* The renderer's context, created on first use and closed with the state (lua_render.c). */
-struct render_context *bind_render_context(lua_State *L, const char *call);
 
 /* luaL_checkoption that helps: the error lists the valid names and suggests the closest one
  * ("invalid option 'stres'; did you mean 'stress'? Valid options: 'energy', 'stress', ...").

@@ -9,6 +9,7 @@
 #include "core/clock.h"
 #include "dem/dem.h"
 #include "lua/bind.h"
+#include "lua/lua_render.h"
 #include "mpm/mpm.h"
 #include "render/cg.h"
 

@@ -781,6 +781,3 @@ void bind_open_render(lua_State *L)
              "clouds (MPM, DSMC), colour maps, text, colour bars and line plots, written as PNG.");
     lua_setglobal(L, "render");
 }
-
-/* The shared render context for other bindings (lua_coarse_grain.c). */
-render_context *bind_render_context(lua_State *L, const char *call) { return context(L, call); }

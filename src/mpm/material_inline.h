@@ -1,5 +1,5 @@
 /* The constitutive update of material.c as inline functions, so that the step's stress update
- * (src/mpm/step.c) inlines it; material.c's mpm_material_update and mpm_elastic_energy_density
+ * (src/mpm/stress.c) inlines it; material.c's mpm_material_update and mpm_elastic_energy_density
  * call the same code. */
 #ifndef GRAINLAB_MPM_MATERIAL_INLINE_H
 #define GRAINLAB_MPM_MATERIAL_INLINE_H
