@@ -71,76 +71,88 @@ static double *fields_array(lua_State *L, int tab, const char *key1, const char 
     return v;
 }
 
-static int l_render_cg(lua_State *L)
+/* What render.coarse_grain draws: the renderer's definition, and the options that choose what is
+ * read from the fields and where the image goes. */
+typedef struct rcg_plot {
+    render_cg_def d;
+    const char *file, *label;
+    int show, tensor, glyphs, every, arrows;
+    char autolabel[96]; /* the colour bar's label when `label` is not given */
+} rcg_plot;
+
+/* The options (argument #2) into p, in the order the usage line lists them. */
+static void read_options(lua_State *L, const char *call, rcg_plot *p)
 {
-    const char *call = "coarse_grain";
-    lua_settop(L, 2);
-    if (!lua_istable(L, 1))
-        return bind_arg_error(L, 1, call, "table (the fields of analysis.coarse_grain)");
     bind_check_table(L, 2, call);
     bind_check_fields(L, 2, call, RCG_FIELDS);
-    const char *file = bind_field_path(L, 2, call, "file", BIND_REQUIRED);
-    const int show = bind_field_option(L, 2, call, "show", SHOWS, 0, 0);
-    const int tensor = bind_field_option(L, 2, call, "tensor", TENSORS, 0, 0);
-    const int invariant = show <= 3;
-    const int glyphs = bind_field_boolean(L, 2, call, "glyphs", invariant);
-    const int every = (int)bind_field_integer(L, 2, call, "glyph_every", 0, 0, 100000, 0);
-    const int arrows = bind_field_option(L, 2, call, "arrows", ARROWS, -1, 0);
-    render_cg_def d = render_default_cg_def();
-    d.field.arrow_every = (int)bind_field_integer(L, 2, call, "arrow_every", 0, 0, 100000, 0);
-    d.field.colormap =
+    p->file = bind_field_path(L, 2, call, "file", BIND_REQUIRED);
+    p->show = bind_field_option(L, 2, call, "show", SHOWS, 0, 0);
+    p->tensor = bind_field_option(L, 2, call, "tensor", TENSORS, 0, 0);
+    const int invariant = p->show <= 3;
+    p->glyphs = bind_field_boolean(L, 2, call, "glyphs", invariant);
+    p->every = (int)bind_field_integer(L, 2, call, "glyph_every", 0, 0, 100000, 0);
+    p->arrows = bind_field_option(L, 2, call, "arrows", ARROWS, -1, 0);
+    p->d = render_default_cg_def();
+    render_cg_def *d = &p->d;
+    d->field.arrow_every = (int)bind_field_integer(L, 2, call, "arrow_every", 0, 0, 100000, 0);
+    d->field.colormap =
         (render_colormap)bind_field_option(L, 2, call, "colormap", CMAPS, RENDER_VIRIDIS, 0);
-    d.field.interp =
+    d->field.interp =
         (render_interp)bind_field_option(L, 2, call, "interpolation", INTERP, RENDER_NEAREST, 0);
     if (lua_getfield(L, 2, "range") != LUA_TNIL) {
         int ok = lua_type(L, -1) == LUA_TTABLE && lua_rawlen(L, -1) == 2;
         for (int k = 0; ok && k < 2; k++) {
             lua_rawgeti(L, -1, k + 1);
             int isnum;
-            d.field.range[k] = lua_tonumberx(L, -1, &isnum);
-            ok = isnum && lua_type(L, -1) == LUA_TNUMBER && fabs(d.field.range[k]) <= 1e100;
+            d->field.range[k] = lua_tonumberx(L, -1, &isnum);
+            ok = isnum && lua_type(L, -1) == LUA_TNUMBER && fabs(d->field.range[k]) <= 1e100;
             lua_pop(L, 1);
         }
-        if (!ok || !(d.field.range[0] < d.field.range[1]))
+        if (!ok || !(d->field.range[0] < d->field.range[1]))
             bind_field_error(L, 2, call, "range", "{lo, hi} with lo < hi");
     }
     lua_pop(L, 1);
-    d.field.width =
+    d->field.width =
         (int)bind_field_integer(L, 2, call, "width", 0, RENDER_MIN_SIZE, RENDER_MAX_SIZE, 0);
-    d.field.height =
+    d->field.height =
         (int)bind_field_integer(L, 2, call, "height", 0, RENDER_MIN_SIZE, RENDER_MAX_SIZE, 0);
-    d.field.title = bind_field_string(L, 2, call, "title", NULL, 0);
-    const char *label = bind_field_string(L, 2, call, "label", NULL, 0);
-    d.field.colorbar = bind_field_boolean(L, 2, call, "colorbar", 1);
-    d.field.box = bind_field_boolean(L, 2, call, "box", 1);
-    if (show == 13 && arrows < 0 && !glyphs) {
+    d->field.title = bind_field_string(L, 2, call, "title", NULL, 0);
+    p->label = bind_field_string(L, 2, call, "label", NULL, 0);
+    d->field.colorbar = bind_field_boolean(L, 2, call, "colorbar", 1);
+    d->field.box = bind_field_boolean(L, 2, call, "box", 1);
+    if (p->show == 13 && p->arrows < 0 && !p->glyphs) {
         lua_getfield(L, 2, "show");
         bind_field_error(L, 2, call, "show", "a field ('none' draws arrows or glyphs only)");
     }
-    /* the grid: cells and region of a 2D grid (3D: one layer in z) */
+}
+
+/* The grid of the fields (argument #1): cells and region of a 2D grid (3D: one layer in z) into
+ * d; returns the number of cells. */
+static size_t read_grid(lua_State *L, const char *call, render_cg_def *d)
+{
     lua_getfield(L, 1, "dim");
     const lua_Integer dim = lua_tointeger(L, -1);
     lua_pop(L, 1);
     if (dim != 2 && dim != 3)
-        return fields_error(L, call, "no dim 2 or 3");
+        fields_error(L, call, "no dim 2 or 3");
     int cells[3] = {1, 1, 1};
     if (lua_getfield(L, 1, "cells") != LUA_TTABLE || lua_rawlen(L, -1) != (size_t)dim)
-        return fields_error(L, call, "no 'cells' (fields at points cannot be drawn)");
+        fields_error(L, call, "no 'cells' (fields at points cannot be drawn)");
     for (int a = 0; a < dim; a++) {
         lua_rawgeti(L, -1, a + 1);
         int isint;
         lua_Integer v = lua_tointegerx(L, -1, &isint);
         if (!isint || v < 1 || v > 100000)
-            return fields_error(L, call, "'cells' of positive integers");
+            fields_error(L, call, "'cells' of positive integers");
         cells[a] = (int)v;
         lua_pop(L, 1);
     }
     lua_pop(L, 1);
     if (dim == 3 && cells[2] != 1)
-        return fields_error(L, call, "a 2D grid (3D: one layer of cells in z)");
+        fields_error(L, call, "a 2D grid (3D: one layer of cells in z)");
     double lo[3], hi[3];
     if (lua_getfield(L, 1, "region") != LUA_TTABLE || lua_rawlen(L, -1) != 2)
-        return fields_error(L, call, "no 'region'");
+        fields_error(L, call, "no 'region'");
     for (int c = 0; c < 2; c++) {
         lua_rawgeti(L, -1, c + 1);
         for (int a = 0; a < 2; a++) {
@@ -148,19 +160,28 @@ static int l_render_cg(lua_State *L)
             int isnum;
             (c ? hi : lo)[a] = lua_tonumberx(L, -1, &isnum);
             if (!isnum || !isfinite((c ? hi : lo)[a]))
-                return fields_error(L, call, "'region' of finite corners");
+                fields_error(L, call, "'region' of finite corners");
             lua_pop(L, 1);
         }
         lua_pop(L, 1);
     }
     lua_pop(L, 1);
     const size_t n = (size_t)cells[0] * (size_t)cells[1];
-    d.field.nx = cells[0];
-    d.field.ny = cells[1];
-    d.field.extent[0][0] = lo[0];
-    d.field.extent[0][1] = lo[1];
-    d.field.extent[1][0] = hi[0];
-    d.field.extent[1][1] = hi[1];
+    d->field.nx = cells[0];
+    d->field.ny = cells[1];
+    d->field.extent[0][0] = lo[0];
+    d->field.extent[0][1] = lo[1];
+    d->field.extent[1][0] = hi[0];
+    d->field.extent[1][1] = hi[1];
+    return n;
+}
+
+/* The values shown (field `show`, of `tensor` for its components and invariants) and their
+ * automatic label; the arrays stay on the stack. */
+static void read_values(lua_State *L, const char *call, rcg_plot *p, size_t n)
+{
+    render_cg_def *d = &p->d;
+    const int show = p->show, tensor = p->tensor;
     static const char *const names[14] = {"principal difference",
                                           "pressure",
                                           "major principal value",
@@ -175,22 +196,21 @@ static int l_render_cg(lua_State *L)
                                           "volume fraction",
                                           "displacement (m)",
                                           ""};
-    char autolabel[96];
     if (show <= 7) {
-        d.field.values = fields_array(L, 1, TENSORS[tensor], SHOWS[show], n, call);
+        d->field.values = fields_array(L, 1, TENSORS[tensor], SHOWS[show], n, call);
         if (tensor == 0 && show <= 3) {
             static const char *const stress[4] = {"principal stress difference", "pressure",
                                                   "major principal stress",
                                                   "minor principal stress"};
-            snprintf(autolabel, sizeof autolabel, "%s (Pa)", stress[show]);
+            snprintf(p->autolabel, sizeof p->autolabel, "%s (Pa)", stress[show]);
         } else {
-            snprintf(autolabel, sizeof autolabel, "%s%s: %s%s", TENSORS[tensor],
+            snprintf(p->autolabel, sizeof p->autolabel, "%s%s: %s%s", TENSORS[tensor],
                      tensor == 1 || tensor == 2 || tensor == 3 ? " stress" : "", names[show],
                      tensor == 4 ? "" : " (Pa)");
         }
     } else if (show == 8 || show == 10 || show == 11) {
-        d.field.values = fields_array(L, 1, SHOWS[show], NULL, n, call);
-        snprintf(autolabel, sizeof autolabel, "%s", names[show]);
+        d->field.values = fields_array(L, 1, SHOWS[show], NULL, n, call);
+        snprintf(p->autolabel, sizeof p->autolabel, "%s", names[show]);
     } else if (show == 9 || show == 12) {
         const char *vec = show == 9 ? "velocity" : "displacement";
         double *vx = fields_array(L, 1, vec, "x", n, call);
@@ -198,14 +218,21 @@ static int l_render_cg(lua_State *L)
         double *m = lua_newuserdatauv(L, n * sizeof *m, 0);
         for (size_t k = 0; k < n; k++)
             m[k] = hypot(vx[k], vy[k]);
-        d.field.values = m;
-        snprintf(autolabel, sizeof autolabel, "%s", names[show]);
+        d->field.values = m;
+        snprintf(p->autolabel, sizeof p->autolabel, "%s", names[show]);
     }
-    d.field.colorbar_label = label ? label : autolabel;
+    d->field.colorbar_label = p->label ? p->label : p->autolabel;
+}
+
+/* The arrows (a vector field) and glyphs (the tensor's major direction) drawn over the values. */
+static void read_overlays(lua_State *L, const char *call, rcg_plot *p, size_t n)
+{
+    render_cg_def *d = &p->d;
+    const int tensor = p->tensor, arrows = p->arrows, glyphs = p->glyphs, every = p->every;
     if (arrows >= 0) {
-        d.field.arrows[0] = fields_array(L, 1, ARROWS[arrows], "x", n, call);
-        d.field.arrows[1] = fields_array(L, 1, ARROWS[arrows], "y", n, call);
-        d.field.arrow_unit = arrows == 0 ? "m/s" : "m";
+        d->field.arrows[0] = fields_array(L, 1, ARROWS[arrows], "x", n, call);
+        d->field.arrows[1] = fields_array(L, 1, ARROWS[arrows], "y", n, call);
+        d->field.arrow_unit = arrows == 0 ? "m/s" : "m";
     }
     if (glyphs) {
         double *dx = fields_array(L, 1, TENSORS[tensor], "dx", n, call);
@@ -213,10 +240,17 @@ static int l_render_cg(lua_State *L)
         double *ang = lua_newuserdatauv(L, n * sizeof *ang, 0);
         for (size_t k = 0; k < n; k++)
             ang[k] = atan2(dy[k], dx[k]);
-        d.glyph_angle = ang;
-        d.glyph_value = fields_array(L, 1, TENSORS[tensor], "psd", n, call);
-        d.glyph_every = every;
+        d->glyph_angle = ang;
+        d->glyph_value = fields_array(L, 1, TENSORS[tensor], "psd", n, call);
+        d->glyph_every = every;
     }
+}
+
+/* Renders p, writes the PNG and pushes { file, width, height, range }. */
+static int draw(lua_State *L, const char *call, rcg_plot *p)
+{
+    const render_cg_def *d = &p->d;
+    const char *file = p->file;
     render_context *rc = bind_render_context(L, call);
     render_image *img = lua_newuserdatauv(L, sizeof *img, 0);
     memset(img, 0, sizeof *img);
@@ -226,7 +260,7 @@ static int l_render_cg(lua_State *L)
     lua_setmetatable(L, -2);
     core_error err;
     render_view view;
-    if (render_cg(rc, &d, img, &view, &err) != CORE_OK)
+    if (render_cg(rc, d, img, &view, &err) != CORE_OK)
         return bind_raise(L, call, &err);
     if (render_write_png(img, file, &err) != CORE_OK)
         return bind_raise(L, call, &err);
@@ -244,6 +278,21 @@ static int l_render_cg(lua_State *L)
     lua_pushstring(L, file);
     lua_setfield(L, -2, "file");
     return 1;
+}
+
+static int l_render_cg(lua_State *L)
+{
+    const char *call = "coarse_grain";
+    lua_settop(L, 2);
+    if (!lua_istable(L, 1))
+        return bind_arg_error(L, 1, call, "table (the fields of analysis.coarse_grain)");
+    rcg_plot p;
+    memset(&p, 0, sizeof p);
+    read_options(L, call, &p);
+    const size_t n = read_grid(L, call, &p.d);
+    read_values(L, call, &p, n);
+    read_overlays(L, call, &p, n);
+    return draw(L, call, &p);
 }
 
 void bind_open_coarse_grain_render(lua_State *L)
