@@ -214,8 +214,8 @@ void bind_open_dsmc(lua_State *L);
 /* Registers the global `analysis` module and the boundary-condition methods of dem.scene
  * (lua_analysis.c); after bind_open_dem. */
 void bind_open_analysis(lua_State *L);
-/* analysis.coarse_grain, analysis.cg_average and render.coarse_grain (lua_coarse_grain.c); after
- * bind_open_analysis and bind_open_render. */
+/* analysis.coarse_grain, analysis.cg_average and render.coarse_grain (lua_coarse_grain.c,
+ * lua_coarse_grain_render.c); after bind_open_analysis and bind_open_render. */
 void bind_open_coarse_grain(lua_State *L);
 /* dem.load's restorer of the Delaunay boundary update s:boundary installs (lua_analysis.c). */
 const struct dem_boundary_restorer *bind_dem_boundary_restorer(void);

@@ -1,5 +1,5 @@
-/* What the bindings of the mpm module share: lua_mpm.c (the module, mpm.scene and mpm.material)
- * and lua_mpm_measure.c (the scene's measurements). */
+/* What the bindings of the mpm module share: lua_mpm.c (the module and mpm.scene),
+ * lua_mpm_material.c (mpm.material) and lua_mpm_measure.c (the scene's measurements). */
 #ifndef GRAINLAB_LUA_MPM_H
 #define GRAINLAB_LUA_MPM_H
 
@@ -19,5 +19,8 @@ void bind_mpm_push_pair(lua_State *L, const double v[2]);
 /* Adds m:field, m:measure, m:grain, m:points and m:timings to mpm.scene (lua_mpm_measure.c;
  * from bind_open_mpm). */
 void bind_open_mpm_measure(lua_State *L);
+/* Adds mpm.material (the function, onto the mpm table at idx) and its type (lua_mpm_material.c;
+ * from bind_open_mpm). */
+void bind_open_mpm_material(lua_State *L, int idx);
 
 #endif
