@@ -8,12 +8,18 @@
 --   Kernels: the Gaussian (w = 2 d, cut at 3 w) and Lucy (w = 2 d); each call timed `reps` times,
 --   the fastest kept (the shared machine's noise only adds).
 --   The time average's cost: `steps` DEM steps with avg:add every `every` steps against the same
---   steps without; the difference over the samples is the cost per sample, compared with a
---   single coarse_grain's (the fields' own cost, without its Lua tables).
+--   steps without (threads in auto mode); the difference over the samples' own time (avg:info)
+--   is what a sample costs a run over what it costs alone.
 --   grainlab scripts/bench/cg.lua [n=100000] [cells=200] [reps=3] [threads=1,2] [steps=200]
 --                                 [every=50]
--- Metrics: seconds per call per kernel and thread count, points x items per second, contacts
--- per particle, sampling cost per sample against one call.
+--   run_all.sh's quick mode: the same scene, reps=1 steps=100.
+-- Report bench_cg: particles, contacts, contacts_per_particle, grid, cell_over_d, width_over_d;
+-- <kernel>_seconds_<k>t (one coarse_grain call, its Lua tables included) and
+-- <kernel>_sample_seconds_<k>t (one avg:add of an average, no Lua tables) for kernel gauss and
+-- lucy on k threads; run_seconds_plain, run_seconds_with_average, average_samples,
+-- average_sampling_seconds and added_per_sample_over_sample (the run's added time over the
+-- samples' own time); with the machine, load and run (common.lua).
+local bench = dofile((arg[0]:match("^(.*)/") or ".") .. "/common.lua")
 local n = params.n or 100000
 local cells = params.cells or 200
 local reps = params.reps or 3
@@ -43,7 +49,7 @@ local ncontacts = math.floor(C.z * s:particles().count / 2 + 0.5)
 
 local region = { { 0, 0 }, { L, L } }
 local metrics = { particles = m * m, contacts = ncontacts, contacts_per_particle = C.z, grid = { cells, cells },
-                  cell_over_d = L / cells / d, build_seconds = t_build }
+                  cell_over_d = L / cells / d, width_over_d = 2, build_seconds = t_build }
 for _, kernel in ipairs{ "gauss", "lucy" } do
   for _, th in ipairs(threads) do
     grainlab.threads(th)
@@ -89,9 +95,9 @@ grainlab.report{
   scenario = "bench_cg",
   params = { n = m * m, cells = cells, width_d = 2, reps = reps, threads = params.threads or "1,2",
              steps = steps, every = every },
-  metrics = metrics,
+  metrics = bench.metrics(metrics),
   checks = {
-    -- the assembly the issue asks for: about four contacts per particle
+    -- the assembly measured: about four contacts per particle
     { name = "contacts_per_particle", value = math.abs(C.z - 4), limit = 0.3 },
   },
 }

@@ -38,11 +38,12 @@ export GRAINLAB_BENCH_MODE GRAINLAB_BENCH_COMMIT GRAINLAB_BENCH_RUN
 if [ $MODE = full ]; then
   DEM_STEPS=20000 LMP_STEPS=2000 LMP_REPS=3 MPM_CYCLES=400 DSMC_STEPS=50
   SCALING="" LARGE_DSMC="n=2e8 steps=4" LARGE_DEM="n=5e6 steps=200" RENDER="repeat=5"
-  BIAX="steps=5000" CONTENDED="seconds=5 rounds=2" MARCH="reps=3 steps=3000 cycles=100"
+  BIAX="steps=5000" CONTENDED="seconds=5 rounds=2" MARCH="reps=3 steps=3000 cycles=100" CGRAIN=""
 else
   DEM_STEPS=2000 LMP_STEPS=500 LMP_REPS=1 MPM_CYCLES=100 DSMC_STEPS=20
   SCALING="reps=1 dem_steps=500 dsmc_steps=10" LARGE_DSMC="n=2e7 steps=4" LARGE_DEM="n=5e5 steps=50"
   RENDER="repeat=3" BIAX="steps=1000" CONTENDED="seconds=2 rounds=1" MARCH="reps=1 steps=1000 cycles=20"
+  CGRAIN="reps=1 steps=100"
 fi
 CG="valgrind --tool=callgrind --instr-atstart=no --callgrind-out-file=$DIR/callgrind.%p"
 # run NAME COMMAND...: the command's output into DIR/NAME.log, its report into DIR/NAME.json
@@ -96,6 +97,7 @@ run scaling "$GL" --quiet --report @REPORT scripts/bench/scaling.lua pile="$PILE
 run largest_dsmc "$GL" --quiet --report @REPORT scripts/bench/largest.lua engine=dsmc $LARGE_DSMC
 run largest_dem "$GL" --quiet --report @REPORT scripts/bench/largest.lua engine=dem $LARGE_DEM
 run render "$GL" --quiet --report @REPORT scripts/bench/render.lua $RENDER
+run cg "$GL" --quiet --report @REPORT scripts/bench/cg.lua $CGRAIN
 run biaxial "$GL" --quiet --report @REPORT scripts/bench/biaxial.lua $BIAX
 run contended "$GL" --quiet --report @REPORT scripts/bench/contended.lua $CONTENDED
 run march_bits sh scripts/bench/march_bits.sh pile="$PILE" grainlab="$GL" out=out/bench/march_bits \

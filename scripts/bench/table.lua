@@ -342,6 +342,39 @@ bench{
 }
 
 bench{
+  name = "Coarse-graining", script = "cg.lua", needs = { "bench_cg" },
+  measures = "`analysis.coarse_grain` of a square lattice of disks, each touching its four " ..
+             "neighbours, the contacts loaded by a few DEM steps: the fields of one call with the " ..
+             "Gaussian kernel (cut at 3 w) and with Lucy's, the fastest of several calls, and one " ..
+             "sample of a time average (`avg:add`: the same sums, no Lua tables); then DEM steps " ..
+             "sampling a Gaussian average against the same steps without, the time added over " ..
+             "the samples' own time",
+  scene = function(m)
+    local c = "bench_cg"
+    local g = m(c, "grid")
+    return string.format("%s disks, %s contacts per particle, %d × %d cells of %s d, w = %g d",
+                         count(m(c, "particles")), num(m(c, "contacts_per_particle")), g[1], g[2],
+                         num(m(c, "cell_over_d")), m(c, "width_over_d"))
+  end,
+  rows = function(m, p)
+    local c, rows = "bench_cg", {}
+    for _, k in ipairs { { "gauss", "Gaussian" }, { "lucy", "Lucy" } } do
+      for _, t in ipairs { 1, 2 } do
+        local call = m(c, string.format("%s_seconds_%dt", k[1], t))
+        local sample = m(c, string.format("%s_sample_seconds_%dt", k[1], t))
+        rows[#rows + 1] = { "seconds per call (per sample of an average), " .. k[2], tostring(t),
+                            string.format("%s s (%s s)", num(call, 2), num(sample, 2)) }
+      end
+    end
+    rows[#rows + 1] = {
+      string.format("a run sampling an average (%d samples in %d steps): time added / the samples' own time",
+                    m(c, "average_samples"), p(c, "steps")),
+      "auto", num(m(c, "added_per_sample_over_sample")) }
+    return rows
+  end,
+}
+
+bench{
   name = "Biaxial boundary conditions", script = "biaxial.lua", needs = { "bench_biaxial" },
   measures = "what each boundary condition of the biaxial laboratory costs over plain DEM steps " ..
              "of the same sample under the same load (CPU time, one thread)",

@@ -4,7 +4,8 @@
 # a set that is incomplete, holds a report twice, mixes runs, or has a failed check.
 # The set: tests/bench/reports/*.json (the reports of a quick run of run_all.sh), four of them
 # replaced by real runs of their benchmarks at tiny size (so that what the benchmarks write is what
-# table.lua reads), the others given this machine's facts. Everything is written under WORK.
+# table.lua reads), the others given this machine's facts; the coarse-graining rows are rendered
+# from the stored report and once more from a real tiny run. Everything is written under WORK.
 #   table_test.sh GRAINLAB SOURCE_DIR WORK_DIR
 set -euo pipefail
 GL=$1 SRC=$2 WORK=$3
@@ -52,6 +53,12 @@ grep -q "| particle-steps/s | 2 | ${mant}·10" <<< "$page" || fail "the DSMC rat
 ratio=$(jq .metrics.ratio_1_cores "$WORK/set/vs_lammps.json")
 r3=$("$GL" -e "print(string.format('%.3g', $ratio))")
 grep -q "| speed, grainlab / LAMMPS | 1 core | $r3 |" <<< "$page" || fail "the LAMMPS ratio $r3 is not on the page"
+# The stored coarse-graining report: its scene and the time average's cost, to 3 digits.
+grep -q '| Coarse-graining | 99,856 disks, 3.89 contacts per particle, 200 × 200 cells of 1.56 d, w = 2 d |' \
+  <<< "$page" || fail "the coarse-graining scene is not on the page"
+cost=$("$GL" -e "print(string.format('%.3g', $(jq .metrics.added_per_sample_over_sample "$WORK/set/cg.json")))")
+grep -q "time added / the samples' own time | auto | $cost |" <<< "$page" ||
+  fail "the time average's cost $cost is not on the page"
 # Every headline row of the README is a row of the page (the same figure, threads and value).
 while IFS= read -r row; do
   tail=$(awk -F' [|] ' '{ print $3 " | " $4 " | " $5 }' <<< "$row")
@@ -73,6 +80,17 @@ refused() { # refused NAME MESSAGE: the set in $WORK/$NAME must be refused with 
   cmp -s "$WORK/readme.before" "$WORK/README.md" || fail "$1: README was written"
 }
 variant() { rm -rf "${WORK:?}/$1"; cp -r "$WORK/set" "$WORK/$1"; }
+
+# cg.lua at tiny size in place of the stored report: its rows from what it writes.
+variant cgtiny
+"$GL" --quiet --report "$WORK/cgtiny/cg.json" scripts/bench/cg.lua n=900 cells=30 reps=1 steps=10 every=5 >/dev/null
+"$GL" --quiet scripts/bench/table.lua dir="$WORK/cgtiny" print=true > "$WORK/cgtiny.txt" ||
+  fail "a set with a tiny coarse-graining run was refused: $(cat "$WORK/cgtiny.txt")"
+grep -q '| Coarse-graining | 900 disks, [0-9.]* contacts per particle, 30 × 30 cells of ' "$WORK/cgtiny.txt" ||
+  fail "the coarse-graining rows do not show the tiny run's 900 disks on 30 × 30 cells"
+[ "$(grep -c 'seconds per call (per sample of an average), ' "$WORK/cgtiny.txt")" -eq 4 ] ||
+  fail "the coarse-graining rows lack a kernel or a thread count"
+
 variant missing
 rm "$WORK/missing/render.json"
 refused missing "incomplete: no report of 'bench_render'"
