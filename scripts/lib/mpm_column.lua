@@ -1,16 +1,20 @@
--- A granular column released on a floor, as an MPM continuum (drucker_prager or mu_i), for
--- scripts/column_collapse.lua. Not a scenario; load it with
+-- A granular column released on a floor, as an MPM continuum (drucker_prager or mu_i), shared by
+-- scripts/column_collapse.lua, scripts/column_two_scales.lua, scripts/study_column.lua and
+-- scripts/bench/continuum.lua. Not a scenario; load it with
 --   local mpm_column = dofile((arg[0]:match("^(.*)/") or ".") .. "/lib/mpm_column.lua")
 --
--- mpm_column.new{ material, L0, H0, cells, ppc, shape, floor_mu, length } builds the scene: a
--- column L0 wide and H0 high against a slip wall at x = 0 (the plane of symmetry of a column
--- 2 L0 wide, as in the quasi-2D experiments' half columns), on a friction floor (floor_mu) at
--- y = 0, `cells` cells across L0 (square cells), ppc x ppc points per cell, linear or B-spline
--- shapes, the grid `length` long (default 3 L0) with a no-slip wall at its end, two cells of
--- headroom over the column and no wall on top. The column starts at rest under the hydrostatic
--- pressure (sigma_xx = sigma_yy = -rho g (H0 - y): a state inside both models' yield surfaces)
--- as if held by a gate that is removed at t = 0. Returns the column c with c.m (the scene),
--- c.L0, c.H0, c.h (the cell size), c.tc = sqrt(H0 / g), c.nx, c.ny, and:
+-- mpm_column.new{ material, L0, H0, cells, ppc, shape, floor_mu, length, strips } builds the
+-- scene: a column L0 wide and H0 high against a slip wall at x = 0 (the plane of symmetry of a
+-- column 2 L0 wide, as in the quasi-2D experiments' half columns), on a friction floor
+-- (floor_mu) at y = 0, `cells` cells across L0 (square cells), ppc x ppc points per cell, linear
+-- or B-spline shapes, the grid `length` long (default 3 L0) with a no-slip wall at its end, two
+-- cells of headroom over the column and no wall on top. With strips = k (default 1) the column
+-- is k grains side by side, so that the step's threads, which split the points by grains, share
+-- it (with the default noslip contact the grains move in one velocity field: one continuum).
+-- The column starts at rest under the hydrostatic pressure (sigma_xx = sigma_yy = -rho g (H0 -
+-- y): a state inside both models' yield surfaces) as if held by a gate that is removed at t = 0.
+-- Returns the column c with c.m (the scene), c.L0, c.H0, c.h (the cell size), c.tc = sqrt(H0 /
+-- g), c.nx, c.ny, and:
 --   c:state()           front: the 99th percentile of the points' x plus half a point spacing
 --                       (so a column at rest has front L0, and a few points ahead of the deposit
 --                       do not count); height: the top of the points within the first cell column
@@ -55,8 +59,16 @@ function mpm_column.new(o)
                        shape = o.shape or "bspline", wall_gap = 0,
                        walls = { left = "slip", right = "noslip", top = "none",
                                  bottom = { kind = "friction", mu = o.floor_mu } } }
-  m:add_rect{ lo = { 0, 0 }, hi = { L0, H0 }, material = o.material, points_per_cell = o.ppc,
-              hydrostatic = true }
+  -- strips > 1: the column as that many side-by-side grains of whole cells (the step's threads
+  -- split the points by grains; with the default noslip contact the grains share one velocity
+  -- field, one continuum), each with the hydrostatic state of the whole column's height
+  local strips = o.strips or 1
+  for k = 1, strips do
+    local x0, x1 = h * math.floor(o.cells * (k - 1) / strips), h * math.floor(o.cells * k / strips)
+    if k == strips then x1 = L0 end
+    m:add_rect{ lo = { x0, 0 }, hi = { x1, H0 }, material = o.material, points_per_cell = o.ppc,
+                hydrostatic = true }
+  end
   local c = setmetatable({ m = m, L0 = L0, H0 = H0, h = h, nx = nx, ny = ny, ppc = o.ppc,
                            density = o.material.density, tc = math.sqrt(H0 / g) }, mpm_column)
   c.pe0 = c:potential()
