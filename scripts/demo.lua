@@ -72,89 +72,18 @@ for name, v in pairs { aspect = aspect, young = young, frame_dt = frame_dt } do
 end
 assert(type(mu) == "number" and mu >= 0, "mu must be a non-negative number")
 
-local g, rho, nu = 9.81, 2650, 0.3
-local rmin, rmax, rf = 0.5e-3, 1e-3, 0.5e-3
-local e_rest, v_e = 0.5, 1.0
-local v_rest, T_max, T_min = 5e-3, 1.5, 0.4
--- Area per disk in a random packing: pi <r^2> / 0.82, <r^2> = (rmax^3 - rmin^3) / (3 (rmax - rmin)).
-local area = math.pi * (rmax ^ 3 - rmin ^ 3) / (3 * (rmax - rmin)) / 0.82
-local W0 = 2 * rf * math.floor(math.sqrt(n * area / aspect) / (2 * rf) + 0.5) -- whole floor disks
-local H0 = n * area / W0
-local L = W0 * (1 + 3.5 * aspect)   -- room for the runout
--- Headroom: 12 %, but at least two grain diameters (a column of a few rows packs less evenly).
-local top = math.max(1.12 * H0, H0 + 4 * rmax)
+-- The column, its floor, walls, gate, packing and preparation: scripts/lib/dem_column.lua, shared
+-- with scripts/column_two_scales.lua.
+local dem_column = dofile((arg[0]:match("^(.*)/") or ".") .. "/lib/dem_column.lua")
+local rmax, v_rest = dem_column.radius_max, dem_column.v_rest
+local nu, rho, rmin, e_rest = dem_column.poisson, dem_column.density, dem_column.radius_min, dem_column.restitution
 
 local t_start = grainlab.clock()
-local mat = grainlab.material{ density = rho, young = young, poisson = nu, friction = mu }
-local s = dem.scene{ dim = 2, box = { { 0, -2 * rf - 1e-6 }, { L, top } }, gravity = { 0, -g } }
-s:contact{ normal = "hertz", tangential = "spring" } -- for pack.deposit's own bookkeeping
-local walls = {
-  { point = { 0, -2 * rf - 1e-6 }, normal = { 0, 1 } },
-  { point = { 0, 0 }, normal = { 1, 0 } },
-  { point = { L, 0 }, normal = { -1, 0 } },
-}
-for _, w in ipairs(walls) do s:add_wall(w) end
-local gate_def = { point = { W0, 0 }, normal = { -1, 0 } }
-local gate = s:add_wall(gate_def)
--- The floor: touching fixed disks, a whole number of them under the column. A wall is a half
--- space, so the disks beyond the gate are added when the gate is removed (ids after the grains).
-local nf = 0
-local function add_floor(beyond_gate)
-  for k = 0, math.floor(L / (2 * rf)) - 1 do
-    local x = rf + 2 * rf * k
-    if (x > W0) == beyond_gate and x + rf < L then
-      s:add_disk{ pos = { x, -rf }, radius = rf, material = mat, fixed = true }
-      if not beyond_gate then nf = nf + 1 end
-    end
-  end
-end
-add_floor(false)
-grainlab.pack.deposit(s, { n = n, radius = { rmin, rmax }, seed = seed, material = mat,
-                           region = { { 0, -2 * rf }, { W0, top } }, relax_steps = 0 })
-s:contact{ normal = "hertz", damping = "brilliantov", restitution = e_rest, impact_velocity = v_e,
-           tangential = "spring" }
-
--- State of the mobile grains (ids nf+1 .. nf+n).
-local function state()
-  local P = s:particles()
-  local xs, vmax, height, xmax, inside = {}, 0, 0, 0, 0
-  local lo, hi = s:info().box[1], s:info().box[2]
-  for i = nf + 1, nf + n do
-    local x, y, r = P.x[i], P.y[i], P.radius[i]
-    xs[#xs + 1] = x + r
-    xmax = math.max(xmax, x + r)
-    vmax = math.max(vmax, math.sqrt(P.vx[i] ^ 2 + P.vy[i] ^ 2))
-    if x < W0 then height = math.max(height, y + r) end
-    if x >= lo[1] and x <= hi[1] and y >= lo[2] and y <= hi[2] then inside = inside + 1 end
-  end
-  table.sort(xs)
-  local e = s:measure("energy")
-  return { front = xs[math.max(1, math.ceil(0.99 * #xs))], xmax = xmax, vmax = vmax,
-           height = height, inside = inside,
-           ke = e.kinetic + e.rotational, total = e.total }
-end
-
-local function overlap_max()
-  local C, m = s:measure("contacts"), 0
-  local P = s:particles()
-  for k = 1, #C.overlap do
-    local i, j = C.i[k], C.j[k]
-    local r = j > 0 and math.min(P.radius[i], P.radius[j]) or P.radius[i]
-    m = math.max(m, C.overlap[k] / r)
-  end
-  return m
-end
-
--- Preparation at the stability limit.
-local dt_prep = s:timestep{ impact_velocity = 0.5 }.limit
-s:drag(20)
-s:run{ time = 0.1, dt = dt_prep, impact_velocity = 0.5, progress = false }
-s:drag(0)
-s:run{ time = 0.02, dt = dt_prep, impact_velocity = 0.5, progress = false }
-local v_imp = math.sqrt(2 * g * H0)
-local dt = s:timestep{ impact_velocity = v_imp }.dt_auto
-local st0 = state()
-local overlap0 = overlap_max()
+local col = dem_column.new{ n = n, seed = seed, aspect = aspect, young = young, mu = mu, frame_dt = frame_dt }
+local s, W0, L, walls, gate_def = col.s, col.W0, col.L, col.walls, col.gate_def
+local st0 = col:prepare()
+local dt = col.dt
+local overlap0 = col:overlap_max()
 local prep_wall = grainlab.clock() - t_start
 print(string.format("demo: %d disks, column %.1f x %.1f mm (aspect %.2f), floor %.0f mm, E = %g Pa, dt = %.3g s; prepared in %.1f s",
                     n, W0 * 1e3, st0.height * 1e3, st0.height / W0, L * 1e3, young, dt, prep_wall))
@@ -200,25 +129,16 @@ movie_frame(0, true)
 
 -- Collapse.
 local E0 = st0.total
-s:remove_wall(gate)
-add_floor(true)
-local t, steps, run_wall = 0, 0, 0
+col:release()
 local series = grainlab.recorder{ file = csv, columns = { "t", "runout", "height", "kinetic", "total" },
                                   units = { t = "s", runout = "mm", height = "mm", kinetic = "J", total = "J" } }
 series:add{ t = 0, runout = 0, height = st0.height * 1e3, kinetic = st0.ke, total = E0 }
 local snaps = { { 0.05, "the gate is gone: the column fails" }, { 0.1, "collapsing" }, { 0.2, "spreading" } }
 local speed_at, chains_at = 0.12, 0.1
-local st = st0
 local E_min, rise_max, overlap_run = E0, 0, overlap0
-while t < T_max - 1e-9 do
-  local c = grainlab.clock()
-  local r = s:run{ time = frame_dt, dt = dt, impact_velocity = v_imp, progress = false }
-  run_wall = run_wall + grainlab.clock() - c
-  steps = steps + r.steps
-  t = t + frame_dt
-  st = state()
+local t, st = col:collapse(function(t, st)
   series:add{ t = t, runout = (st.front - W0) * 1e3, height = st.height * 1e3, kinetic = st.ke, total = st.total }
-  overlap_run = math.max(overlap_run, overlap_max())
+  overlap_run = math.max(overlap_run, col:overlap_max())
   rise_max = math.max(rise_max, st.total - E_min)
   E_min = math.min(E_min, st.total)
   movie_frame(t)
@@ -235,8 +155,8 @@ while t < T_max - 1e-9 do
                show = { "walls", "box", "colorbar" }, label = "speed (m/s)",
                title = "grain speed", stamp = stamp(t) })
   end
-  if t >= T_min - 1e-9 and st.vmax < v_rest then break end
-end
+end)
+local steps, run_wall = col.steps, col.run_wall
 local released = E0 - st.total
 snap(t, "at rest")
 
