@@ -13,12 +13,13 @@
 --   same continuum at the resolution of scripts/column_two_scales.lua (10 cells across W0) until
 --   its front stops, both on one thread: wall time, steps, particle- or point-steps.
 --   grainlab scripts/bench/continuum.lua [cells=160] [strips=8] [model=mu_i|drucker_prager]
---       [warm=200] [steps=200] [threads=N] [whole=false]
--- Report bench_mpm_continuum: points, cells, particle_steps_per_s_<k>_threads (point-steps per
--- second), wall_s_<k>_threads, stage_<name>_ns (wall ns per point-step of each stage of the last
--- thread count's run, from m:timings()); with the whole collapse, whole_dem_wall_s,
--- whole_dem_steps, whole_dem_particle_steps_per_s, whole_mpm_wall_s, whole_mpm_steps,
--- whole_mpm_points, whole_mpm_point_steps_per_s, whole_dem_over_mpm (the wall-time ratio).
+--       [warm=200] [steps=200] [threads=N] [whole=false] [scenario=bench_mpm_continuum_large]
+-- Report bench_mpm_continuum (or the name given as scenario=, so that two sizes are two
+-- reports): points, cells, particle_steps_per_s_<k>_threads (point-steps per second),
+-- wall_s_<k>_threads, stage_<name>_ns and stage_total_ns (wall ns per point-step of each
+-- stage and of the whole step in the last thread count's run, from m:timings()); with the
+-- whole collapse, whole_dem_wall_s, whole_dem_steps, whole_dem_particle_steps_per_s,
+-- whole_mpm_wall_s, whole_mpm_steps, whole_mpm_points, whole_mpm_point_steps_per_s, whole_dem_over_mpm (the wall-time ratio).
 local bench = dofile((arg[0]:match("^(.*)/") or ".") .. "/common.lua")
 local here = (arg[0]:match("^(.*)/") or ".") .. "/.."
 local mpm_column = dofile(here .. "/lib/mpm_column.lua")
@@ -28,8 +29,10 @@ local warm = math.tointeger(tonumber(params.warm or 200))
 local steps = math.tointeger(tonumber(params.steps or 200))
 local whole = params.whole ~= false
 local strips = math.tointeger(tonumber(params.strips or 8))
+local scenario = params.scenario or "bench_mpm_continuum"
 assert(cells and cells >= 2, "cells must be an integer >= 2")
 assert(model == "mu_i" or model == "drucker_prager", "model must be mu_i or drucker_prager")
+assert(scenario:match("^bench_mpm_continuum[%w_]*$"), "scenario must be bench_mpm_continuum[_suffix]")
 assert(warm and warm >= 0 and steps and steps >= 1, "warm >= 0 and steps >= 1 must be integers")
 
 local L0, a = 0.05, 2
@@ -77,6 +80,7 @@ for _, k in ipairs(names) do
   metrics["stage_" .. k .. "_ns"] = ns
   print(string.format("  %-9s %8.1f  %5.1f %%", k, ns, 100 * stages[k] / stages.total))
 end
+metrics.stage_total_ns = stages.total / (np * steps) * 1e9
 local e = m:measure("energy")
 local checks = { { name = "finite_energy", pass = e.total == e.total and e.total < math.huge } }
 
@@ -117,7 +121,7 @@ if whole then
 end
 
 grainlab.report{
-  scenario = "bench_mpm_continuum",
+  scenario = scenario,
   params = { cells = cells, strips = strips, model = model, warm = warm, steps = steps, threads = params.threads or "1,2",
              whole = whole },
   metrics = bench.metrics(metrics),

@@ -39,11 +39,12 @@ if [ $MODE = full ]; then
   DEM_STEPS=20000 LMP_STEPS=2000 LMP_REPS=3 MPM_CYCLES=400 DSMC_STEPS=50
   SCALING="" LARGE_DSMC="n=2e8 steps=4" LARGE_DEM="n=5e6 steps=200" RENDER="repeat=5"
   BIAX="steps=5000" CONTENDED="seconds=5 rounds=2" MARCH="reps=3 steps=3000 cycles=100" CGRAIN=""
+  CONT="cells=160" CONT_LARGE="cells=360"
 else
   DEM_STEPS=2000 LMP_STEPS=500 LMP_REPS=1 MPM_CYCLES=100 DSMC_STEPS=20
   SCALING="reps=1 dem_steps=500 dsmc_steps=10" LARGE_DSMC="n=2e7 steps=4" LARGE_DEM="n=5e5 steps=50"
   RENDER="repeat=3" BIAX="steps=1000" CONTENDED="seconds=2 rounds=1" MARCH="reps=1 steps=1000 cycles=20"
-  CGRAIN="reps=1 steps=100"
+  CGRAIN="reps=1 steps=100" CONT="cells=60 warm=50 steps=50" CONT_LARGE="cells=120 warm=20 steps=20"
 fi
 CG="valgrind --tool=callgrind --instr-atstart=no --callgrind-out-file=$DIR/callgrind.%p"
 # run NAME COMMAND...: the command's output into DIR/NAME.log, its report into DIR/NAME.json
@@ -90,6 +91,9 @@ run mpm_shear_noslip "$GL" --quiet --report @REPORT scripts/bench/mpm_shear.lua 
   cycles=$MPM_CYCLES save="$MPMN"
 run mpm_shear_noslip_callgrind $CG "$GL" --quiet --report @REPORT scripts/bench/mpm_shear.lua load="$MPMN" \
   cycles=10 "$CGO"
+run continuum "$GL" --quiet --report @REPORT scripts/bench/continuum.lua $CONT
+run continuum_large "$GL" --quiet --report @REPORT scripts/bench/continuum.lua $CONT_LARGE whole=false \
+  scenario=bench_mpm_continuum_large
 run dsmc_cooling "$GL" --quiet --report @REPORT scripts/bench/dsmc_cooling.lua steps=$DSMC_STEPS
 run dsmc_cooling_callgrind $CG "$GL" --quiet --report @REPORT scripts/bench/dsmc_cooling.lua n=100000 \
   steps=20 "$CGO"

@@ -233,6 +233,54 @@ bench{
   rows = function(m) return mpm_rows("bench_mpm_shear_noslip", m, false) end,
 }
 
+local function continuum_rows(sc, m)
+  return {
+    { "point-steps/s", "1", num(m(sc, "particle_steps_per_s_1_threads")) },
+    { "point-steps/s", "2", num(m(sc, "particle_steps_per_s_2_threads")) },
+    { "share of the step in the material update", "2",
+      string.format("%.0f %%", 100 * m(sc, "stage_material_ns") / m(sc, "stage_total_ns")) },
+  }
+end
+bench{
+  name = "MPM continuum column", script = "continuum.lua", needs = { "bench_mpm_continuum" },
+  measures = "the collapsing column of `column_collapse.lua` (μ(I) glass beads, a = 2, B-splines, " ..
+             "2 × 2 points per cell) timed from its 200th step, as 8 side-by-side grains of one " ..
+             "continuum; then the whole collapse of the demo's column both ways on one thread: " ..
+             "1500 disks in DEM from the gate's removal to rest, and its continuum twin (10 cells " ..
+             "across the column) until its front stops",
+  scene = function(m)
+    local c = "bench_mpm_continuum"
+    return string.format("%s points, %s cells across the column", count(m(c, "points")),
+                         m(c, "cells_across_l0"))
+  end,
+  rows = function(m)
+    local c = "bench_mpm_continuum"
+    local rows = continuum_rows(c, m)
+    rows[#rows + 1] = { string.format("whole collapse, DEM: %s disk-steps", count(1500 * m(c, "whole_dem_steps"))),
+                        "1", string.format("%s s", num(m(c, "whole_dem_wall_s"))) }
+    rows[#rows + 1] = { string.format("whole collapse, continuum: %s point-steps",
+                                      count(m(c, "whole_mpm_points") * m(c, "whole_mpm_steps"))),
+                        "1", string.format("%s s", num(m(c, "whole_mpm_wall_s"))) }
+    rows[#rows + 1] = { "whole collapse, DEM time / continuum time", "1", num(m(c, "whole_dem_over_mpm")), true }
+    return rows
+  end,
+}
+bench{
+  name = "MPM continuum column, large", script = "continuum.lua cells=360 whole=false",
+  needs = { "bench_mpm_continuum_large" },
+  measures = "the same column on a finer grid",
+  scene = function(m)
+    local c = "bench_mpm_continuum_large"
+    return string.format("%s points, %s cells across the column", count(m(c, "points")),
+                         m(c, "cells_across_l0"))
+  end,
+  rows = function(m)
+    local rows = continuum_rows("bench_mpm_continuum_large", m)
+    rows[2][4] = true
+    return rows
+  end,
+}
+
 bench{
   name = "DSMC cooling", script = "dsmc_cooling.lua", needs = { "bench_dsmc_cooling", "bench_dsmc_cooling_callgrind" },
   measures = "a homogeneously cooling granular gas of disks (e = 0.9, a tenth of the mean " ..

@@ -59,6 +59,13 @@ grep -q '| Coarse-graining | 99,856 disks, 3.89 contacts per particle, 200 × 20
 cost=$("$GL" -e "print(string.format('%.3g', $(jq .metrics.added_per_sample_over_sample "$WORK/set/cg.json")))")
 grep -q "time added / the samples' own time | auto | $cost |" <<< "$page" ||
   fail "the time average's cost $cost is not on the page"
+# The stored continuum reports: the column's points and the whole collapse's DEM / continuum ratio.
+pts=$(jq .metrics.points tests/bench/reports/continuum_large.json)
+grep -q "| MPM continuum column, large | $("$GL" -e "print((string.format('%d', $pts):reverse():gsub('(%d%d%d)', '%1,'):reverse():gsub('^,', '')))") points, " \
+  <<< "$page" || fail "the large continuum column's $pts points are not on the page"
+ratio=$("$GL" -e "print(string.format('%.3g', $(jq .metrics.whole_dem_over_mpm tests/bench/reports/continuum.json)))")
+grep -q "| whole collapse, DEM time / continuum time | 1 | $ratio |" <<< "$page" ||
+  fail "the whole collapse's DEM / continuum ratio $ratio is not on the page"
 # Every headline row of the README is a row of the page (the same figure, threads and value).
 while IFS= read -r row; do
   tail=$(awk -F' [|] ' '{ print $3 " | " $4 " | " $5 }' <<< "$row")
