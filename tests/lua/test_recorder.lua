@@ -5,12 +5,9 @@ local check = grainlab.check
 local tmp = os.tmpname()
 os.remove(tmp)
 local dir = tmp .. "_rec"
-local function slurp(path)
-  local f = io.open(path, "rb")
-  if not f then return nil end
-  local s = f:read("a")
-  f:close()
-  return s
+local function slurp(path) -- the file's bytes, or nil when it does not exist
+  local f <close> = io.open(path, "rb")
+  return f and f:read("a")
 end
 
 -- ---- the CSV, exactly: header with units, integers as %d, floats as %.17g, nan, order kept ----

@@ -82,8 +82,7 @@ local function scene()
 end
 
 local function dump(m)
-  local p = m:points()
-  local t = {}
+  local p, t = m:points(), {}
   for i = 1, p.count do
     t[#t + 1] = string.format("%a %a %a %a %a %a %a %a", p.x[i], p.y[i], p.vx[i], p.vy[i], p.sxx[i],
                               p.szz[i], p.eps_p[i], p.rate[i])
