@@ -37,6 +37,8 @@ run haff.lua n=500 -- haff_time.png haff_collisions.png haff_particles.png haff_
 run vibrated_bed.lua n=100 settle=0.1 avg=0.1 -- vibrated_bed_density.png vibrated_bed_temperature.png \
     vibrated_bed_density_field.png vibrated_bed_temperature_field.png vibrated_bed_particles.png
 run incline.lua quick=true T=0.1 -- incline_cases.png incline_refinement.png
+run column_two_scales.lua n=300 -- column_two_scales_profiles.png column_two_scales_front.png \
+    column_two_scales_fields.png
 run column_collapse.lua aspects=0.5 model=dp -- column_collapse_runout.png column_collapse_height.png \
     column_collapse_profiles.png column_collapse_front.png
 
