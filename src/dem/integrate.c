@@ -689,6 +689,10 @@ static core_status run_steps(dem_scene *s, const dem_run_def *run, core_error *e
                          "boundary conditions (pressure tractions, the minimal boundary, springs, "
                          "ties to walls, prescribed spins) do not yet run distributed "
                          "(comm_size() > 1): run this scene on one rank");
+    if (comm_size() > 1 && dem_cohesive(&s->contact))
+        return core_fail(err, CORE_ERR_STATE,
+                         "cohesive contacts (normal 'jkr' or 'dmt', cohesion 'capillary') do not "
+                         "yet run distributed (comm_size() > 1): run this scene on one rank");
     for (int w = 0; w < s->nwalls && comm_size() > 1; w++)
         if (s->walls[w].active && s->walls[w].shape)
             return core_fail(err, CORE_ERR_STATE,
