@@ -20,8 +20,8 @@
  * f = -5/6:
  *   delta_c = D y_c = -(3/4) (pi^2 Gamma^2 R / E*^2)^{1/3}
  * (Johnson 1985 Sec. 5.5; Thornton & Ning 1998 use the same separation). */
-#define COH_JKR_YC (-0.47247039983852)   /* -3/4 4^{-1/3} */
-#define COH_JKR_UC 0.39685026299204984   /* 4^{-2/3} */
+#define COH_JKR_YC (-0.47247039371057745) /* -3/4 4^{-1/3} */
+#define COH_JKR_UC 0.39685026299204984 /* 4^{-2/3} */
 
 /* u from y >= y_c on the stable branch: Newton from u0 = 1 + sqrt(max(y, 0)), where
  * g(u) = u^2 - sqrt(u) - y >= 0 (g(1) = -y for y < 0; (1 + s)^2 - sqrt(1 + s) >= s^2 + 2 s + 1 -
