@@ -19,7 +19,7 @@
  * dy/du > 0, u > u_c = 4^{-2/3}, and breaks at y_c = u_c^2 - sqrt(u_c) = -3/4 4^{-1/3}, where
  * f = -5/6:
  *   delta_c = D y_c = -(3/4) (pi^2 Gamma^2 R / E*^2)^{1/3}
- * (Johnson 1985 Sec. 5.5; Thornton & Ning 1998 use the same separation). */
+ * (fixed grips, Johnson 1985 Sec. 5.5; derived here from d delta / du = 0). */
 #define COH_JKR_YC (-0.47247039371057745) /* -3/4 4^{-1/3} */
 #define COH_JKR_UC 0.39685026299204984 /* 4^{-2/3} */
 
