@@ -77,6 +77,35 @@ for _, dim in ipairs({ 2, 3 }) do
   end
 end
 
+-- The same bits on 1 and 2 threads: a bed large enough for the threads (over 4096 pairs), with
+-- bonds forming and holding across gaps as it settles.
+for _, contact in ipairs({ { normal = "jkr", tangential = "spring" },
+                           { normal = "hertz", cohesion = "capillary", liquid_volume = 1e-11,
+                             surface_tension = 0.07, tangential = "spring" } }) do
+  local function bed()
+    local mat = grainlab.material{ density = 1000, young = 1e6, friction = 0.4, work_of_adhesion = 2 }
+    local s = dem.scene{ box = { { 0, 0 }, { 0.16, 0.16 } }, gravity = { 0, -9.81 } }
+    s:contact(contact)
+    s:add_wall{ point = { 0, 0 }, normal = { 0, 1 } }
+    for a = 0, 69 do
+      for b = 0, 69 do
+        local jig = (((a * 70 + b) * 7919) % 13) / 13 - 0.5
+        s:add_disk{ pos = { 0.0011 + a * 0.00199, 0.0011 + b * 0.00199 },
+                    radius = 0.001 * (1 + 0.004 * jig), material = mat, vel = { 0.3 * jig, -0.05 } }
+      end
+    end
+    return s
+  end
+  local function go(threads)
+    grainlab.threads(threads)
+    local s = bed()
+    s:run{ steps = 200, dt = 2e-6, progress = false }
+    grainlab.threads(1)
+    return dump(s)
+  end
+  check.is_true(go(1) == go(2), (contact.cohesion or contact.normal) .. ": 1 and 2 threads, the same bits")
+end
+
 -- Sticky grains stay stuck: a pair pulled apart gently holds with JKR, parts with Hertz.
 do
   local function pair(normal)
