@@ -418,6 +418,11 @@ static void read_cohesion(reader *r, dem_scene *s)
     for (int k = 0; k < s->nmat && !r->st; k++)
         s->mats[k].adhesion = get_num_in(r, "a material's work of adhesion", 0, DBL_MAX);
     get_opt(r, &s->pairs.hist[DEM_HIST_BOND], s->pairs.n, s->pairs.n);
+    if (u64(r) != (uint64_t)s->nwalls)
+        bad(r, "wall count");
+    const size_t n = s->n;
+    for (int k = 0; k < s->nwalls && !r->st; k++)
+        get_opt(r, &s->walls[k].hist[DEM_HIST_BOND], n, n ? n : 1);
 }
 
 /* A file that passed the checksum but was not written by dem_save (forged, or a bug) must not

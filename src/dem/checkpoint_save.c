@@ -79,7 +79,7 @@ static core_status write_rolling(const dem_scene *s, ckpt_writer *w, core_error 
 
 /* Cohesion (cohesion.h) has its own section too, written only by a scene that uses it (a JKR or
  * DMT law, a liquid bridge, or a material with a work of adhesion): the contact's values, the
- * materials' work of adhesion, and which pairs' cohesive contacts hold. */
+ * materials' work of adhesion, and which pairs' and planes' cohesive contacts hold. */
 static int uses_cohesion(const dem_scene *s)
 {
     int used = dem_cohesive(&s->contact);
@@ -103,6 +103,9 @@ static core_status write_cohesion(const dem_scene *s, ckpt_writer *w, core_error
     for (int k = 0; k < s->nmat; k++)
         ckpt_put_f64(w, s->mats[k].adhesion);
     put_opt(w, s->pairs.hist[DEM_HIST_BOND], s->pairs.n);
+    ckpt_put_u64(w, (uint64_t)s->nwalls);
+    for (int k = 0; k < s->nwalls; k++)
+        put_opt(w, s->walls[k].hist[DEM_HIST_BOND], s->n);
     return end(w, err);
 }
 

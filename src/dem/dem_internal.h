@@ -14,8 +14,8 @@
 
 /* Contact history slots (pairs and walls): [0..2] the tangential spring force and [3] its last
  * stiffness (SPRING law), [4..6] the rolling spring torque (rolling EPSD; 2D: [4] only, the z
- * component), [7] (pairs only) 1 while a cohesive contact holds: a JKR contact or a liquid
- * bridge formed at touch that has not yet broken (cohesion.h). Slots a scene's laws do not use
+ * component), [7] 1 while a cohesive contact holds: a JKR contact or a liquid bridge formed at
+ * touch that has not yet broken (cohesion.h; pairs and planes). Slots a scene's laws do not use
  * stay NULL. */
 #define DEM_HIST 8
 #define DEM_HIST_ROLL 4
@@ -366,6 +366,14 @@ static inline double dem_pair_adhesion(const dem_scene *s, size_t i, size_t j)
     if (s->contact.adhesion >= 0)
         return s->contact.adhesion;
     return sqrt(s->mats[s->mat[i]].adhesion * s->mats[s->mat[j]].adhesion);
+}
+/* The same for particle i against wall w (its material, or i's own). */
+static inline double dem_wall_adhesion(const dem_scene *s, const dem_wall *w, size_t i)
+{
+    if (s->contact.adhesion >= 0)
+        return s->contact.adhesion;
+    const int mi = s->mat[i], mw = w->material >= 0 ? w->material : mi;
+    return sqrt(s->mats[mi].adhesion * s->mats[mw].adhesion);
 }
 
 /* scene.c */

@@ -452,7 +452,7 @@ static core_status plane_candidates(dem_scene *s, dem_wall *wl, core_error *err)
         double dist = 0;
         for (int d = 0; d < D; d++)
             dist += (s->x[d][i] - wl->point[d]) * wl->normal[d];
-        if (dist >= s->r[i] + s->skin)
+        if (dist >= s->r[i] + s->skin + s->reach)
             continue;
         if (wl->ncand == wl->cap_cand) {
             size_t cap = wl->cap_cand ? 2 * wl->cap_cand : 256;
@@ -475,16 +475,16 @@ static core_status plane_candidates(dem_scene *s, dem_wall *wl, core_error *err)
     return CORE_OK;
 }
 
-/* How far beyond touch a contact of two particles of the largest radius can hold: a JKR contact
- * to its pull-off distance (the largest over pairs of materials, or with the contact's work of
- * adhesion), a liquid bridge to its rupture distance (cohesion.h). A bound: each pair holds to its
- * own. */
+/* How far beyond touch a contact of a particle of the largest radius can hold, with another or
+ * with a plane (R* = r_max): a JKR contact to its pull-off distance (the largest over pairs of
+ * materials, or with the contact's work of adhesion), a liquid bridge to its rupture distance
+ * (cohesion.h). A bound: each contact holds to its own. */
 double dem_cohesion_reach(const dem_scene *s)
 {
     const dem_contact_def *c = &s->contact;
     double reach = 0;
     if (c->normal == DEM_NORMAL_JKR) {
-        const double R = 0.5 * s->r_max;
+        const double R = s->r_max;
         for (int a = 0; a < s->nmat; a++)
             for (int b = a; b < s->nmat; b++) {
                 const dem_material *ma = &s->mats[a], *mb = &s->mats[b];

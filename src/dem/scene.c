@@ -360,6 +360,10 @@ core_status dem_set_contact(dem_scene *s, const dem_contact_def *c, core_error *
     if (bonds_before != dem_bonds(c)) { /* the cohesive contacts that hold */
         free(s->pairs.hist[DEM_HIST_BOND]);
         s->pairs.hist[DEM_HIST_BOND] = NULL;
+        for (int w = 0; w < s->nwalls; w++) {
+            free(s->walls[w].hist[DEM_HIST_BOND]);
+            s->walls[w].hist[DEM_HIST_BOND] = NULL;
+        }
     }
     dem_invalidate(s, 1);
     return CORE_OK;
@@ -407,8 +411,8 @@ static core_status grow(dem_scene *s, size_t need, core_error *err)
             if (s->gear_w[k][d])
                 st = dem_alloc_array(&s->gear_w[k][d], cap, err);
         for (int w = 0; w < s->nwalls && st == CORE_OK; w++)
-            for (int k = d; k < DEM_HIST; k += 3) /* components d (tangential, rolling), and
-                                                   * [3] once (with d = 0) */
+            for (int k = d; k < DEM_HIST; k += 3) /* components d (tangential, rolling), [3]
+                                                   * once (with d = 0), [7] (with d = 1) */
                 if (s->walls[w].hist[k] && (k != 3 || d == 0)) {
                     st = dem_alloc_array(&s->walls[w].hist[k], cap, err);
                     if (st == CORE_OK)

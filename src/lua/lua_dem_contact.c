@@ -331,8 +331,9 @@ void ldem_open_contact(lua_State *L)
          "bridge to the linear, power or hertz law (Rabinovich et al. 2005): F = 4 pi R* "
          "surface_tension cos(contact_angle) (1 - S/sqrt(S^2 + V/(pi R*))) at separation S, "
          "formed at touch, ruptured at S = (1 + theta/2) V^(1/3); liquid_volume V (m^3) of each "
-         "bridge, surface_tension (N/m), contact_angle in degrees [0, 180). Walls feel no "
-         "cohesion. Returns damping_time when one is given, else nothing."},
+         "bridge, surface_tension (N/m), contact_angle in degrees [0, 180). Planes stick as "
+         "partners of infinite radius (R* = r); other walls feel the Hertzian part. Returns "
+         "damping_time when one is given, else nothing."},
         {"damping_time", l_damping_time, "s:damping_time(i, j) or s:damping_time(i, { wall = w })",
          "The Brilliantov damping time T (s) of particles i and j, or of particle i against wall "
          "w, "

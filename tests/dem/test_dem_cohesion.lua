@@ -1,6 +1,6 @@
 -- Cohesive contacts (normal 'jkr' and 'dmt', cohesion 'capillary'): their checkpoints continue
--- bit for bit (the contacts that hold beyond touch are contact history), sticky grains stay
--- stuck where plain ones part, and every bad value is refused naming the call, field and value.
+-- bit for bit (the contacts that hold beyond touch are contact history, of pairs and planes),
+-- sticky grains stay stuck where plain ones part, on each other and on planes, and every bad value is refused naming the call, field and value.
 -- The closed forms are scripts/cohesion.lua's (script_cohesion_small).
 local check = grainlab.check
 
@@ -119,6 +119,44 @@ do
   end
   check.lt(pair("jkr"), 0, "jkr: the pair holds together")
   check.gt(pair("hertz"), 1e-5, "hertz: the pair parts")
+end
+
+-- Planes stick too (R* = r): a sphere on a floor pulled up by 0.9 of its pull-off force stays,
+-- by 1.1 it leaves; the same for a liquid bridge (pull-off 4 pi r gamma cos(theta)), in 2D and 3D.
+for _, dim in ipairs({ 2, 3 }) do
+  for _, law in ipairs({ "jkr", "dmt", "capillary" }) do
+    local function pull(load)
+      local r, G = 50e-6, 0.1
+      local mat = grainlab.material{ density = 2500, young = 1e8, poisson = 0.25, work_of_adhesion = G }
+      local box = dim == 2 and { { -1e-3, 0 }, { 1e-3, 1e-2 } } or { { -1e-3, -1e-3, 0 }, { 1e-3, 1e-3, 1e-2 } }
+      local s = dem.scene{ dim = dim, box = box }
+      local c = { normal = law == "capillary" and "hertz" or law, damping = "viscous", gamma_n = 1e-4,
+                  tangential = "spring" }
+      local gcos = 0.07 * math.cos(math.rad(30))
+      if law == "capillary" then
+        c.cohesion, c.liquid_volume, c.surface_tension, c.contact_angle = "capillary", 1e-16, 0.07, 30
+      end
+      s:contact(c)
+      local up = dim == 2 and { 0, 1 } or { 0, 0, 1 }
+      s:add_wall{ point = dim == 2 and { 0, 0 } or { 0, 0, 0 }, normal = up }
+      local p0 = r + 1e-9                               -- approaching: it touches, and sticks
+      local add = dim == 2 and s.add_disk or s.add_sphere
+      add(s, { pos = dim == 2 and { 0, p0 } or { 0, 0, p0 }, radius = r, material = mat,
+               vel = dim == 2 and { 0, -0.01 } or { 0, 0, -0.01 } })
+      local f_po = law == "jkr" and 1.5 * math.pi * G * r or law == "dmt" and 2 * math.pi * G * r
+                   or 4 * math.pi * r * gcos
+      local f = { ids = { 1 }, fx = { 0 }, fy = { 0 } }
+      if dim == 2 then f.fy[1] = load * f_po else f.fz = { load * f_po } end
+      s:set_forces(f)
+      s:run{ time = 3e-4, progress = false }
+      local p = s:particles()
+      return (dim == 2 and p.y[1] or p.z[1]) - r
+    end
+    local held, torn = pull(0.9), pull(1.1)
+    local what = string.format("%dD %s on a plane", dim, law)
+    check.lt(held, 2e-7, what .. ": 0.9 of the pull-off force, it stays")
+    check.gt(torn, 1e-6, what .. ": 1.1 of it, it leaves")
+  end
 end
 
 -- A scene whose normal law stops being cohesive drops its bonds and runs as before.
