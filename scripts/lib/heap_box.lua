@@ -1,6 +1,8 @@
 -- The pile in a box of Herrmann & Mueller Sec. 3, shared by scripts/repose.lua (the angle of
 -- repose: the gate removed) and scripts/marginal_stability.lua (the angle of marginal stability:
--- the box tilted), and their tests. Not a scenario; load it with
+-- the box tilted), their variants with rolling resistance and with liquid bridges
+-- (scripts/repose_rolling.lua, scripts/repose_cohesive.lua), and their tests. Not a scenario;
+-- load it with
 --   local heap_box = dofile((arg[0]:match("^(.*)/") or ".") .. "/lib/heap_box.lua")
 --
 -- heap_box.new{ n, mu, seed, young, aspect, ... } builds and settles the packing (the procedure
@@ -12,8 +14,10 @@
 --          leave it when the gate is removed; the domain has no open side.
 --   law    Hertz + Brilliantov damping (restitution e_rest at 1 m/s, every pair its own time) +
 --          Cundall-Strack spring capped at mu f_n; with mu_r, rolling resistance (the EPSD law,
---          rolling friction mu_r, rolling damping 0.3); dt = dt_factor x the stability limit at
---          2 m/s.
+--          rolling friction mu_r, rolling damping 0.3); with bridge = { liquid_volume,
+--          surface_tension, contact_angle }, a liquid bridge on every contact, planes included
+--          (cohesion "capillary", docs/dem.md "Cohesion"); dt = dt_factor x the stability limit
+--          at 2 m/s.
 --   settle 0.1 s with a background drag of 20/s, then without, in slices of 0.02 s, until the
 --          fastest grain is below v_rest (at most 0.6 s).
 -- The returned box b has b.s (the scene), b.nf (the floor disks, the scene's first particles),
@@ -115,9 +119,12 @@ function heap_box.new(o)
   grainlab.pack.deposit(s, { n = b.n, radius = { rmin, rmax }, seed = b.seed, material = mat,
                              region = { { 0, -2 * b.rf }, { b.W, b.top - 2 * rmax } },
                              relax_steps = 0 })
+  local bridge = o.bridge or {} -- nil: dry grains, the law above and nothing more
   s:contact{ normal = "hertz", damping = "brilliantov", restitution = b.e_rest, impact_velocity = 1,
              tangential = "spring", rolling_resistance = b.mu_r and "epsd" or nil,
-             rolling_damping = b.mu_r and 0.3 or nil }
+             rolling_damping = b.mu_r and 0.3 or nil, cohesion = o.bridge and "capillary" or nil,
+             liquid_volume = bridge.liquid_volume, surface_tension = bridge.surface_tension,
+             contact_angle = bridge.contact_angle }
   b.dt = b.dt_factor * s:timestep{ impact_velocity = v_imp }.limit
 
   s:drag(20)
