@@ -39,6 +39,7 @@ run vibrated_bed.lua n=100 settle=0.1 avg=0.1 -- vibrated_bed_density.png vibrat
 run incline.lua quick=true T=0.1 -- incline_cases.png incline_refinement.png
 run column_two_scales.lua n=300 -- column_two_scales_profiles.png column_two_scales_front.png \
     column_two_scales_fields.png
+run repose_cohesive.lua n=200 bos=0,1 seeds=2 -- repose_cohesive.png
 run column_collapse.lua aspects=0.5 model=dp -- column_collapse_runout.png column_collapse_height.png \
     column_collapse_profiles.png column_collapse_front.png
 
