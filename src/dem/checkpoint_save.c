@@ -264,6 +264,9 @@ static core_status write_scene(const dem_scene *s, ckpt_writer *w, core_error *e
 
 core_status dem_save(const dem_scene *s, const char *path, const char *version, core_error *err)
 {
+    if (dem_clump_count(s))
+        return core_fail(err, CORE_ERR_STATE, "checkpoints of scenes with clumps are not yet "
+                         "supported");
     ckpt_writer *w;
     core_status st = ckpt_writer_open(&w, path, "dem", version, err);
     if (st)

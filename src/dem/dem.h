@@ -138,6 +138,62 @@ const double *dem_angular_velocities(const dem_scene *s, int d);
 const double *dem_radii(const dem_scene *s);
 /* 2D orientation angles (rad, integrated from omega; NULL when rotations are off or in 3D). */
 const double *dem_angles(const dem_scene *s);
+
+/* ---- clumps: rigid bodies made of overlapping disks or spheres (clump.c) -------------------- *
+ * A clump's members are particles of the scene (ids first .. first + count - 1) that carry no
+ * dynamics of their own: each step the forces and torques on them are summed onto the body,
+ * the body moves (2D: its angle; 3D: a quaternion by the NO_SQUISH splitting, Miller et al.
+ * 2002), and the members are placed and given velocities from it. Members of one clump never
+ * touch each other. Mass, centre and inertia are those of the union of the members, integrated
+ * numerically (dem_clump_shape_compute). */
+enum { DEM_CLUMP_MAX_MEMBERS = 256 };
+typedef struct dem_clump_member {
+    double offset[3]; /* in the members' own frame (2D: [2] = 0) */
+    double radius;
+} dem_clump_member;
+
+typedef struct dem_clump_shape {
+    int dim, planar;    /* planar: 2D disks of unit thickness; else spheres (in 2D: centres in
+                         * the plane) */
+    int resolution;     /* quadrature lines along the longest side of the bounding box */
+    double measure;     /* area (planar) or volume of the union */
+    double centre[3];   /* of the union, in the members' frame */
+    double tensor[9];   /* central inertia tensor per unit density (planar: per unit thickness) */
+    double moments[3];  /* principal moments, ascending (2D: [2] = the moment about z) */
+    double axes[9];     /* row-major; column k: principal axis k in the members' frame (2D: I) */
+    double rel_error;   /* largest relative change of the measure and moments from half the
+                         * resolution: an estimate of (an upper bound on) the quadrature error */
+} dem_clump_shape;
+
+/* Checks the members (radius > 0 and finite, offsets finite, 1..DEM_CLUMP_MAX_MEMBERS members
+ * that form one connected body: each overlaps or touches another) and integrates the union. */
+core_status dem_clump_shape_compute(const dem_clump_member *m, int n, int dim, int planar,
+                                    int resolution, dem_clump_shape *out, core_error *err);
+
+typedef struct dem_clump_def {
+    const dem_clump_member *members;
+    int n;
+    const dem_clump_shape *shape; /* of these members for this scene (planar when the scene's
+                                   * thickness > 0); NULL: computed here */
+    int material;
+    double x[3];     /* the centre of mass */
+    double q[4];     /* 3D: orientation (w, x, y, z), unit, members' frame to world */
+    double angle;    /* 2D: orientation, rad */
+    double v[3], omega[3]; /* 2D: omega[2] */
+} dem_clump_def;
+/* Returns the clump's index (>= 0) or -1 with err filled. */
+long dem_add_clump(dem_scene *s, const dem_clump_def *c, core_error *err);
+size_t dem_clump_count(const dem_scene *s);
+typedef struct dem_clump_state {
+    double mass, x[3], v[3], omega[3], L[3]; /* L: angular momentum about the centre, world */
+    double q[4];       /* 3D: principal (body) frame to world */
+    double angle;      /* 2D */
+    double moments[3]; /* principal moments (2D: [2]) */
+    size_t first, count;
+} dem_clump_state;
+core_status dem_clump_get(const dem_scene *s, size_t k, dem_clump_state *out, core_error *err);
+/* The clump of particle i (>= 0), or -1 for a particle of no clump. */
+long dem_particle_clump(const dem_scene *s, size_t i);
 /* Material index of each particle. */
 const int *dem_particle_materials(const dem_scene *s);
 const double *dem_masses(const dem_scene *s);

@@ -94,6 +94,9 @@ static long long atom_id(const dem_scene *s, size_t i)
 core_status dem_write_lammps_data(const dem_scene *s, const char *path,
                                   const dem_lammps_write_def *def, core_error *err)
 {
+    if (dem_clump_count(s))
+        return core_fail(err, CORE_ERR_STATE, "LAMMPS data files of scenes with clumps are not "
+                         "yet supported (their members would come back as free particles)");
     int *type = NULL, ntypes = 0;
     core_status st = atom_types(s, def, &type, &ntypes, err);
     if (st != CORE_OK)

@@ -479,4 +479,5 @@ void bind_open_dem(lua_State *L)
     bind_doc(L, -1, "dem", "dem",
              "Discrete elements: soft disks and spheres with contact laws, walls, integrators.");
     lua_setglobal(L, "dem");
+    ldem_open_clump(L);
 }
