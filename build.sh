@@ -13,11 +13,13 @@ cd "$(dirname "$0")"
 # report JSON with it), python3-vtk9 and python3-numpy (tests open the VTK files with VTK's
 # readers, whose array access needs numpy, a package --no-install-recommends leaves out) and
 # Open MPI (distributed runs: mpirun -np K grainlab script.lua), universal-ctags (the test
-# src_lengths measures functions with it). scripts/fresh_machine.sh checks this list on a clean
+# src_lengths measures functions with it), libc6-dbg (glibc's symbols: the sanitizer build's
+# leak reports name glibc's frames, and the MPI tests' suppressions of Open MPI's allocations
+# made through asprintf match them). scripts/fresh_machine.sh checks this list on a clean
 # Debian 12 root.
 packages=(build-essential cmake pkg-config liblua5.4-dev libreadline-dev libosmesa6-dev
           libpng-dev libfreetype-dev fonts-dejavu-core libcmocka-dev jq libqhull-dev
-          python3-vtk9 python3-numpy libopenmpi-dev openmpi-bin universal-ctags)
+          python3-vtk9 python3-numpy libopenmpi-dev openmpi-bin universal-ctags libc6-dbg)
 
 install_packages() {
     local missing=()

@@ -1,5 +1,6 @@
 -- grainlab.material{…}: a validated, read-only description of a grain material, shared by the
--- methods (DEM reads density, young, poisson, friction, restitution, rolling_friction).
+-- methods (DEM reads density, young, poisson, friction, restitution, rolling_friction,
+-- work_of_adhesion).
 local FIELDS = {
   name        = { kind = "string" },
   density     = { kind = "positive", required = true },  -- kg/m^3
@@ -8,6 +9,7 @@ local FIELDS = {
   friction    = { kind = "nonneg", default = 0 },         -- Coulomb coefficient
   restitution = { kind = "range", lo = 0, hi = 1, open_lo = true, default = 1 },
   rolling_friction = { kind = "nonneg", default = 0 },    -- rolling resistance mu_r (DEM)
+  work_of_adhesion = { kind = "nonneg", default = 0 },    -- Gamma, J/m^2 (DEM jkr, dmt)
 }
 
 local function describe(v)
@@ -46,7 +48,8 @@ local function material(t)
   for k in pairs(t) do
     if not FIELDS[k] then
       error("bad argument #1 to 'material' " .. require("grainlab.args").unknown(k,
-        { "density", "friction", "name", "poisson", "restitution", "rolling_friction", "young" }), 2)
+        { "density", "friction", "name", "poisson", "restitution", "rolling_friction",
+          "work_of_adhesion", "young" }), 2)
     end
   end
   local m = {}
@@ -82,9 +85,11 @@ local field_names = {}
 for name in pairs(FIELDS) do field_names[#field_names + 1] = name end
 table.sort(field_names)
 grainlab.doc(material, { name = "grainlab.material", fields = field_names,
-  usage = "grainlab.material{ density = 2650, young = 30e9, poisson = 0.3, friction = 0.45, restitution = 0.5, rolling_friction = 0, name = 'quartz' }",
+  usage = "grainlab.material{ density = 2650, young = 30e9, poisson = 0.3, friction = 0.45, restitution = 0.5, rolling_friction = 0, work_of_adhesion = 0, name = 'quartz' }",
   doc = [[A read-only grain material. density (kg/m^3) and young (Pa) are required; poisson defaults
 to 0.3, friction (Coulomb mu) to 0, restitution to 1 (elastic), rolling_friction (the rolling
-resistance mu_r of a DEM contact law with rolling_resistance) to 0. A DEM pair uses the smaller
-friction, restitution and rolling_friction of its two materials and the effective modulus of both.]] })
+resistance mu_r of a DEM contact law with rolling_resistance) to 0, work_of_adhesion (the work
+of adhesion Gamma in J/m^2 of the DEM normal laws jkr and dmt, twice the surface energy per
+surface) to 0. A DEM pair uses the smaller friction, restitution and rolling_friction of its two
+materials, the geometric mean of their work_of_adhesion and the effective modulus of both.]] })
 return material

@@ -233,6 +233,12 @@ bench{
   rows = function(m) return mpm_rows("bench_mpm_shear_noslip", m, false) end,
 }
 
+local function continuum_scene(sc)
+  return function(m)
+    return string.format("%s points, %s cells across the column", count(m(sc, "points")),
+                         m(sc, "cells_across_l0"))
+  end
+end
 local function continuum_rows(sc, m)
   return {
     { "point-steps/s", "1", num(m(sc, "particle_steps_per_s_1_threads")) },
@@ -248,11 +254,7 @@ bench{
              "continuum; then the whole collapse of the demo's column both ways on one thread: " ..
              "1500 disks in DEM from the gate's removal to rest, and its continuum twin (10 cells " ..
              "across the column) until its front stops",
-  scene = function(m)
-    local c = "bench_mpm_continuum"
-    return string.format("%s points, %s cells across the column", count(m(c, "points")),
-                         m(c, "cells_across_l0"))
-  end,
+  scene = continuum_scene("bench_mpm_continuum"),
   rows = function(m)
     local c = "bench_mpm_continuum"
     local rows = continuum_rows(c, m)
@@ -269,11 +271,7 @@ bench{
   name = "MPM continuum column, large", script = "continuum.lua cells=360 whole=false",
   needs = { "bench_mpm_continuum_large" },
   measures = "the same column on a finer grid",
-  scene = function(m)
-    local c = "bench_mpm_continuum_large"
-    return string.format("%s points, %s cells across the column", count(m(c, "points")),
-                         m(c, "cells_across_l0"))
-  end,
+  scene = continuum_scene("bench_mpm_continuum_large"),
   rows = function(m)
     local rows = continuum_rows("bench_mpm_continuum_large", m)
     rows[2][4] = true

@@ -402,6 +402,29 @@ static void read_rolling(reader *r, dem_scene *s)
     }
 }
 
+static void read_cohesion(reader *r, dem_scene *s)
+{
+    dem_contact_def *c = &s->contact;
+    c->adhesion = get_finite(r, "work_of_adhesion");
+    uint32_t law = u32(r);
+    if (law >= DEM_COHESION_COUNT)
+        bad(r, "unknown cohesion law");
+    c->cohesion = (dem_cohesion_law)law;
+    c->liquid_volume = get_finite(r, "liquid_volume");
+    c->surface_tension = get_finite(r, "surface_tension");
+    c->contact_angle = get_finite(r, "contact_angle");
+    if (u64(r) != (uint64_t)s->nmat)
+        bad(r, "material count");
+    for (int k = 0; k < s->nmat && !r->st; k++)
+        s->mats[k].adhesion = get_num_in(r, "a material's work of adhesion", 0, DBL_MAX);
+    get_opt(r, &s->pairs.hist[DEM_HIST_BOND], s->pairs.n, s->pairs.n);
+    if (u64(r) != (uint64_t)s->nwalls)
+        bad(r, "wall count");
+    const size_t n = s->n;
+    for (int k = 0; k < s->nwalls && !r->st; k++)
+        get_opt(r, &s->walls[k].hist[DEM_HIST_BOND], n, n ? n : 1);
+}
+
 /* A file that passed the checksum but was not written by dem_save (forged, or a bug) must not
  * make a step read arrays that are not there: the kernels allocate their state in whole sets,
  * and a list in use covers every particle. Returns what is wrong, or NULL. */
@@ -445,6 +468,8 @@ static const char *inconsistent(const dem_scene *s, int gear_ready, int prev_rea
                 return "rolling history missing";
         if (s->contact.rolling_law && !p->rt[2])
             return "rolling torques missing";
+        if (dem_bonds(&s->contact) && p->n > 0 && !p->hist[DEM_HIST_BOND])
+            return "cohesion history missing";
     }
     return NULL;
 }
@@ -473,8 +498,8 @@ static void read_materials(reader *r, ckpt_reader *ck, dem_scene *s)
         double v[5];
         if ((r->st = ckpt_get_f64s(&r->sec, v, 5, r->err)))
             break;
-        /* the checks of s:add_material; rolling friction: its own section */
-        const dem_material m = {v[0], v[1], v[2], v[3], v[4], 0};
+        /* the checks of s:add_material; rolling friction, adhesion: their own sections */
+        const dem_material m = {v[0], v[1], v[2], v[3], v[4], 0, 0};
         if (relay(r, dem_add_material(s, &m, r->err) < 0 ? CORE_ERR_ARG : CORE_OK))
             break;
     }
@@ -683,6 +708,13 @@ static void read_all(reader *r, ckpt_reader *ck, const dem_boundary_restorer *re
     if (!r->st && ckpt_has(ck, "rolling")) {
         open_section(r, ck, "rolling");
         read_rolling(r, s);
+        if (!r->st)
+            check_contact(r, &def, &s->contact);
+        close_section(r);
+    }
+    if (!r->st && ckpt_has(ck, "cohesion")) {
+        open_section(r, ck, "cohesion");
+        read_cohesion(r, s);
         if (!r->st)
             check_contact(r, &def, &s->contact);
         close_section(r);

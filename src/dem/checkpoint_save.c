@@ -77,6 +77,38 @@ static core_status write_rolling(const dem_scene *s, ckpt_writer *w, core_error 
     return end(w, err);
 }
 
+/* Cohesion (cohesion.h) has its own section too, written only by a scene that uses it (a JKR or
+ * DMT law, a liquid bridge, or a material with a work of adhesion): the contact's values, the
+ * materials' work of adhesion, and which pairs' and planes' cohesive contacts hold. */
+static int uses_cohesion(const dem_scene *s)
+{
+    int used = dem_cohesive(&s->contact);
+    for (int k = 0; k < s->nmat; k++)
+        used |= s->mats[k].adhesion != 0;
+    return used;
+}
+
+static core_status write_cohesion(const dem_scene *s, ckpt_writer *w, core_error *err)
+{
+    core_status st;
+    if ((st = ckpt_section_begin(w, "cohesion", CKPT_REQUIRED, err)))
+        return st;
+    const dem_contact_def *c = &s->contact;
+    ckpt_put_f64(w, c->adhesion);
+    ckpt_put_u32(w, (uint32_t)c->cohesion);
+    ckpt_put_f64(w, c->liquid_volume);
+    ckpt_put_f64(w, c->surface_tension);
+    ckpt_put_f64(w, c->contact_angle);
+    ckpt_put_u64(w, (uint64_t)s->nmat);
+    for (int k = 0; k < s->nmat; k++)
+        ckpt_put_f64(w, s->mats[k].adhesion);
+    put_opt(w, s->pairs.hist[DEM_HIST_BOND], s->pairs.n);
+    ckpt_put_u64(w, (uint64_t)s->nwalls);
+    for (int k = 0; k < s->nwalls; k++)
+        put_opt(w, s->walls[k].hist[DEM_HIST_BOND], s->n);
+    return end(w, err);
+}
+
 /* Damping solved from a restitution (restitution.c) has its own section, written only by a
  * scene whose law uses it: the coefficients of s:contact's restitution and of each material, as
  * they were solved (a file without it, from a scene whose law needs it, is refused). */
@@ -254,6 +286,8 @@ static core_status write_scene(const dem_scene *s, ckpt_writer *w, core_error *e
     if ((st = end(w, err)))
         return st;
     if (uses_rolling(s) && (st = write_rolling(s, w, err)))
+        return st;
+    if (uses_cohesion(s) && (st = write_cohesion(s, w, err)))
         return st;
     if (dem_checkpoint_damping(&s->contact) && (st = write_damping(s, w, err)))
         return st;

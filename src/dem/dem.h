@@ -73,6 +73,8 @@ typedef struct dem_material {
                           * pair takes the smaller of its two); 1 = none */
     double rolling_friction; /* rolling resistance mu_r >= 0 (the torque limit is mu_r R_eff
                               * F_n); a pair uses the smaller of its two; 0 (default) = none */
+    double adhesion; /* work of adhesion Gamma >= 0, J/m^2 (JKR, DMT); a pair takes the geometric
+                      * mean of its two, unless the contact gives one; 0 (default) = none */
 } dem_material;
 
 dem_material dem_default_material(void); /* quartz: 2650, 30 GPa, 0.3, 0.45, 0.5 */
@@ -110,6 +112,12 @@ typedef struct dem_contact_def {
     double rolling_rate;    /* CONSTANT w_c, rad/s; 0 (default) = automatic: the rate below
                              * which the full torque would stop the relative rotation of the
                              * contact within 10 steps (rolling.inc) */
+    double adhesion;        /* JKR, DMT: the work of adhesion Gamma of every pair, J/m^2; < 0
+                             * (default) = the materials' (cohesion.h) */
+    dem_cohesion_law cohesion; /* a liquid bridge added to the normal law; NONE default */
+    double liquid_volume;      /* CAPILLARY: the volume V of each bridge, m^3 */
+    double surface_tension;    /* CAPILLARY: the liquid's gamma, N/m */
+    double contact_angle;      /* CAPILLARY: theta in [0, pi), rad */
 } dem_contact_def;
 
 dem_contact_def dem_default_contact_def(void); /* Hertz, no damping, no friction, clip */

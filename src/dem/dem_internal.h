@@ -14,9 +14,12 @@
 
 /* Contact history slots (pairs and walls): [0..2] the tangential spring force and [3] its last
  * stiffness (SPRING law), [4..6] the rolling spring torque (rolling EPSD; 2D: [4] only, the z
- * component). Slots a scene's laws do not use stay NULL. */
-#define DEM_HIST 7
+ * component), [7] 1 while a cohesive contact holds: a JKR contact or a liquid bridge formed at
+ * touch that has not yet broken (cohesion.h; pairs and planes). Slots a scene's laws do not use
+ * stay NULL. */
+#define DEM_HIST 8
 #define DEM_HIST_ROLL 4
+#define DEM_HIST_BOND 7
 
 typedef struct dem_shape dem_shape; /* walls beyond planes (walls.c) */
 enum { DEM_SHAPE_LOAD = 7 };        /* per candidate: force[3], torque[3], f_n */
@@ -53,7 +56,8 @@ typedef struct dem_pairs {
     double *mu;       /* friction of the pair */
     double *hist[DEM_HIST]; /* SPRING law: the tangential force on i ([0..2]; 2D: [0] along t)
                              * and [3] the spring stiffness of the last step (for the unloading
-                             * rescale); rolling EPSD: [4..6] the rolling spring torque on i */
+                             * rescale); rolling EPSD: [4..6] the rolling spring torque on i;
+                             * JKR, capillary: [7] the contact holds (DEM_HIST_BOND) */
     double *rt[3];          /* rolling resistance: the rolling torque on i of the evaluation
                              * (j gets the opposite; 2D: rt[2] only), scratch between the pair
                              * kernel and the gather; NULL without a rolling law */
@@ -74,6 +78,8 @@ struct dem_scene {
     double drag;           /* background drag rate, 1/s */
     double skin_def;       /* as given (0 = automatic) */
     double skin;           /* in use */
+    double reach;          /* how far beyond touch a cohesive contact holds, at most (the pair
+                            * list's cutoff adds it; 0 without cohesion) */
 
     size_t n, cap;
     double *x[3], *v[3], *f[3];
@@ -343,6 +349,35 @@ static inline int dem_rolling_slots(const dem_scene *s)
     return dem_rolling_history(s->contact.rolling_law) ? (s->dim == 2 ? 1 : 3) : 0;
 }
 static inline int dem_hist_width(const dem_scene *s) { return dem_rolling_slots(s) ? DEM_HIST : 4; }
+
+/* The laws that make a contact cohesive (cohesion.h); the ones that hold beyond touch keep the
+ * history slot DEM_HIST_BOND. */
+static inline int dem_cohesive(const dem_contact_def *c)
+{
+    return c->normal == DEM_NORMAL_JKR || c->normal == DEM_NORMAL_DMT ||
+           c->cohesion != DEM_COHESION_NONE;
+}
+static inline int dem_bonds(const dem_contact_def *c)
+{
+    return c->normal == DEM_NORMAL_JKR || c->cohesion != DEM_COHESION_NONE;
+}
+/* neighbor.c: the scene's reach (dem_scene.reach) under its laws, materials and largest radius;
+ * the pair's work of adhesion. */
+double dem_cohesion_reach(const dem_scene *s);
+static inline double dem_pair_adhesion(const dem_scene *s, size_t i, size_t j)
+{
+    if (s->contact.adhesion >= 0)
+        return s->contact.adhesion;
+    return sqrt(s->mats[s->mat[i]].adhesion * s->mats[s->mat[j]].adhesion);
+}
+/* The same for particle i against wall w (its material, or i's own). */
+static inline double dem_wall_adhesion(const dem_scene *s, const dem_wall *w, size_t i)
+{
+    if (s->contact.adhesion >= 0)
+        return s->contact.adhesion;
+    const int mi = s->mat[i], mw = w->material >= 0 ? w->material : mi;
+    return sqrt(s->mats[mi].adhesion * s->mats[mw].adhesion);
+}
 
 /* clump.c: rigid bodies of member particles. body[i] is particle i's clump or -1; off holds
  * each member's offset in its body's principal frame (3 per particle). */

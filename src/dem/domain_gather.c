@@ -130,7 +130,7 @@ core_status dem_parray_resize(dem_scene *s, const dem_parray *a, int na, size_t 
  */
 typedef struct pair_rec {
     uint32_t i, j;
-    double v[16]; /* k, gamma, mu, f[3], c[3], hist[DEM_HIST] */
+    double v[9 + DEM_HIST]; /* k, gamma, mu, f[3], c[3], hist[DEM_HIST] */
 } pair_rec;
 
 static int cmp_pair(const void *pa, const void *pb)

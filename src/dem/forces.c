@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "core/clones.h"
+#include "dem/cohesion.h"
 #include "dem/dem_internal.h"
 
 #include "dem/laws.inc"
@@ -61,6 +62,75 @@ static inline double normal_force(const dem_contact_def *c, double k, double gam
         break;
     }
     return f;
+}
+
+/* The damping law alone: f plus its dashpot. */
+static inline double damping_force(const dem_contact_def *c, double f, double k, double gamma,
+                                   double sqrt_delta, double ddelta)
+{
+    switch (c->damping) {
+#define LAW_(a, ID, name, ...)                                                                     \
+    case DEM_DAMPING_##ID:                                                                         \
+        return damping_##name(f, k, gamma, sqrt_delta, ddelta);
+        DEM_DAMPING_LAWS(LAW_, _)
+#undef LAW_
+    default:
+        LAW_OUT_OF_RANGE();
+    }
+}
+
+/* A cohesive pair's constants (cohesion.h): R*, E* (from k = 4/3 E* sqrt(R*)), Gamma, and the
+ * scene's bridge: V, gamma cos(theta), the rupture separation. */
+typedef struct coh_pair {
+    double R, E, G, V, gcos, rupture;
+} coh_pair;
+
+/* How far beyond touch (> 0) a contact that holds may be pulled before it breaks. */
+static inline double coh_reach(const dem_contact_def *c, const coh_pair *h)
+{
+    return c->normal == DEM_NORMAL_JKR ? coh_jkr_pulloff_distance(h->R, h->E, h->G) : h->rupture;
+}
+
+/* One cohesive contact (JKR, DMT, or a normal law with a liquid bridge) at overlap delta (< 0: a
+ * JKR contact or a bridge that holds): *fn the normal force (> 0 repulsive), *fnt the normal
+ * load of the friction limit, *sqe the sqrt(delta) that the damping and the tangential spring
+ * take. Returns 1 when the surfaces touch (a tangential force acts). As for the tension column of
+ * laws.h, the clip keeps only the damping from pulling: the adhesion is added after it. The
+ * friction limit of JKR and DMT is LAMMPS's, |F_ne + 2 F_pulloff| with F_ne the elastic force
+ * including the adhesion (pull-off forces 3/2 pi Gamma R and 2 pi Gamma R); a bridge's is the
+ * contact's repulsion, which carries the bridge's pull. */
+static inline int cohesive_force(const dem_contact_def *c, const coh_pair *h, double k,
+                                 double gamma, double delta, double sq, double ddelta, double *fn,
+                                 double *fnt, double *sqe)
+{
+    if (c->normal == DEM_NORMAL_JKR || c->normal == DEM_NORMAL_DMT) {
+        double fh, fa, se = sq;
+        if (c->normal == DEM_NORMAL_JKR) {
+            coh_jkr(h->R, h->E, h->G, delta, &fh, &fa, &se);
+        } else {
+            fh = k * delta * sq;
+            fa = 2 * COH_PI * h->G * h->R;
+        }
+        double f = damping_force(c, fh, k, gamma, se, ddelta);
+        if (c->clip && f < 0)
+            f = 0;
+        const double po = c->normal == DEM_NORMAL_JKR ? 1.5 * COH_PI * h->G * h->R : fa;
+        *fn = f - fa;
+        *fnt = fabs(fh - fa + 2 * po);
+        *sqe = se;
+        return 1;
+    }
+    if (delta > 0) {
+        const double f = normal_force(c, k, gamma, delta, sq, ddelta);
+        *fn = f - coh_capillary(h->R, h->V, h->gcos, 0);
+        *fnt = f;
+        *sqe = sq;
+        return 1;
+    }
+    *fn = -coh_capillary(h->R, h->V, h->gcos, -delta);
+    *fnt = 0;
+    *sqe = 0;
+    return 0;
 }
 
 double dem_normal_force(const dem_contact_def *c, double k, double gamma, double delta,

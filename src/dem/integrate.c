@@ -39,6 +39,14 @@ static core_status prepare(dem_scene *s, const dem_run_def *run, core_error *err
             }
         }
     }
+    for (int w = 0; w < s->nwalls && dem_bonds(&s->contact); w++) { /* cohesion.h: planes */
+        double **h = &s->walls[w].hist[DEM_HIST_BOND];
+        if (!s->walls[w].active || s->walls[w].shape || *h)
+            continue;
+        if (dem_alloc_array(h, s->cap, err))
+            return err->status;
+        memset(*h, 0, s->cap * sizeof(double));
+    }
     for (int w = 0; w < s->nwalls; w++) /* the rolling spring's, per particle (rolling.inc) */
         for (int d = 0; d < dem_rolling_slots(s) && s->walls[w].active; d++) {
             double **h = &s->walls[w].hist[DEM_HIST_ROLL + d];
@@ -695,6 +703,10 @@ static core_status run_steps(dem_scene *s, const dem_run_def *run, core_error *e
                          "boundary conditions (pressure tractions, the minimal boundary, springs, "
                          "ties to walls, prescribed spins) do not yet run distributed "
                          "(comm_size() > 1): run this scene on one rank");
+    if (comm_size() > 1 && dem_cohesive(&s->contact))
+        return core_fail(err, CORE_ERR_STATE,
+                         "cohesive contacts (normal 'jkr' or 'dmt', cohesion 'capillary') do not "
+                         "yet run distributed (comm_size() > 1): run this scene on one rank");
     for (int w = 0; w < s->nwalls && comm_size() > 1; w++)
         if (s->walls[w].active && s->walls[w].shape)
             return core_fail(err, CORE_ERR_STATE,

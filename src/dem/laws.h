@@ -22,7 +22,11 @@
     X(a, LINEAR, linear, STIFFNESS, 0, 1) /* f = k delta (Herrmann Eq. 1a, beta = 1) */            \
     X(a, POWER, power, STIFFNESS, 0, 0)   /* f = k delta^beta, beta in {1, 3/2, 2} (Eq. 1a) */     \
     X(a, HERTZ, hertz, MODULI, 0, 1)      /* f = K delta^{3/2}, K = 4/3 E* sqrt(R) (Padbidri       \
-                                           * Eq. 1.1, 2.16) */
+                                           * Eq. 1.1, 2.16) */                                     \
+    X(a, DMT, dmt, MODULI, 0, 0)          /* Hertz minus 2 pi Gamma R* in contact (Derjaguin,      \
+                                           * Muller & Toporov 1975): cohesion.h */                 \
+    X(a, JKR, jkr, MODULI, 0, 0)          /* Johnson, Kendall & Roberts 1971, with its hysteresis: \
+                                           * cohesion.h */
 
 /* Normal damping, added to the elastic force. The function (laws.inc):
  * damping_NAME(f, k, gamma, sqrt_delta, ddelta) returns f plus the damping force; gamma is the
@@ -58,6 +62,13 @@
     X(a, CONSTANT, constant, 0) /* Ai et al. type A: M = -mu_r R_eff F_n w_rel / |w_rel|, linear   \
                                  * below a rate w_c so that a grain at rest does not chatter */
 
+/* Cohesion added to the normal law of a contact (cohesion.h): a liquid bridge that forms at touch
+ * and ruptures at a separation. JKR and DMT are normal laws of their own (above).
+ *   holds    1: the contact holds beyond touch (the history slot DEM_HIST_BOND) */
+#define DEM_COHESION_LAWS(X, a)                                                                    \
+    X(a, NONE, none, 0)                                                                            \
+    X(a, CAPILLARY, capillary, 1) /* Rabinovich et al. 2005, rupture (1 + theta/2) V^{1/3} */
+
 /* ---- what the lists make ----------------------------------------------------------------- */
 #define DEM_LAW_ENUM_(prefix, ID, ...) prefix##ID,
 typedef enum dem_normal_law {
@@ -72,6 +83,9 @@ typedef enum dem_tangential_law {
 typedef enum dem_rolling_law {
     DEM_ROLLING_LAWS(DEM_LAW_ENUM_, DEM_ROLLING_) DEM_ROLLING_COUNT
 } dem_rolling_law;
+typedef enum dem_cohesion_law {
+    DEM_COHESION_LAWS(DEM_LAW_ENUM_, DEM_COHESION_) DEM_COHESION_COUNT
+} dem_cohesion_law;
 #undef DEM_LAW_ENUM_
 
 /* The names, in enum order, each list ended by NULL (laws.c). */
@@ -79,6 +93,7 @@ extern const char *const dem_normal_names[];
 extern const char *const dem_damping_names[];
 extern const char *const dem_tangent_names[];
 extern const char *const dem_rolling_names[];
+extern const char *const dem_cohesion_names[];
 
 /* The columns, for a law known at run time (constants fold where it is a constant). */
 #define DEM_LAW_K_MODULI 1
@@ -94,6 +109,12 @@ static inline int dem_normal_from_moduli(dem_normal_law law)
     default:
         return 0;
     }
+}
+
+/* Hertz and the laws with its elastic part (JKR, DMT): Brilliantov damping applies. */
+static inline int dem_normal_hertzian(dem_normal_law law)
+{
+    return law == DEM_NORMAL_HERTZ || law == DEM_NORMAL_JKR || law == DEM_NORMAL_DMT;
 }
 
 static inline double dem_damping_exponent(dem_damping_law law)

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "dem/cohesion.h"
 #include "dem/dem_internal.h"
 
 void dem_free_pairs(dem_pairs *p)
@@ -158,6 +159,8 @@ static core_status reserve_pairs(dem_scene *s, size_t n, core_error *err)
         st = dem_alloc_array(&p->rt[d], cap, err);
     for (int d = 0; d < dem_rolling_slots(s) && !st; d++)
         st = dem_alloc_array(&p->hist[DEM_HIST_ROLL + d], cap, err);
+    if (!st && dem_bonds(&s->contact))
+        st = dem_alloc_array(&p->hist[DEM_HIST_BOND], cap, err);
     if (!st)
         p->cap = cap;
     return st;
@@ -278,7 +281,7 @@ static size_t scan(const dem_scene *s, size_t i, uint32_t *out)
                     uint32_t j = s->cell_items[e];
                     if (j <= i || (gi && gh[j]) || (bi >= 0 && bd[j] == bi))
                         continue;
-                    double cut = s->r[i] + s->r[j] + s->skin;
+                    double cut = s->r[i] + s->r[j] + s->skin + s->reach;
                     if (dist2(s, i, j) < cut * cut) {
                         if (out)
                             out[count] = j;
@@ -401,7 +404,7 @@ static void carry_history(dem_scene *s, const dem_pairs *old_list, int carry)
     dem_pairs *p = &s->pairs;
     const size_t *start = p->start;
     const dem_pairs old = *old_list;
-    const int any_hist = p->hist[0] || p->hist[DEM_HIST_ROLL];
+    const int any_hist = p->hist[0] || p->hist[DEM_HIST_ROLL] || p->hist[DEM_HIST_BOND];
     if (any_hist && s->dom) {
         /* Distributed: the history came with each first particle (its bundle, domain.c). */
         const int hw = dem_hist_width(s);
@@ -452,7 +455,7 @@ static core_status plane_candidates(dem_scene *s, dem_wall *wl, core_error *err)
         double dist = 0;
         for (int d = 0; d < D; d++)
             dist += (s->x[d][i] - wl->point[d]) * wl->normal[d];
-        if (dist >= s->r[i] + s->skin)
+        if (dist >= s->r[i] + s->skin + s->reach)
             continue;
         if (wl->ncand == wl->cap_cand) {
             size_t cap = wl->cap_cand ? 2 * wl->cap_cand : 256;
@@ -475,16 +478,41 @@ static core_status plane_candidates(dem_scene *s, dem_wall *wl, core_error *err)
     return CORE_OK;
 }
 
+/* How far beyond touch a contact of a particle of the largest radius can hold, with another or
+ * with a plane (R* = r_max): a JKR contact to its pull-off distance (the largest over pairs of
+ * materials, or with the contact's work of adhesion), a liquid bridge to its rupture distance
+ * (cohesion.h). A bound: each contact holds to its own. */
+double dem_cohesion_reach(const dem_scene *s)
+{
+    const dem_contact_def *c = &s->contact;
+    double reach = 0;
+    if (c->normal == DEM_NORMAL_JKR) {
+        const double R = s->r_max;
+        for (int a = 0; a < s->nmat; a++)
+            for (int b = a; b < s->nmat; b++) {
+                const dem_material *ma = &s->mats[a], *mb = &s->mats[b];
+                const double E = effective_modulus(ma, mb);
+                const double G = c->adhesion >= 0 ? c->adhesion : sqrt(ma->adhesion * mb->adhesion);
+                const double d = coh_jkr_pulloff_distance(R, E, G);
+                reach = d > reach ? d : reach;
+            }
+    }
+    if (c->cohesion == DEM_COHESION_CAPILLARY)
+        reach = coh_capillary_rupture(c->liquid_volume, c->contact_angle);
+    return reach * 1.0001; /* rounding */
+}
+
 core_status dem_build_pairs(dem_scene *s, core_error *err)
 {
     const int D = s->dim;
     const size_t n = s->n;
     dem_pairs *p = &s->pairs;
     s->skin = s->skin_def > 0 ? s->skin_def : 0.2 * s->r_max;
+    s->reach = dem_cohesive(&s->contact) ? dem_cohesion_reach(s) : 0;
 
     dem_wrap_positions(s);
 
-    core_status st = setup_cells(s, 2 * s->r_max + s->skin, err);
+    core_status st = setup_cells(s, 2 * s->r_max + s->skin + s->reach, err);
     if (st)
         return st;
     if ((st = bin_particles(s, err)))
@@ -505,7 +533,7 @@ core_status dem_build_pairs(dem_scene *s, core_error *err)
 
     /* Keep the old list to carry the contact history over. */
     dem_pairs old = *p;
-    int carry = (old.hist[0] || old.hist[DEM_HIST_ROLL]) && old.start;
+    int carry = (old.hist[0] || old.hist[DEM_HIST_ROLL] || old.hist[DEM_HIST_BOND]) && old.start;
     memset(p, 0, sizeof *p);
     if ((st = reserve_pairs(s, npairs, err))) {
         free(start);

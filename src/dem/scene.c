@@ -42,7 +42,12 @@ dem_contact_def dem_default_contact_def(void)
                              .rolling_friction = -1,
                              .rolling_stiffness = -1,
                              .rolling_damping = 0,
-                             .rolling_rate = 0};
+                             .rolling_rate = 0,
+                             .adhesion = -1,
+                             .cohesion = DEM_COHESION_NONE,
+                             .liquid_volume = 0,
+                             .surface_tension = 0,
+                             .contact_angle = 0};
 }
 
 void dem_invalidate(dem_scene *s, int list)
@@ -164,6 +169,9 @@ int dem_add_material(dem_scene *s, const dem_material *m, core_error *err)
         return core_fail(err, CORE_ERR_ARG, "rolling_friction must be >= 0, got %g",
                          m->rolling_friction),
                -1;
+    if (!(m->adhesion >= 0) || !isfinite(m->adhesion))
+        return core_fail(err, CORE_ERR_ARG, "work_of_adhesion must be >= 0, got %g", m->adhesion),
+               -1;
     /* the damping its restitution gives under the scene's law (restitution.c) */
     double coef = 0;
     int same = 0;
@@ -192,6 +200,32 @@ int dem_add_material(dem_scene *s, const dem_material *m, core_error *err)
 }
 
 /* ---- contact law ---------------------------------------------------------------------------- */
+/* The cohesive laws' values (cohesion.h) and what they compose with. */
+static core_status check_cohesion(const dem_contact_def *c, core_error *err)
+{
+    if ((unsigned)c->cohesion >= DEM_COHESION_COUNT)
+        return core_fail(err, CORE_ERR_ARG, "unknown cohesion law %d", (int)c->cohesion);
+    if (!(c->adhesion < 0 || isfinite(c->adhesion)))
+        return core_fail(err, CORE_ERR_ARG, "work_of_adhesion must be finite, got %g",
+                         c->adhesion);
+    if (c->cohesion != DEM_COHESION_CAPILLARY)
+        return CORE_OK;
+    if (c->normal == DEM_NORMAL_JKR || c->normal == DEM_NORMAL_DMT)
+        return core_fail(err, CORE_ERR_ARG,
+                         "cohesion 'capillary' adds a liquid bridge to the linear, power or hertz "
+                         "law; the %s law has its own adhesion: choose one of the two",
+                         dem_normal_names[c->normal]);
+    if (!(c->liquid_volume > 0) || !isfinite(c->liquid_volume))
+        return core_fail(err, CORE_ERR_ARG, "liquid_volume must be > 0, got %g", c->liquid_volume);
+    if (!(c->surface_tension >= 0) || !isfinite(c->surface_tension))
+        return core_fail(err, CORE_ERR_ARG, "surface_tension must be >= 0, got %g",
+                         c->surface_tension);
+    if (!(c->contact_angle >= 0 && c->contact_angle < DEM_PI))
+        return core_fail(err, CORE_ERR_ARG, "contact_angle must be in [0, pi) rad, got %g",
+                         c->contact_angle);
+    return CORE_OK;
+}
+
 core_status dem_set_contact(dem_scene *s, const dem_contact_def *c, core_error *err)
 {
     if ((unsigned)c->normal >= DEM_NORMAL_COUNT || (unsigned)c->damping >= DEM_DAMPING_COUNT ||
@@ -205,11 +239,14 @@ core_status dem_set_contact(dem_scene *s, const dem_contact_def *c, core_error *
     }
     if (c->normal == DEM_NORMAL_POWER && c->beta != 1 && c->beta != 1.5 && c->beta != 2)
         return core_fail(err, CORE_ERR_ARG, "beta must be 1, 1.5 or 2, got %g", c->beta);
-    if (c->damping == DEM_DAMPING_BRILLIANTOV && c->normal != DEM_NORMAL_HERTZ)
+    if (c->damping == DEM_DAMPING_BRILLIANTOV && !dem_normal_hertzian(c->normal))
         return core_fail(err, CORE_ERR_ARG,
-                         "brilliantov damping needs the hertz normal law (with the %s law, "
-                         "damping 'viscous' honours a restitution)",
+                         "brilliantov damping needs the hertz, jkr or dmt normal law (with the %s "
+                         "law, damping 'viscous' honours a restitution)",
                          dem_normal_names[c->normal]);
+    core_status cst = check_cohesion(c, err);
+    if (cst != CORE_OK)
+        return cst;
     if (c->damping == DEM_DAMPING_BRILLIANTOV && !(c->damping_time < 0 || isfinite(c->damping_time)))
         return core_fail(err, CORE_ERR_ARG, "damping_time must be finite, got %g", c->damping_time);
     if (c->damping == DEM_DAMPING_VISCOUS && !(c->gamma_n < 0 || isfinite(c->gamma_n)))
@@ -287,6 +324,7 @@ core_status dem_set_contact(dem_scene *s, const dem_contact_def *c, core_error *
         }
     }
     int spring_before = dem_tangent_history(s->contact.tangential);
+    int bonds_before = dem_bonds(&s->contact);
     int roll_before = s->contact.rolling_law;
     s->contact = *c;
     s->brill_c = brill_c;
@@ -320,6 +358,14 @@ core_status dem_set_contact(dem_scene *s, const dem_contact_def *c, core_error *
                 s->walls[w].hist[DEM_HIST_ROLL + d] = NULL;
             }
         }
+    if (bonds_before != dem_bonds(c)) { /* the cohesive contacts that hold */
+        free(s->pairs.hist[DEM_HIST_BOND]);
+        s->pairs.hist[DEM_HIST_BOND] = NULL;
+        for (int w = 0; w < s->nwalls; w++) {
+            free(s->walls[w].hist[DEM_HIST_BOND]);
+            s->walls[w].hist[DEM_HIST_BOND] = NULL;
+        }
+    }
     dem_invalidate(s, 1);
     return CORE_OK;
 }
@@ -366,8 +412,8 @@ static core_status grow(dem_scene *s, size_t need, core_error *err)
             if (s->gear_w[k][d])
                 st = dem_alloc_array(&s->gear_w[k][d], cap, err);
         for (int w = 0; w < s->nwalls && st == CORE_OK; w++)
-            for (int k = d; k < DEM_HIST; k += 3) /* components d (tangential, rolling), and
-                                                   * [3] once (with d = 0) */
+            for (int k = d; k < DEM_HIST; k += 3) /* components d (tangential, rolling), [3]
+                                                   * once (with d = 0), [7] (with d = 1) */
                 if (s->walls[w].hist[k] && (k != 3 || d == 0)) {
                     st = dem_alloc_array(&s->walls[w].hist[k], cap, err);
                     if (st == CORE_OK)

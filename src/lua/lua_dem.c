@@ -162,7 +162,9 @@ int ldem_material_index(lua_State *L, int scene, int arg, const char *call, cons
         m.restitution = lua_tonumber(L, -1);
         lua_getfield(L, -7, "rolling_friction");
         m.rolling_friction = lua_tonumber(L, -1);
-        lua_pop(L, 6);
+        lua_getfield(L, -8, "work_of_adhesion");
+        m.adhesion = lua_tonumber(L, -1);
+        lua_pop(L, 7);
     }
     core_error err;
     int idx = dem_add_material(s, &m, &err);
@@ -384,6 +386,8 @@ static int l_info(lua_State *L)
     lua_setfield(L, -2, "tangential");
     lua_pushstring(L, dem_rolling_names[c->rolling_law]);
     lua_setfield(L, -2, "rolling_resistance");
+    lua_pushstring(L, dem_cohesion_names[c->cohesion]);
+    lua_setfield(L, -2, "cohesion");
     lua_pushnumber(L, c->damping_time);
     lua_setfield(L, -2, "damping_time");
     dem_domain_stats ds;

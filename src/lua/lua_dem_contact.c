@@ -34,6 +34,11 @@ static const char *const CONTACT_FIELDS[] = {"normal",
                                              "rolling_stiffness",
                                              "rolling_damping",
                                              "rolling_rate",
+                                             "work_of_adhesion",
+                                             "cohesion",
+                                             "liquid_volume",
+                                             "surface_tension",
+                                             "contact_angle",
                                              NULL};
 
 /* The normal laws whose k is s:contact's stiffness (moduli 0), or comes from the materials
@@ -79,12 +84,12 @@ static void read_laws(lua_State *L, dem_contact_def *c)
     c->tangential = (dem_tangential_law)bind_field_option(L, 2, "contact", "tangential",
                                                           dem_tangent_names, DEM_TANGENT_NONE, 0);
     lua_settop(L, 2);
-    if (c->damping == DEM_DAMPING_BRILLIANTOV && c->normal != DEM_NORMAL_HERTZ) {
+    if (c->damping == DEM_DAMPING_BRILLIANTOV && !dem_normal_hertzian(c->normal)) {
         lua_getfield(L, 2, "damping");
         bind_field_error(L, 2, "contact", "damping",
                          "'none' or 'viscous' with the linear and power laws (brilliantov "
-                         "damping needs normal = 'hertz'; viscous damping honours a "
-                         "restitution with every law)");
+                         "damping needs normal = 'hertz', 'jkr' or 'dmt'; viscous damping "
+                         "honours a restitution with every law)");
     }
     char given[96], moduli[96], why[256];
     normal_names_by_k(0, 1, given, sizeof given);
@@ -135,7 +140,7 @@ static void read_damping(lua_State *L, dem_contact_def *c, double *e_out, double
             bind_field_error(L, 2, "contact", "restitution", "number in (0, 1]");
         if (c->damping == DEM_DAMPING_NONE && e < 1)
             bind_field_error(L, 2, "contact", "restitution",
-                             c->normal == DEM_NORMAL_HERTZ
+                             dem_normal_hertzian(c->normal)
                                  ? "1 when 'damping' is 'none' (for a rebound below 1 "
                                    "give damping = 'viscous' or 'brilliantov')"
                                  : "1 when 'damping' is 'none' (for a rebound below 1 "
@@ -189,6 +194,40 @@ static void read_rolling(lua_State *L, dem_contact_def *c)
     c->rolling_rate = bind_field_number(L, 2, "contact", "rolling_rate", 0, BIND_POSITIVE);
 }
 
+/* Cohesion (dem.h, src/dem/cohesion.h): JKR's and DMT's work of adhesion, the liquid bridge. */
+static void read_cohesion(lua_State *L, dem_contact_def *c)
+{
+    c->cohesion = (dem_cohesion_law)bind_field_option(L, 2, "contact", "cohesion",
+                                                      dem_cohesion_names, DEM_COHESION_NONE, 0);
+    lua_settop(L, 2);
+    const int adh = c->normal == DEM_NORMAL_JKR || c->normal == DEM_NORMAL_DMT;
+    const int cap = c->cohesion == DEM_COHESION_CAPILLARY;
+    if (cap && adh) {
+        lua_getfield(L, 2, "cohesion");
+        bind_field_error(L, 2, "contact", "cohesion",
+                         "'none' with normal = 'jkr' or 'dmt', which have their own adhesion (a "
+                         "liquid bridge adds to the linear, power and hertz laws)");
+    }
+    only_with(L, "work_of_adhesion", adh, "'normal' is 'jkr' or 'dmt'");
+    only_with(L, "liquid_volume", cap, "'cohesion' is 'capillary'");
+    only_with(L, "surface_tension", cap, "'cohesion' is 'capillary'");
+    only_with(L, "contact_angle", cap, "'cohesion' is 'capillary'");
+    /* absent: -1, the materials' (dem.h) */
+    c->adhesion = bind_field_number(L, 2, "contact", "work_of_adhesion", -1, BIND_NONNEG);
+    const unsigned need = cap ? BIND_REQUIRED : 0;
+    c->liquid_volume =
+        bind_field_number(L, 2, "contact", "liquid_volume", 0, BIND_POSITIVE | need);
+    c->surface_tension =
+        bind_field_number(L, 2, "contact", "surface_tension", 0, BIND_NONNEG | need);
+    const double deg = bind_field_number(L, 2, "contact", "contact_angle", 0, BIND_NONNEG);
+    if (!(deg < 180)) {
+        lua_getfield(L, 2, "contact_angle");
+        bind_field_error(L, 2, "contact", "contact_angle", "number of degrees in [0, 180)");
+    }
+    c->contact_angle = deg * (3.14159265358979323846 / 180);
+    lua_settop(L, 2);
+}
+
 static int l_contact(lua_State *L)
 {
     dem_scene *s = ldem_check_scene(L, 1);
@@ -210,6 +249,7 @@ static int l_contact(lua_State *L)
     c.clip = bind_field_boolean(L, 2, "contact", "clip", 1);
     c.rolling = bind_field_boolean(L, 2, "contact", "rolling", 0);
     read_rolling(L, &c);
+    read_cohesion(L, &c);
     /* From a restitution (this one, else the materials') each pair gets its own damping when
      * the pair list is built: nothing depends on the particles present now. */
     c.restitution = e;
@@ -253,12 +293,13 @@ void ldem_open_contact(lua_State *L)
 {
     static const bind_fn methods[] = {
         {"contact", l_contact,
-         "s:contact{ normal = 'hertz'|'linear'|'power', stiffness =, beta =, damping = "
+         "s:contact{ normal = 'hertz'|'linear'|'power'|'dmt'|'jkr', stiffness =, beta =, damping = "
          "'none'|'viscous'|'brilliantov', gamma_n =, damping_time =, restitution =, "
          "impact_velocity =, tangential = 'none'|'viscous'|'spring'|'coulomb_regularized', "
          "gamma_t =, kt =, v_r =, exponent =, clip = true, rolling = false, rolling_resistance = "
          "'none'|'epsd'|'constant', rolling_friction =, rolling_stiffness =, rolling_damping = 0, "
-         "rolling_rate = }",
+         "rolling_rate =, work_of_adhesion =, cohesion = 'none'|'capillary', liquid_volume =, "
+         "surface_tension =, contact_angle = 0 }",
          "Sets the contact law of the scene. Normal: linear f = k d (Herrmann Eq. 1a, beta = 1), "
          "power f = k d^beta (beta 1, 1.5 or 2), hertz f = 4/3 E* sqrt(R) d^1.5 (Padbidri Eq. "
          "1.1). Damping: viscous gamma_n d' (Eq. 1b), brilliantov T K d^0.5 d' (Eq. 2.16, hertz "
@@ -280,7 +321,18 @@ void ldem_open_contact(lua_State *L)
          "k_t R_eff^2) with a dashpot of damping ratio rolling_damping in [0, 1] below the "
          "limit; constant, type A, the limit torque against w, linear below rolling_rate w_c "
          "(rad/s; default: the rate that stops a contact's relative rotation in ten steps). "
-         "mu_r: rolling_friction, or the smaller of the two materials' rolling_friction. Returns "
+         "mu_r: rolling_friction, or the smaller of the two materials' rolling_friction. "
+         "Cohesion: normal = 'dmt' is hertz minus 2 pi Gamma R* while the grains overlap; "
+         "normal = 'jkr' is Johnson-Kendall-Roberts, F = 4 E* a^3/(3 R*) - sqrt(8 pi Gamma E* "
+         "a^3), delta = a^2/R* - sqrt(2 pi Gamma a/E*): the contact forms at touch and holds "
+         "until the separation (3/4) (pi^2 Gamma^2 R*/E*^2)^(1/3), pull-off force 3/2 pi Gamma "
+         "R*. Gamma is work_of_adhesion (J/m^2, twice LAMMPS's surface energy), or the geometric "
+         "mean of the two materials' work_of_adhesion. cohesion = 'capillary' adds a liquid "
+         "bridge to the linear, power or hertz law (Rabinovich et al. 2005): F = 4 pi R* "
+         "surface_tension cos(contact_angle) (1 - S/sqrt(S^2 + V/(pi R*))) at separation S, "
+         "formed at touch, ruptured at S = (1 + theta/2) V^(1/3); liquid_volume V (m^3) of each "
+         "bridge, surface_tension (N/m), contact_angle in degrees [0, 180). Planes stick as "
+         "partners of infinite radius (R* = r); other walls feel the Hertzian part. Returns "
          "damping_time when one is given, else nothing."},
         {"damping_time", l_damping_time, "s:damping_time(i, j) or s:damping_time(i, { wall = w })",
          "The Brilliantov damping time T (s) of particles i and j, or of particle i against wall "

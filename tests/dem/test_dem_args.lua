@@ -112,13 +112,13 @@ check.eq(w:info().count, 1, "only the touching disk was added")
 
 -- ---- laws and options --------------------------------------------------------------------------
 check.errors(function() s:contact{ normal = "hertzian" } end,
-  "bad field 'normal' in argument #1 to 'contact' (one of 'linear', 'power', 'hertz' expected, got 'hertzian')", "unknown normal law")
+  "bad field 'normal' in argument #1 to 'contact' (one of 'linear', 'power', 'hertz', 'dmt', 'jkr' expected, got 'hertzian')", "unknown normal law")
 check.errors(function() s:contact{ damping = "viscus" } end,
   "bad field 'damping' in argument #1 to 'contact' (one of 'none', 'viscous', 'brilliantov' expected, got 'viscus')", "unknown damping law")
 check.errors(function() s:contact{ tangential = "coulomb" } end,
   "bad field 'tangential' in argument #1 to 'contact' (one of 'none', 'viscous', 'spring', 'coulomb_regularized' expected, got 'coulomb')", "unknown tangential law")
 check.errors(function() s:contact{ normal = 3 } end,
-  "bad field 'normal' in argument #1 to 'contact' (one of 'linear', 'power', 'hertz' expected, got 3)", "law not a string")
+  "bad field 'normal' in argument #1 to 'contact' (one of 'linear', 'power', 'hertz', 'dmt', 'jkr' expected, got 3)", "law not a string")
 check.errors(function() s:run{ steps = 1, integrator = "verlet" } end,
   "bad field 'integrator' in argument #1 to 'run' (one of 'velocity_verlet', 'position_verlet', 'gear', 'two_timescales' expected, got 'verlet')", "unknown integrator")
 check.errors(function() s:measure("energie") end, "bad argument #1 to 'measure' (invalid option 'energie'; did you mean 'energy'? Valid options: 'energy', 'stress',", "unknown measurement")
@@ -159,7 +159,7 @@ check.errors(function() s:run{ step = 10 } end,
 check.errors(function() s:timestep{ impact = 1 } end,
   "bad argument #1 to 'timestep' (unknown field 'impact'; did you mean 'impact_velocity'? Valid fields: impact_velocity)", "timestep typo")
 check.errors(function() grainlab.material{ densty = 2650, young = 1e9 } end,
-  "bad argument #1 to 'material' (unknown field 'densty'; did you mean 'density'? Valid fields: density, friction, name, poisson, restitution, rolling_friction, young)", "material typo")
+  "bad argument #1 to 'material' (unknown field 'densty'; did you mean 'density'? Valid fields: density, friction, name, poisson, restitution, rolling_friction, work_of_adhesion, young)", "material typo")
 check.errors(function() s:add_disk{ pos = { 0.5, 0.5 }, radius = 1e-3, material = { density = 2650 } } end,
   "bad field 'material' in argument #1 to 'add_disk' (grainlab.material expected, got table)", "plain table as material")
 

@@ -80,7 +80,7 @@ for _, law in ipairs(laws) do
       -- refused whatever is asked, naming the alternative
       check.errors(function() s:contact(law_def(law, damping, { restitution = 0.7 })) end,
         "bad field 'damping' in argument #1 to 'contact' ('none' or 'viscous' with the linear and power laws " ..
-        "(brilliantov damping needs normal = 'hertz'; viscous damping honours a restitution with every law) " ..
+        "(brilliantov damping needs normal = 'hertz', 'jkr' or 'dmt'; viscous damping honours a restitution with every law) " ..
         "expected, got 'brilliantov')", what .. ": refused")
     elseif damping == "none" then
       -- no damping rebounds with 1: a restitution below 1 is refused, 1 is honoured

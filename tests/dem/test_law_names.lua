@@ -12,6 +12,7 @@ local fields = {
   { field = "damping", row = "damping", info = "damping" },
   { field = "tangential", row = "tangential", info = "tangential" },
   { field = "rolling_resistance", row = "rolling resistance", info = "rolling_resistance" },
+  { field = "cohesion", row = "cohesion", info = "cohesion" },
 }
 
 local function scene() return dem.scene{ dim = 2, box = { { 0, 0 }, { 1, 1 } } } end
@@ -31,7 +32,10 @@ end
 -- a contact table choosing law `name` for `field`, with what that law requires
 local function choose(field, name)
   local c = { [field] = name }
-  if field == "normal" and name ~= "hertz" then c.stiffness = 1e5 end
+  if field == "normal" and (name == "linear" or name == "power") then c.stiffness = 1e5 end
+  if field == "cohesion" and name == "capillary" then
+    c.liquid_volume, c.surface_tension = 1e-12, 0.07
+  end
   if field == "damping" then c.normal = "hertz" end
   return c
 end

@@ -50,10 +50,12 @@ local calls = {
   ["grainlab.doc_of"] = { args = function() return { print } end, pos = { ALL } },
   ["grainlab.material"] = {
     args = function() return { { name = "q", density = 2650, young = 1e9, poisson = 0.2, friction = 0.5,
-                                 restitution = 0.5, rolling_friction = 0.1 } } end,
+                                 restitution = 0.5, rolling_friction = 0.1,
+                                 work_of_adhesion = 0.05 } } end,
     opts = 1,
     accept = { name = TEXT, density = {}, young = {}, poisson = { "nil", "zero" },
-               friction = { "nil", "zero" }, restitution = OPT, rolling_friction = { "nil", "zero" } },
+               friction = { "nil", "zero" }, restitution = OPT, rolling_friction = { "nil", "zero" },
+               work_of_adhesion = { "nil", "zero" } },
   },
   ["grainlab.pack.random"] = {
     setup = scene, args = function(s) return { s, { n = 2, radius = 1e-3, region = { { 0, 0 }, { 0.02, 0.02 } },
@@ -255,7 +257,7 @@ check.errors(function() q.colour = "red" end,
   "a grainlab.material is read-only: field 'colour' cannot be set", "material read-only (new field)")
 local n = 0
 for k, v in pairs(q) do n = n + 1; check.eq(q[k], v, "pairs gives the fields") end
-check.eq(n, 6, "pairs over a material (name absent)")
+check.eq(n, 7, "pairs over a material (name absent)")
 -- grainlab.pack errors name the public call and point at the caller's line.
 local msg = check.errors(function() grainlab.pack.deposit(scene(), { n = -3 }) end,
   "bad field 'n' in argument #2 to 'grainlab.pack.deposit' (integer in [1, 10000000] expected, got -3)", "deposit n")

@@ -65,7 +65,7 @@ static dem_scene *one_disk(double radius, int dim)
     dem_scene *s;
     core_error err;
     assert_int_equal(dem_create(&def, &s, &err), CORE_OK);
-    assert_true(dem_add_material(s, &(dem_material){2650, 30e9, 0.3, 0.45, 0.5, 0}, &err) >= 0);
+    assert_true(dem_add_material(s, &(dem_material){2650, 30e9, 0.3, 0.45, 0.5, 0, 0}, &err) >= 0);
     dem_particle_def p = {.x = {0.5, 0.5, 0.5}, .radius = radius};
     assert_true(dem_add_particle(s, &p, &err) >= 0);
     return s;
