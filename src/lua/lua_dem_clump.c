@@ -171,6 +171,25 @@ static int l_template_info(lua_State *L)
     return 1;
 }
 
+static int l_template_members(lua_State *L)
+{
+    ltemplate *t = bind_check_self(L, 1, TEMPLATE, "members");
+    lua_createtable(L, t->n, 0);
+    for (int k = 0; k < t->n; k++) {
+        lua_createtable(L, 0, 2);
+        lua_createtable(L, t->dim, 0);
+        for (int d = 0; d < t->dim; d++) {
+            lua_pushnumber(L, t->m[k].offset[d]);
+            lua_rawseti(L, -2, d + 1);
+        }
+        lua_setfield(L, -2, "offset");
+        lua_pushnumber(L, t->m[k].radius);
+        lua_setfield(L, -2, "radius");
+        lua_rawseti(L, -2, k + 1);
+    }
+    return 1;
+}
+
 static int l_template_tostring(lua_State *L)
 {
     ltemplate *t = luaL_checkudata(L, 1, TEMPLATE);
@@ -361,6 +380,8 @@ void ldem_open_clump(lua_State *L)
          "moments, axes (principal, ascending; columns) and tensor (3D), error (the estimated "
          "relative quadrature error), resolution; in 2D also disks = the same for disks of unit "
          "thickness (area, inertia per unit thickness), as in scenes with thickness > 0."},
+        {"members", l_template_members, "T:members()",
+         "The members as given: {{offset = {...}, radius = r}, ...} in the members' frame."},
         {NULL, NULL, NULL, NULL}};
     static const luaL_Reg meta[] = {{"__tostring", l_template_tostring}, {NULL, NULL}};
     bind_new_type(L, TEMPLATE, tmethods, meta,

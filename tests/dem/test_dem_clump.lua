@@ -293,6 +293,62 @@ for _, w in ipairs(walls) do
                                                   w[1], w[2], low))
 end
 
+-- ---- pouring: pack.clumps ----------------------------------------------------------------
+-- Random sequential addition places every clump with no member overlapping another clump's and
+-- every member inside the region, in 2D and 3D, the same placement for the same seed.
+for _, dim in ipairs{ 2, 3 } do
+  local function scene()
+    return dem.scene{ dim = dim, box = dim == 2 and { { 0, 0 }, { 0.05, 0.05 } } or { { 0, 0, 0 }, { 0.05, 0.05, 0.05 } } }
+  end
+  local mat = grainlab.material{ density = 2650, young = 1e7, poisson = 0.3, friction = 0.5 }
+  local function member(x, r) return { offset = dim == 2 and { x, 0 } or { x, 0, 0 }, radius = r } end
+  local D = dem.clump_template{ members = { member(-1.5e-3, 2e-3), member(1.5e-3, 2e-3) } }
+  local R3 = dem.clump_template{ members = { member(0, 1.5e-3), member(2e-3, 1.5e-3), member(4e-3, 1.5e-3) } }
+  local region = dim == 2 and { { 0.005, 0.005 }, { 0.045, 0.045 } } or { { 0.005, 0.005, 0.005 }, { 0.045, 0.045, 0.045 } }
+  local s = scene()
+  local ids, st = grainlab.pack.clumps(s, { n = 30, template = { D, R3 }, region = region, seed = 4, material = mat })
+  check.eq(#ids, 30, dim .. "D pack.clumps: every clump placed")
+  check.eq(s:clump_count(), 30, dim .. "D pack.clumps: the scene has them")
+  local p = s:particles()
+  local worst_gap, outside, kinds = math.huge, 0, {}
+  for k = 1, s:clump_count() do kinds[#s:clump(k).members] = true end
+  local body = {}
+  for k = 1, s:clump_count() do for _, i in ipairs(s:clump(k).members) do body[i] = k end end
+  local X = { p.x, p.y, p.z }
+  for i = 1, p.count do
+    for d = 1, dim do
+      if X[d][i] - p.radius[i] < region[1][d] - 1e-12 or X[d][i] + p.radius[i] > region[2][d] + 1e-12 then outside = outside + 1 end
+    end
+    for j = i + 1, p.count do
+      if body[i] ~= body[j] then
+        local d2 = 0
+        for d = 1, dim do d2 = d2 + (X[d][i] - X[d][j]) ^ 2 end
+        worst_gap = math.min(worst_gap, math.sqrt(d2) - p.radius[i] - p.radius[j])
+      end
+    end
+  end
+  check.is_true(worst_gap >= 0, string.format("%dD pack.clumps: no overlap between clumps (least gap %.3g m)", dim, worst_gap))
+  check.eq(outside, 0, dim .. "D pack.clumps: every member inside the region")
+  check.is_true(kinds[2] and kinds[3], dim .. "D pack.clumps: both templates drawn")
+  check.is_true(st.fraction > 0 and st.fraction < 1 and st.tries >= 30, dim .. "D pack.clumps: the report")
+  local s2 = scene()
+  grainlab.pack.clumps(s2, { n = 30, template = { D, R3 }, region = region, seed = 4, material = mat })
+  check.eq(s2:particles().x[17], p.x[17], dim .. "D pack.clumps: the same seed, the same placement")
+  check.errors(function() grainlab.pack.clumps(scene(), { n = 3, template = 5, material = mat }) end,
+               "template", "a number for a template")
+  check.errors(function() grainlab.pack.clumps(scene(), { n = 3, material = mat }) end, "template", "no template")
+end
+check.errors(function()
+  local s = dem.scene{ dim = 3, box = { { 0, 0, 0 }, { 1, 1, 1 } } }
+  grainlab.pack.clumps(s, { n = 1, template = dem.clump_template{ members = { { offset = { 0, 0 }, radius = 0.1 } } },
+                            material = grainlab.material{ density = 2650, young = 1e7, poisson = 0.3 } })
+end, "2D", "a 2D template in a 3D scene")
+check.errors(function()
+  local s = dem.scene{ dim = 2, box = { { 0, 0 }, { 1, 1 } } }
+  grainlab.pack.clumps(s, { n = 100, template = dem.clump_template{ members = { { offset = { 0, 0 }, radius = 0.2 } } },
+                            max_tries = 2000, material = grainlab.material{ density = 2650, young = 1e7, poisson = 0.3 } })
+end, "too full", "more clumps than the region holds")
+
 -- ---- refusals -------------------------------------------------------------------------------
 do
   local mat = grainlab.material{ density = 2500, young = 1e8, poisson = 0.3, friction = 0.5 }

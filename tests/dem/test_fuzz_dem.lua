@@ -317,6 +317,7 @@ for _, k in ipairs{ "dem.read_lammps_data", "dem.scene:read_lammps_data", "dem.s
 
 local template = dem.clump_template{ members = { { offset = { 0, 0 }, radius = 0.01 } } }
 calls["dem.clump_template:info"] = { self = function() return template end }
+calls["dem.clump_template:members"] = { self = function() return template end }
 fuzz.run{ modules = { dem = dem }, types = { ["dem.scene"] = scene2(), ["dem.clump_template"] = template },
           calls = calls, skip = skip }
 os.execute("rm -rf '" .. vtkdir .. "'")
