@@ -23,12 +23,12 @@ s0:add_disk{ pos = { 0.5, 0.5 }, radius = 0.1 }
 check.errors(function() s0:write_vtk(P("x.txt")) end,
   "bad argument #1 to 'write_vtk' (file name ending in .vtu expected, got '", "extension")
 check.errors(function() s0:write_vtk(P("x.vtu"), { contact = true }) end,
-  "bad argument #2 to 'write_vtk' (unknown field 'contact'; did you mean 'contacts'? Valid fields: contacts, walls)",
+  "bad argument #2 to 'write_vtk' (unknown field 'contact'; did you mean 'contacts'? Valid fields: contacts, walls, clumps)",
   "typo in an option")
 check.errors(function() s0:write_vtk(P("x.vtu"), { walls = 1 }) end,
   "bad field 'walls' in argument #2 to 'write_vtk' (boolean expected, got 1)", "option type")
 check.errors(function() s0:write_vtk(P("x.vtu"), { grid = true }) end,
-  "bad argument #2 to 'write_vtk' (unknown field 'grid'; valid fields: contacts, walls)",
+  "bad argument #2 to 'write_vtk' (unknown field 'grid'; valid fields: contacts, walls, clumps)",
   "option of another engine")
 check.errors(function() grainlab.vtk.series(P("r.pvd"), { grid = false }):add(s0) end,
   "add: option 'grid' is for a mpm.scene, not a dem.scene", "series option of another engine")
