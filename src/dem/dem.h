@@ -589,11 +589,16 @@ typedef struct dem_lammps_write_def {
     int append;                  /* dump: append a frame instead of writing a new file */
 } dem_lammps_write_def;
 
-/* A data file, written whole (temporary file + rename). */
+/* A data file, written whole (temporary file + rename). A scene with clumps is written in
+ * atom_style hybrid sphere molecular, Atoms "id type x y z diameter density mol ix iy iz", for
+ * LAMMPS's fix rigid/small molecule: mol is the clump id (1-based) of a member of a clump of two
+ * or more members, 0 for a grain of no clump and for a clump of one sphere (LAMMPS refuses a
+ * rigid body of one particle). */
 core_status dem_write_lammps_data(const dem_scene *s, const char *path,
                                   const dem_lammps_write_def *def, core_error *err);
-/* One `dump custom` frame (id type radius mass x y z vx vy vz fx fy fz omegax omegay omegaz): a
- * new file written whole, or appended; an append that fails is cut back to the old length. */
+/* One `dump custom` frame (id type radius mass x y z vx vy vz fx fy fz omegax omegay omegaz; a
+ * scene with clumps adds mol after id, as in its data file): a new file written whole, or
+ * appended; an append that fails is cut back to the old length. */
 core_status dem_write_lammps_dump(const dem_scene *s, const char *path,
                                   const dem_lammps_write_def *def, core_error *err);
 
