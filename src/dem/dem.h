@@ -520,7 +520,8 @@ double dem_thickness(const dem_scene *s);
 const double *dem_forces(const dem_scene *s, int d);
 /* VTK XML unstructured grids (.vtu) for ParaView, written whole. Particles: one vertex cell per
  * particle with point data id (1-based), radius, velocity, angular_velocity, force (3-vectors,
- * z = 0 in 2D), mass, material (1-based), angle (2D with rotations). Contacts: a line per contact
+ * z = 0 in 2D), mass, material (1-based), angle (2D with rotations), clump (in a scene with
+ * clumps: the clump id, 1-based, 0 for a grain of no clump). Contacts: a line per contact
  * from i's centre to j's (its image across a periodic boundary) or to the contact point on a wall,
  * cell data i, j (walls: minus the wall id), fn, ft, overlap, normal, force (on i),
  * normal_force, tangential_force (0 for walls, which report the normal force only). Walls: each
@@ -528,6 +529,11 @@ const double *dem_forces(const dem_scene *s, int d);
 core_status dem_vtk_particles(const dem_scene *s, const char *path, core_error *err);
 core_status dem_vtk_contacts(dem_scene *s, const char *path, core_error *err);
 core_status dem_vtk_walls(const dem_scene *s, const char *path, core_error *err);
+/* One vertex per clump at its centre of mass: id (1-based, the particles' "clump" array), mass,
+ * velocity, angular_velocity, angular_momentum, orientation (2D: the angle; 3D: the quaternion
+ * w, x, y, z of the principal frame), inertia (principal moments), members and first_member
+ * (the particle id of its first member). */
+core_status dem_vtk_clumps(const dem_scene *s, const char *path, core_error *err);
 
 /* ---- LAMMPS data and dump files (lammps.c, lammps_write.c) --------------------------------- *
  * Data files in atom_style sphere (LIGGGHTS: granular): Atoms "id type diameter density x y z
@@ -583,11 +589,16 @@ typedef struct dem_lammps_write_def {
     int append;                  /* dump: append a frame instead of writing a new file */
 } dem_lammps_write_def;
 
-/* A data file, written whole (temporary file + rename). */
+/* A data file, written whole (temporary file + rename). A scene with clumps is written in
+ * atom_style hybrid sphere molecular, Atoms "id type x y z diameter density mol ix iy iz", for
+ * LAMMPS's fix rigid/small molecule: mol is the clump id (1-based) of a member of a clump of two
+ * or more members, 0 for a grain of no clump and for a clump of one sphere (LAMMPS refuses a
+ * rigid body of one particle). */
 core_status dem_write_lammps_data(const dem_scene *s, const char *path,
                                   const dem_lammps_write_def *def, core_error *err);
-/* One `dump custom` frame (id type radius mass x y z vx vy vz fx fy fz omegax omegay omegaz): a
- * new file written whole, or appended; an append that fails is cut back to the old length. */
+/* One `dump custom` frame (id type radius mass x y z vx vy vz fx fy fz omegax omegay omegaz; a
+ * scene with clumps adds mol after id, as in its data file): a new file written whole, or
+ * appended; an append that fails is cut back to the old length. */
 core_status dem_write_lammps_dump(const dem_scene *s, const char *path,
                                   const dem_lammps_write_def *def, core_error *err);
 

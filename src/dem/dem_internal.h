@@ -404,6 +404,10 @@ core_status dem_clumps_grow(dem_scene *s, size_t old_cap, size_t cap, core_error
 /* Kinetic, rotational and gravitational energies of the bodies (measure.c skips members). */
 void dem_clumps_energy(const dem_scene *s, double *kin, double *rot, double *pot);
 void dem_clumps_free(dem_scene *s);
+/* clump_checkpoint.c: the section "clumps", written only by a scene with clumps; the load runs
+ * after the particles' section, in the open section of r. */
+core_status dem_clumps_save(const dem_scene *s, struct ckpt_writer *w, core_error *err);
+core_status dem_clumps_load(dem_scene *s, struct dem_reader *r);
 static inline int dem_is_member(const dem_scene *s, size_t i)
 {
     return s->clumps && s->clumps->body[i] >= 0;

@@ -304,8 +304,8 @@ os.remove(vtkdir)
 os.execute("mkdir -p '" .. vtkdir .. "'")
 calls["dem.scene:write_vtk"] = {
   setup = scene2, self = self, opts = 2, opts_optional = true, pos = { {} },
-  args = function() return { vtkdir .. "/f.vtu", { contacts = true, walls = false } } end,
-  accept = { contacts = BOOL, walls = BOOL },
+  args = function() return { vtkdir .. "/f.vtu", { contacts = true, walls = false, clumps = true } } end,
+  accept = { contacts = BOOL, walls = BOOL, clumps = BOOL },
 }
 -- The methods lua_analysis.c registers on dem.scene have their own fuzz test.
 local elsewhere = "boundary-condition methods of lua_analysis.c: fuzzed by test_fuzz_analysis.lua"

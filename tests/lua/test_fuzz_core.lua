@@ -152,10 +152,11 @@ calls["grainlab.mpi.bcast"] = { args = function() return { { 1, 2 }, 0 } end,
 
 -- grainlab.vtk.series (lua_vtk.c): the options are checked at creation, nothing is written.
 calls["grainlab.vtk.series"] = {
-  args = function() return { "r.pvd", { contacts = true, walls = true, grid = true, cells = true } } end,
+  args = function() return { "r.pvd", { contacts = true, walls = true, grid = true, cells = true,
+                                        clumps = true } } end,
   opts = 2, opts_optional = true, pos = { {} },
   accept = { contacts = { "nil", "boolean" }, walls = { "nil", "boolean" }, grid = { "nil", "boolean" },
-             cells = { "nil", "boolean" } },
+             cells = { "nil", "boolean" }, clumps = { "nil", "boolean" } },
 }
 
 -- grainlab.report (report.lua): one report per run, so each case starts from a fresh module
