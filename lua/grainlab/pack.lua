@@ -34,6 +34,12 @@ local SPECS = {
   random = { n = { "integer", min = 1, max = MAX_COUNT, required = true }, radius = RADIUS,
              region = { "table" }, seed = { "integer", min = 0 }, material = { check = args.material },
              max_tries = { "integer", min = 1, max = 1e12 }, speed = { "nonneg" } },
+  clumps = { n = { "integer", min = 1, max = MAX_COUNT, required = true }, template = { required = true, check = function(v)
+               return type(v) == "userdata" or (type(v) == "table" and #v > 0),
+                 "dem.clump_template or a non-empty array of them"
+             end },
+             region = { "table" }, seed = { "integer", min = 0 }, material = { check = args.material },
+             max_tries = { "integer", min = 1, max = 1e12 }, speed = { "nonneg" } },
   deposit = { n = { "integer", min = 1, max = MAX_COUNT, required = true }, radius = RADIUS,
               region = { "table" }, seed = { "integer", min = 0 }, material = { check = args.material },
               relax_steps = { "integer", min = 0, max = 1e12 }, drag = DRAG },
@@ -237,6 +243,126 @@ function pack.random(s, opts)
     end
   end
   return ids, { placed = #ids, tries = tries, fraction = area / vol }
+end
+
+-- Random sequential addition of clumps: n copies of the template (or of templates drawn at
+-- random from a list), each at a uniformly random centre and orientation (2D: an angle; 3D: a
+-- uniform quaternion, Shoemake's normalised Gaussian 4-vector) such that no member overlaps a
+-- particle already there and every member lies inside the region. Returns the clumps' ids and
+-- { placed, tries, fraction } (the unions' area in 2D, volume in 3D, over the region's).
+local function is_template(v) return type(v) == "userdata" and tostring(v):find("^dem.clump_template") end
+
+local function rotate(dim, q, v)
+  if dim == 2 then
+    local c, sn = math.cos(q), math.sin(q)
+    return { c * v[1] - sn * v[2], sn * v[1] + c * v[2] }
+  end
+  local w, x, y, z = q[1], q[2], q[3], q[4]
+  return { (1 - 2 * (y * y + z * z)) * v[1] + 2 * (x * y - w * z) * v[2] + 2 * (x * z + w * y) * v[3],
+           2 * (x * y + w * z) * v[1] + (1 - 2 * (x * x + z * z)) * v[2] + 2 * (y * z - w * x) * v[3],
+           2 * (x * z - w * y) * v[1] + 2 * (y * z + w * x) * v[2] + (1 - 2 * (x * x + y * y)) * v[3] }
+end
+
+function pack.clumps(s, opts)
+  local call = "grainlab.pack.clumps"
+  args.object(call, 1, s, "dem.scene")
+  args.check(call, 2, opts, SPECS.clumps)
+  local info = s:info()
+  local dim = info.dim
+  local list = is_template(opts.template) and { opts.template } or opts.template
+  if type(list) ~= "table" or #list == 0 then
+    fail(call, "template", "dem.clump_template or a non-empty array of them", opts.template)
+  end
+  local planar = dim == 2 and (info.thickness or 0) > 0
+  local shapes = {}
+  for k, T in ipairs(list) do
+    if not is_template(T) then fail(call, "template", "dem.clump_template or a non-empty array of them", T) end
+    local ti = T:info()
+    if ti.dim ~= dim then
+      fail(call, "template", string.format("%dD templates (the scene's), not a %dD one (entry %d)", dim, ti.dim, k), T)
+    end
+    local sh = planar and ti.disks or ti
+    local centre, members, bound, rbig = sh.centre, T:members(), 0, 0
+    for _, m in ipairs(members) do
+      local o = {}
+      for d = 1, dim do o[d] = m.offset[d] - centre[d] end
+      m.rel = o
+      local l = 0
+      for d = 1, dim do l = l + o[d] ^ 2 end
+      bound, rbig = math.max(bound, math.sqrt(l) + m.radius), math.max(rbig, m.radius)
+    end
+    shapes[k] = { T = T, members = members, bound = bound, rbig = rbig,
+                  size = dim == 2 and ti.disks.area or ti.volume }
+  end
+  local rng = grainlab.rng{ seed = opts.seed or 0 }
+  local lo, hi = region_of(call, s, opts.region, dim)
+  local n = opts.n
+  local max_tries = positive_int(call, opts, "max_tries", 1000 * n)
+  local speed = opts.speed or 0
+  local placed, rmax = existing(s, dim)
+  for _, sh in ipairs(shapes) do
+    for d = 1, dim do
+      if 2 * sh.bound > hi[d] - lo[d] then
+        fail(call, "region", string.format("a region wider than the clumps' bounding diameter %g", 2 * sh.bound), opts.region)
+      end
+    end
+    rmax = math.max(rmax, sh.rbig)
+  end
+  local grid = new_grid(lo, hi, 2 * rmax, dim)
+  for _, p in ipairs(placed) do grid.add(p) end
+  local vol = 1
+  for d = 1, dim do vol = vol * (hi[d] - lo[d]) end
+  local ids, tries, filled = {}, 0, 0
+  for _ = 1, n do
+    local sh = shapes[#shapes == 1 and 1 or rng:integer(1, #shapes)]
+    while true do
+      tries = tries + 1
+      if tries > max_tries then
+        error(string.format("%s: placed %d of %d clumps in %d tries; the region is too full for random addition " ..
+                            "(a larger region, fewer clumps, or pour them in layers)", call, #ids, n, max_tries), 2)
+      end
+      local x, q = {}, nil
+      for d = 1, dim do x[d] = rng:uniform(lo[d] + sh.bound, hi[d] - sh.bound) end
+      if dim == 2 then
+        q = rng:uniform(0, 2 * math.pi)
+      else
+        local g, l = {}, 0
+        repeat
+          for a = 1, 4 do g[a] = rng:normal() end
+          l = math.sqrt(g[1] ^ 2 + g[2] ^ 2 + g[3] ^ 2 + g[4] ^ 2)
+        until l > 1e-6
+        q = { g[1] / l, g[2] / l, g[3] / l, g[4] / l }
+      end
+      local world, clash = {}, false
+      for k, m in ipairs(sh.members) do
+        local r = rotate(dim, q, m.rel)
+        local p = { r = m.radius }
+        for d = 1, dim do p[d] = x[d] + r[d] end
+        world[k] = p
+        clash = clash or grid.near(p, m.radius + rmax, function(o)
+          local d2 = 0
+          for d = 1, dim do d2 = d2 + (p[d] - o[d]) ^ 2 end
+          return d2 < (m.radius + o.r) ^ 2
+        end)
+        if clash then break end
+      end
+      if not clash then
+        local vel
+        if speed > 0 then
+          local v, norm = {}, 0
+          for d = 1, dim do v[d] = rng:normal(); norm = norm + v[d] ^ 2 end
+          for d = 1, dim do v[d] = speed * v[d] / math.sqrt(norm) end
+          vel = v
+        end
+        ids[#ids + 1] = s:add_clump{ template = sh.T, material = opts.material, position = x,
+                                     orientation = q, velocity = vel }
+        for _, p in ipairs(world) do grid.add(p) end
+        filled = filled + sh.size
+        break
+      end
+    end
+  end
+  return ids, { placed = #ids, tries = tries, fraction = filled / vol }
 end
 
 -- 2D drop-and-roll: the resting place of a disk of radius r dropped at abscissa x0 onto the
@@ -811,6 +937,7 @@ require("grainlab.entry").wrap_all(pack, "grainlab.pack")
 -- Each function answers help() itself, with the fields its entry check accepts.
 for name, usage in pairs{
   random = "grainlab.pack.random(s, { n =, radius = r | {min, max}, region = {{lo},{hi}}, seed =, material =, max_tries =, speed = })",
+  clumps = "grainlab.pack.clumps(s, { n =, template = T | {T1, T2, ...}, region = {{lo},{hi}}, seed =, material =, max_tries =, speed = })",
   deposit = "grainlab.pack.deposit(s, { n =, radius = {0.5e-3, 1e-3}, region =, seed =, material =, relax_steps = 20000, drag = 'auto' })",
   settle = "grainlab.pack.settle(s, { drag = 'auto', quiet = 1e-5, max_steps = 200000, ... })",
   slab = "grainlab.pack.slab{ size = L, n = 369, diameter = {d_min, d_mean, d_max}, seed = 5, width = 1.8, margin = 0 }",

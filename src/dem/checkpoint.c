@@ -620,6 +620,61 @@ static void read_walls(reader *r, ckpt_reader *ck, dem_scene *s, size_t n)
     close_section(r);
 }
 
+/* The sections a scene writes only when it uses their feature, each read when present. */
+static void read_optional(reader *r, ckpt_reader *ck, dem_scene *s, const dem_scene_def *def,
+                          const dem_boundary_restorer *restorer)
+{
+    if (!r->st && ckpt_has(ck, "rolling")) {
+        open_section(r, ck, "rolling");
+        read_rolling(r, s);
+        if (!r->st)
+            check_contact(r, def, &s->contact);
+        close_section(r);
+    }
+    if (!r->st && ckpt_has(ck, "cohesion")) {
+        open_section(r, ck, "cohesion");
+        read_cohesion(r, s);
+        if (!r->st)
+            check_contact(r, def, &s->contact);
+        close_section(r);
+    }
+    if (!r->st && ckpt_has(ck, "damping")) {
+        open_section(r, ck, "damping");
+        read_damping(r, s);
+        close_section(r);
+    } else if (!r->st && dem_checkpoint_damping(&s->contact)) {
+        r->st = core_fail(r->err, CORE_ERR_IO,
+                          "'%s' has no section 'damping', which its contact law (%s damping from "
+                          "a restitution) needs: a file from a grainlab whose damping of this "
+                          "law did not honour the restitution cannot continue; build the scene "
+                          "again",
+                          ckpt_reader_path(ck),
+                          s->contact.damping == DEM_DAMPING_VISCOUS ? "viscous" : "brilliantov");
+    }
+    if (!r->st && ckpt_has(ck, "boundary")) {
+        open_section(r, ck, "boundary");
+        if (!r->st)
+            r->st = dem_boundary_load(s, &r->sec, r->err);
+    }
+    if (!r->st && ckpt_has(ck, "boundary_update")) {
+        open_section(r, ck, "boundary_update");
+        if (!r->st)
+            r->st = dem_boundary_load_update(s, &r->sec, restorer, r->err);
+    }
+    if (!r->st && ckpt_has(ck, "flow")) { /* inserters and outflows (flow.c) */
+        open_section(r, ck, "flow");
+        if (!r->st)
+            r->st = dem_flow_load(s, r);
+        close_section(r);
+    }
+    if (!r->st && ckpt_has(ck, "clumps")) { /* rigid bodies (clump_checkpoint.c) */
+        open_section(r, ck, "clumps");
+        if (!r->st)
+            dem_clumps_load(s, r);
+        close_section(r);
+    }
+}
+
 static void read_all(reader *r, ckpt_reader *ck, const dem_boundary_restorer *restorer,
                      dem_scene **out)
 {
@@ -705,49 +760,7 @@ static void read_all(reader *r, ckpt_reader *ck, const dem_boundary_restorer *re
     open_section(r, ck, "pairs");
     read_pairs(r, s);
     close_section(r);
-    if (!r->st && ckpt_has(ck, "rolling")) {
-        open_section(r, ck, "rolling");
-        read_rolling(r, s);
-        if (!r->st)
-            check_contact(r, &def, &s->contact);
-        close_section(r);
-    }
-    if (!r->st && ckpt_has(ck, "cohesion")) {
-        open_section(r, ck, "cohesion");
-        read_cohesion(r, s);
-        if (!r->st)
-            check_contact(r, &def, &s->contact);
-        close_section(r);
-    }
-    if (!r->st && ckpt_has(ck, "damping")) {
-        open_section(r, ck, "damping");
-        read_damping(r, s);
-        close_section(r);
-    } else if (!r->st && dem_checkpoint_damping(&s->contact)) {
-        r->st = core_fail(r->err, CORE_ERR_IO,
-                          "'%s' has no section 'damping', which its contact law (%s damping from "
-                          "a restitution) needs: a file from a grainlab whose damping of this "
-                          "law did not honour the restitution cannot continue; build the scene "
-                          "again",
-                          ckpt_reader_path(ck),
-                          s->contact.damping == DEM_DAMPING_VISCOUS ? "viscous" : "brilliantov");
-    }
-    if (!r->st && ckpt_has(ck, "boundary")) {
-        open_section(r, ck, "boundary");
-        if (!r->st)
-            r->st = dem_boundary_load(s, &r->sec, r->err);
-    }
-    if (!r->st && ckpt_has(ck, "boundary_update")) {
-        open_section(r, ck, "boundary_update");
-        if (!r->st)
-            r->st = dem_boundary_load_update(s, &r->sec, restorer, r->err);
-    }
-    if (!r->st && ckpt_has(ck, "flow")) { /* inserters and outflows (flow.c) */
-        open_section(r, ck, "flow");
-        if (!r->st)
-            r->st = dem_flow_load(s, r);
-        close_section(r);
-    }
+    read_optional(r, ck, s, &def, restorer);
     if (!r->st) { /* values, named by the section that holds them */
         r->sec.tag = "particles";
         check_particles(r, s);

@@ -293,7 +293,9 @@ static core_status write_scene(const dem_scene *s, ckpt_writer *w, core_error *e
         return st;
     if (s->bnd && (st = dem_boundary_save(s, w, err)))
         return st;
-    return s->flow ? dem_flow_save(s, w, err) : CORE_OK;
+    if (s->flow && (st = dem_flow_save(s, w, err)))
+        return st;
+    return dem_clump_count(s) ? dem_clumps_save(s, w, err) : CORE_OK;
 }
 
 core_status dem_save(const dem_scene *s, const char *path, const char *version, core_error *err)

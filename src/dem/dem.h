@@ -146,6 +146,62 @@ const double *dem_angular_velocities(const dem_scene *s, int d);
 const double *dem_radii(const dem_scene *s);
 /* 2D orientation angles (rad, integrated from omega; NULL when rotations are off or in 3D). */
 const double *dem_angles(const dem_scene *s);
+
+/* ---- clumps: rigid bodies made of overlapping disks or spheres (clump.c) -------------------- *
+ * A clump's members are particles of the scene (ids first .. first + count - 1) that carry no
+ * dynamics of their own: each step the forces and torques on them are summed onto the body,
+ * the body moves (2D: its angle; 3D: a quaternion by the NO_SQUISH splitting, Miller et al.
+ * 2002), and the members are placed and given velocities from it. Members of one clump never
+ * touch each other. Mass, centre and inertia are those of the union of the members, integrated
+ * numerically (dem_clump_shape_compute). */
+enum { DEM_CLUMP_MAX_MEMBERS = 256 };
+typedef struct dem_clump_member {
+    double offset[3]; /* in the members' own frame (2D: [2] = 0) */
+    double radius;
+} dem_clump_member;
+
+typedef struct dem_clump_shape {
+    int dim, planar;    /* planar: 2D disks of unit thickness; else spheres (in 2D: centres in
+                         * the plane) */
+    int resolution;     /* quadrature lines along the longest side of the bounding box */
+    double measure;     /* area (planar) or volume of the union */
+    double centre[3];   /* of the union, in the members' frame */
+    double tensor[9];   /* central inertia tensor per unit density (planar: per unit thickness) */
+    double moments[3];  /* principal moments, ascending (2D: [2] = the moment about z) */
+    double axes[9];     /* row-major; column k: principal axis k in the members' frame (2D: I) */
+    double rel_error;   /* largest relative change of the measure and moments from half the
+                         * resolution: an estimate of (an upper bound on) the quadrature error */
+} dem_clump_shape;
+
+/* Checks the members (radius > 0 and finite, offsets finite, 1..DEM_CLUMP_MAX_MEMBERS members
+ * that form one connected body: each overlaps or touches another) and integrates the union. */
+core_status dem_clump_shape_compute(const dem_clump_member *m, int n, int dim, int planar,
+                                    int resolution, dem_clump_shape *out, core_error *err);
+
+typedef struct dem_clump_def {
+    const dem_clump_member *members;
+    int n;
+    const dem_clump_shape *shape; /* of these members for this scene (planar when the scene's
+                                   * thickness > 0); NULL: computed here */
+    int material;
+    double x[3];     /* the centre of mass */
+    double q[4];     /* 3D: orientation (w, x, y, z), unit, members' frame to world */
+    double angle;    /* 2D: orientation, rad */
+    double v[3], omega[3]; /* 2D: omega[2] */
+} dem_clump_def;
+/* Returns the clump's index (>= 0) or -1 with err filled. */
+long dem_add_clump(dem_scene *s, const dem_clump_def *c, core_error *err);
+size_t dem_clump_count(const dem_scene *s);
+typedef struct dem_clump_state {
+    double mass, x[3], v[3], omega[3], L[3]; /* L: angular momentum about the centre, world */
+    double q[4];       /* 3D: principal (body) frame to world */
+    double angle;      /* 2D */
+    double moments[3]; /* principal moments (2D: [2]) */
+    size_t first, count;
+} dem_clump_state;
+core_status dem_clump_get(const dem_scene *s, size_t k, dem_clump_state *out, core_error *err);
+/* The clump of particle i (>= 0), or -1 for a particle of no clump. */
+long dem_particle_clump(const dem_scene *s, size_t i);
 /* Material index of each particle. */
 const int *dem_particle_materials(const dem_scene *s);
 const double *dem_masses(const dem_scene *s);
@@ -464,7 +520,8 @@ double dem_thickness(const dem_scene *s);
 const double *dem_forces(const dem_scene *s, int d);
 /* VTK XML unstructured grids (.vtu) for ParaView, written whole. Particles: one vertex cell per
  * particle with point data id (1-based), radius, velocity, angular_velocity, force (3-vectors,
- * z = 0 in 2D), mass, material (1-based), angle (2D with rotations). Contacts: a line per contact
+ * z = 0 in 2D), mass, material (1-based), angle (2D with rotations), clump (in a scene with
+ * clumps: the clump id, 1-based, 0 for a grain of no clump). Contacts: a line per contact
  * from i's centre to j's (its image across a periodic boundary) or to the contact point on a wall,
  * cell data i, j (walls: minus the wall id), fn, ft, overlap, normal, force (on i),
  * normal_force, tangential_force (0 for walls, which report the normal force only). Walls: each
@@ -472,6 +529,11 @@ const double *dem_forces(const dem_scene *s, int d);
 core_status dem_vtk_particles(const dem_scene *s, const char *path, core_error *err);
 core_status dem_vtk_contacts(dem_scene *s, const char *path, core_error *err);
 core_status dem_vtk_walls(const dem_scene *s, const char *path, core_error *err);
+/* One vertex per clump at its centre of mass: id (1-based, the particles' "clump" array), mass,
+ * velocity, angular_velocity, angular_momentum, orientation (2D: the angle; 3D: the quaternion
+ * w, x, y, z of the principal frame), inertia (principal moments), members and first_member
+ * (the particle id of its first member). */
+core_status dem_vtk_clumps(const dem_scene *s, const char *path, core_error *err);
 
 /* ---- LAMMPS data and dump files (lammps.c, lammps_write.c) --------------------------------- *
  * Data files in atom_style sphere (LIGGGHTS: granular): Atoms "id type diameter density x y z
@@ -527,11 +589,16 @@ typedef struct dem_lammps_write_def {
     int append;                  /* dump: append a frame instead of writing a new file */
 } dem_lammps_write_def;
 
-/* A data file, written whole (temporary file + rename). */
+/* A data file, written whole (temporary file + rename). A scene with clumps is written in
+ * atom_style hybrid sphere molecular, Atoms "id type x y z diameter density mol ix iy iz", for
+ * LAMMPS's fix rigid/small molecule: mol is the clump id (1-based) of a member of a clump of two
+ * or more members, 0 for a grain of no clump and for a clump of one sphere (LAMMPS refuses a
+ * rigid body of one particle). */
 core_status dem_write_lammps_data(const dem_scene *s, const char *path,
                                   const dem_lammps_write_def *def, core_error *err);
-/* One `dump custom` frame (id type radius mass x y z vx vy vz fx fy fz omegax omegay omegaz): a
- * new file written whole, or appended; an append that fails is cut back to the old length. */
+/* One `dump custom` frame (id type radius mass x y z vx vy vz fx fy fz omegax omegay omegaz; a
+ * scene with clumps adds mol after id, as in its data file): a new file written whole, or
+ * appended; an append that fails is cut back to the old length. */
 core_status dem_write_lammps_dump(const dem_scene *s, const char *path,
                                   const dem_lammps_write_def *def, core_error *err);
 

@@ -150,6 +150,9 @@ struct dem_scene {
     long watch_next, watch_min_step;
     double watch_min, watch_min_t, watch_scale;
 
+    /* Clumps (clump.c): NULL in a scene without them, which then pays nothing for them. */
+    struct dem_clumps *clumps;
+
     /* The run in progress (integrate.c), for the likely cause of an instability (unstable.c). */
     const dem_run_def *run;
 };
@@ -374,6 +377,40 @@ static inline double dem_wall_adhesion(const dem_scene *s, const dem_wall *w, si
         return s->contact.adhesion;
     const int mi = s->mat[i], mw = w->material >= 0 ? w->material : mi;
     return sqrt(s->mats[mi].adhesion * s->mats[mw].adhesion);
+}
+
+/* clump.c: rigid bodies of member particles. body[i] is particle i's clump or -1; off holds
+ * each member's offset in its body's principal frame (3 per particle). */
+typedef struct dem_body {
+    double x[3], v[3], q[4], L[3], omega[3], f[3], t[3];
+    double mass, moment[3], angle;
+    size_t first, count;
+} dem_body;
+typedef struct dem_clumps {
+    dem_body *b;
+    size_t n, cap;
+    int32_t *body; /* per particle (scene cap) */
+    double *off;   /* 3 per particle (scene cap) */
+} dem_clumps;
+/* What a run with clumps refuses (named in the error); CORE_OK without clumps. */
+core_status dem_clumps_check_run(const dem_scene *s, int integrator, core_error *err);
+/* Velocity Verlet's first half: the bodies' half kick from their members' forces, the drift and
+ * rotation by dt, the members placed from the bodies. */
+void dem_clumps_kick_drift(dem_scene *s, double h, double dt);
+/* The second half kick, the members' velocities from the bodies. */
+void dem_clumps_kick(dem_scene *s, double h);
+/* The particle arrays grew to cap (scene.c's grow). */
+core_status dem_clumps_grow(dem_scene *s, size_t old_cap, size_t cap, core_error *err);
+/* Kinetic, rotational and gravitational energies of the bodies (measure.c skips members). */
+void dem_clumps_energy(const dem_scene *s, double *kin, double *rot, double *pot);
+void dem_clumps_free(dem_scene *s);
+/* clump_checkpoint.c: the section "clumps", written only by a scene with clumps; the load runs
+ * after the particles' section, in the open section of r. */
+core_status dem_clumps_save(const dem_scene *s, struct ckpt_writer *w, core_error *err);
+core_status dem_clumps_load(dem_scene *s, struct dem_reader *r);
+static inline int dem_is_member(const dem_scene *s, size_t i)
+{
+    return s->clumps && s->clumps->body[i] >= 0;
 }
 
 /* scene.c */

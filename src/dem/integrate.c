@@ -459,11 +459,17 @@ static core_status step_velocity_verlet(dem_scene *s, double dt, core_error *err
     if (!s->forces_ready && (st = forces(s, dt, -1, err)))
         return st;
     double disp2 = kick_drift(s, 0.5 * dt, dt);
+    if (s->clumps) { /* the members go where their bodies take them */
+        dem_clumps_kick_drift(s, 0.5 * dt, dt);
+        disp2 = -1;
+    }
     move_walls(s, dt);
     s->time += dt;
     if ((st = forces(s, dt, disp2, err)))
         return st;
     kick_check(s, 0.5 * dt);
+    if (s->clumps)
+        dem_clumps_kick(s, 0.5 * dt);
     return CORE_OK;
 }
 
@@ -709,6 +715,8 @@ static core_status run_steps(dem_scene *s, const dem_run_def *run, core_error *e
                              "run this scene on one rank",
                              w + 1);
     if (s->flow && (st0 = dem_flow_check_run(s, err)))
+        return st0;
+    if (s->clumps && (st0 = dem_clumps_check_run(s, (int)run->integrator, err)))
         return st0;
     core_status st = prepare(s, run, err);
     if (st)

@@ -1,5 +1,5 @@
-/* LAMMPS files written from a DEM scene: data files in atom_style sphere and `dump custom`
- * frames (lammps.c reads data files back). */
+/* LAMMPS files written from a DEM scene: data files in atom_style sphere (hybrid sphere molecular
+ * in a scene with clumps) and `dump custom` frames (lammps.c reads atom_style sphere back). */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
 #include <fcntl.h>
@@ -91,9 +91,21 @@ static long long atom_id(const dem_scene *s, size_t i)
     return (s->tag ? (long long)s->tag[i] : (long long)i) + 1;
 }
 
+/* LAMMPS's molecule id of particle i in a scene with clumps, the convention of its rigid bodies
+ * (fix rigid/small molecule): the clump id (1-based) of a member of a clump of two or more
+ * members; 0 for a grain of no clump and for a clump of one sphere, which LAMMPS refuses as a
+ * rigid body and which moves as that sphere would. */
+static long mol_id(const dem_scene *s, size_t i)
+{
+    const long k = dem_particle_clump(s, i);
+    return k >= 0 && s->clumps->b[k].count > 1 ? k + 1 : 0;
+}
+
 core_status dem_write_lammps_data(const dem_scene *s, const char *path,
                                   const dem_lammps_write_def *def, core_error *err)
 {
+    /* atom_style hybrid sphere molecular carries the molecule id after sphere's values */
+    const int mol = dem_clump_count(s) > 0;
     int *type = NULL, ntypes = 0;
     core_status st = atom_types(s, def, &type, &ntypes, err);
     if (st != CORE_OK)
@@ -109,9 +121,10 @@ core_status dem_write_lammps_data(const dem_scene *s, const char *path,
         snprintf(title, sizeof title, "%s", def->title);
     else
         snprintf(title, sizeof title,
-                 "LAMMPS data file (atom_style sphere) from grainlab: %dD, "
+                 "LAMMPS data file (atom_style %s) from grainlab: %dD, "
                  "boundary %c %c %c, time %.17g s",
-                 s->dim, s->periodic[0] ? 'p' : 'f', s->periodic[1] ? 'p' : 'f',
+                 mol ? "hybrid sphere molecular" : "sphere", s->dim, s->periodic[0] ? 'p' : 'f',
+                 s->periodic[1] ? 'p' : 'f',
                  s->dim == 2 || s->periodic[2] ? 'p' : 'f', s->time);
     for (char *c = title; *c; c++) /* one line */
         if (*c == '\n' || *c == '\r')
@@ -121,13 +134,18 @@ core_status dem_write_lammps_data(const dem_scene *s, const char *path,
     fprintf(fp, "%s\n\n%zu atoms\n%d atom types\n\n", title, s->n, ntypes);
     for (int a = 0; a < 3; a++)
         fprintf(fp, "%.17g %.17g %clo %chi\n", lo[a], hi[a], 'x' + a, 'x' + a);
-    fprintf(fp, "\nAtoms # sphere\n\n");
+    fprintf(fp, "\nAtoms # %s\n\n", mol ? "hybrid" : "sphere");
     for (size_t i = 0; i < s->n; i++) {
         double x[3];
         long img[3];
         wrapped(s, i, x, img);
-        fprintf(fp, "%lld %d %.17g %.17g %.17g %.17g %.17g %ld %ld %ld\n", atom_id(s, i), type[i],
-                2 * s->r[i], s->mats[s->mat[i]].density, x[0], x[1], x[2], img[0], img[1], img[2]);
+        const double dia = 2 * s->r[i], rho = s->mats[s->mat[i]].density;
+        if (mol) /* hybrid: id type x y z, then each sub-style's own values */
+            fprintf(fp, "%lld %d %.17g %.17g %.17g %.17g %.17g %ld %ld %ld %ld\n", atom_id(s, i),
+                    type[i], x[0], x[1], x[2], dia, rho, mol_id(s, i), img[0], img[1], img[2]);
+        else
+            fprintf(fp, "%lld %d %.17g %.17g %.17g %.17g %.17g %ld %ld %ld\n", atom_id(s, i),
+                    type[i], dia, rho, x[0], x[1], x[2], img[0], img[1], img[2]);
     }
     fprintf(fp, "\nVelocities\n\n");
     for (size_t i = 0; i < s->n; i++) {
@@ -196,8 +214,9 @@ core_status dem_write_lammps_dump(const dem_scene *s, const char *path,
     sb_printf(&b, "ITEM: BOX BOUNDS %c%c %c%c %c%c\n", bc[0], bc[0], bc[1], bc[1], bc[2], bc[2]);
     for (int a = 0; a < 3; a++)
         sb_printf(&b, "%.17g %.17g\n", lo[a], hi[a]);
-    sb_printf(&b, "ITEM: ATOMS id type radius mass x y z vx vy vz fx fy fz omegax omegay "
-                  "omegaz\n");
+    const int mol = dem_clump_count(s) > 0; /* clumps: the molecule id after the atom id */
+    sb_printf(&b, "ITEM: ATOMS id %stype radius mass x y z vx vy vz fx fy fz omegax omegay "
+                  "omegaz\n", mol ? "mol " : "");
     for (size_t i = 0; i < s->n; i++) {
         double x[3];
         long img[3];
@@ -207,10 +226,14 @@ core_status dem_write_lammps_dump(const dem_scene *s, const char *path,
             v[a] = a < s->dim ? s->v[a][i] : 0;
             f[a] = a < s->dim ? s->f[a][i] : 0;
         }
+        if (mol)
+            sb_printf(&b, "%lld %ld ", atom_id(s, i), mol_id(s, i));
+        else
+            sb_printf(&b, "%lld ", atom_id(s, i));
         sb_printf(&b,
-                  "%lld %d %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g "
+                  "%d %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g "
                   "%.17g %.17g %.17g\n",
-                  atom_id(s, i), type[i], s->r[i], s->m[i], x[0], x[1], x[2], v[0], v[1], v[2],
+                  type[i], s->r[i], s->m[i], x[0], x[1], x[2], v[0], v[1], v[2],
                   f[0], f[1], f[2], omega_of(s, 0, i), omega_of(s, 1, i), omega_of(s, 2, i));
     }
     free(type);

@@ -64,8 +64,8 @@ void dem_measure_energy(dem_scene *s, dem_energy *e)
      * first particle, then a sum over ranks, the same on every rank. */
     const unsigned char *gh = s->ghost;
     for (size_t i = 0; i < s->n; i++) {
-        if ((s->flags[i] & DEM_FIXED) || (gh && gh[i]))
-            continue;
+        if ((s->flags[i] & DEM_FIXED) || (gh && gh[i]) || dem_is_member(s, i))
+            continue; /* a clump's members: its body's energies below */
         double v2 = 0, gx = 0;
         for (int d = 0; d < D; d++) {
             v2 += s->v[d][i] * s->v[d][i];
@@ -80,6 +80,11 @@ void dem_measure_energy(dem_scene *s, dem_energy *e)
                 w2 += s->w[d][i] * s->w[d][i];
             e->rotational += 0.5 * w2 / s->inv_inertia[i];
         }
+    }
+    if (s->clumps) {
+        double kin, rot, pot;
+        dem_clumps_energy(s, &kin, &rot, &pot);
+        e->kinetic += kin, e->rotational += rot, e->potential += pot;
     }
     if (s->need_rebuild || !s->pairs.start)
         dem_build_pairs(s, NULL);

@@ -263,6 +263,9 @@ static size_t scan(const dem_scene *s, size_t i, uint32_t *out)
     /* Distributed: a pair of two ghosts is no owned particle's business. */
     const unsigned char *gh = s->ghost;
     const int gi = gh && gh[i];
+    /* Clumps: no pair inside one (bi < 0 for a particle of no clump, and in scenes without) */
+    const int32_t *bd = s->clumps ? s->clumps->body : NULL;
+    const int32_t bi = bd ? bd[i] : -1;
     int k[3];
     for (k[2] = lo[2]; k[2] <= hi[2]; k[2]++)
         for (k[1] = lo[1]; k[1] <= hi[1]; k[1]++)
@@ -276,7 +279,7 @@ static size_t scan(const dem_scene *s, size_t i, uint32_t *out)
                 size_t cell = cell_index(s, cc);
                 for (size_t e = s->cell_start[cell]; e < s->cell_start[cell + 1]; e++) {
                     uint32_t j = s->cell_items[e];
-                    if (j <= i || (gi && gh[j]))
+                    if (j <= i || (gi && gh[j]) || (bi >= 0 && bd[j] == bi))
                         continue;
                     double cut = s->r[i] + s->r[j] + s->skin + s->reach;
                     if (dist2(s, i, j) < cut * cut) {

@@ -122,6 +122,7 @@ void dem_destroy(dem_scene *s)
     dem_domain_free(s);
     dem_clear_boundary(s);
     dem_flow_free(s);
+    dem_clumps_free(s);
     for (int d = 0; d < 3; d++) {
         core_free_staggered(s->x[d], DEM_HOT_X + d), core_free_staggered(s->v[d], DEM_HOT_V + d);
         core_free_staggered(s->f[d], DEM_HOT_F + d), core_free_staggered(s->w[d], DEM_HOT_W + d);
@@ -441,6 +442,8 @@ static core_status grow(dem_scene *s, size_t need, core_error *err)
         s->flags = fl;
     if (!mat || !fl)
         return core_fail(err, CORE_ERR_NOMEM, "cannot allocate %zu particles", cap);
+    if (s->clumps && (st = dem_clumps_grow(s, s->cap, cap, err)))
+        return st;
     s->cap = cap;
     return CORE_OK;
 }
@@ -601,6 +604,10 @@ core_status dem_set_velocity(dem_scene *s, size_t i, const double v[3], core_err
             return core_fail(err, CORE_ERR_ARG, "velocity must be finite");
     if (s->flags[i] & DEM_FIXED)
         return core_fail(err, CORE_ERR_STATE, "particle %zu is fixed", i + 1);
+    if (dem_is_member(s, i))
+        return core_fail(err, CORE_ERR_STATE,
+                         "particle %zu is a member of clump %ld: it moves with its clump", i + 1,
+                         (long)s->clumps->body[i] + 1);
     for (int d = 0; d < s->dim; d++)
         s->v[d][i] = v[d];
     dem_invalidate(s, 0);
@@ -618,6 +625,12 @@ core_status dem_scale_mass(dem_scene *s, double factor, core_error *err)
     }
     for (int k = 0; k < s->nmat; k++)
         s->mats[k].density *= factor;
+    for (size_t k = 0; k < dem_clump_count(s); k++) { /* the same spin, a heavier body */
+        dem_body *b = &s->clumps->b[k];
+        b->mass *= factor;
+        for (int d = 0; d < 3; d++)
+            b->moment[d] *= factor, b->L[d] *= factor;
+    }
     dem_invalidate(s, 1); /* damping coefficients depend on masses */
     return CORE_OK;
 }

@@ -58,7 +58,11 @@ core_status dem_vtk_particles(const dem_scene *s, const char *path, core_error *
     int32_t *mat = m ? vtk_i32(f, VTK_POINT_DATA, "material", 1, n, err) : NULL;
     double *angle =
         mat && D == 2 && dem_angles(s) ? vtk_f64(f, VTK_POINT_DATA, "angle", 1, n, err) : NULL;
-    if (!mat || (D == 2 && dem_angles(s) && !angle))
+    /* clump scenes: each member's clump id (1-based, as s:add_clump returns it), 0 for a grain
+     * of no clump */
+    const int clumps = dem_clump_count(s) > 0;
+    int64_t *clump = mat && clumps ? vtk_i64(f, VTK_POINT_DATA, "clump", 1, n, err) : NULL;
+    if (!mat || (D == 2 && dem_angles(s) && !angle) || (clumps && !clump))
         return vtk_file_finish(f, path, err ? err->status : CORE_ERR_NOMEM, err);
     interleave(x, pos, n);
     interleave(v, vel, n);
@@ -73,12 +77,65 @@ core_status dem_vtk_particles(const dem_scene *s, const char *path, core_error *
         r[i] = rad[i];
         m[i] = mass[i];
         mat[i] = pm[i] + 1;
+        if (clump)
+            clump[i] = dem_particle_clump(s, i) + 1;
     }
     if (angle)
         memcpy(angle, dem_angles(s), n * sizeof *angle);
     st = vtk_set_time(f, dem_time(s), dem_steps_done(s), err);
     if (!st)
         st = vtk_set_active(f, VTK_POINT_DATA, "Scalars", "radius", err);
+    if (!st)
+        st = vtk_set_active(f, VTK_POINT_DATA, "Vectors", "velocity", err);
+    return vtk_file_finish(f, path, st, err);
+}
+
+/* ---- clumps ------------------------------------------------------------------------------- */
+core_status dem_vtk_clumps(const dem_scene *s, const char *path, core_error *err)
+{
+    const size_t n = dem_clump_count(s);
+    const int D = dem_dim(s);
+    vtk_file *f;
+    core_status st = vtk_unstructured(n, n, &f, err);
+    if (st)
+        return st;
+    double *x = vtk_f64(f, VTK_POINTS, "Points", 3, n, err);
+    int64_t *conn = x ? vtk_cells(f, VTK_CELL_VERTEX, 1, err) : NULL;
+    int64_t *id = conn ? vtk_i64(f, VTK_POINT_DATA, "id", 1, n, err) : NULL;
+    double *m = id ? vtk_f64(f, VTK_POINT_DATA, "mass", 1, n, err) : NULL;
+    double *v = m ? vtk_f64(f, VTK_POINT_DATA, "velocity", 3, n, err) : NULL;
+    double *w = v ? vtk_f64(f, VTK_POINT_DATA, "angular_velocity", 3, n, err) : NULL;
+    double *L = w ? vtk_f64(f, VTK_POINT_DATA, "angular_momentum", 3, n, err) : NULL;
+    const int nq = D == 2 ? 1 : 4;
+    double *q = L ? vtk_f64(f, VTK_POINT_DATA, "orientation", nq, n, err) : NULL;
+    double *in = q ? vtk_f64(f, VTK_POINT_DATA, "inertia", 3, n, err) : NULL;
+    int64_t *cnt = in ? vtk_i64(f, VTK_POINT_DATA, "members", 1, n, err) : NULL;
+    int64_t *first = cnt ? vtk_i64(f, VTK_POINT_DATA, "first_member", 1, n, err) : NULL;
+    if (!first)
+        return vtk_file_finish(f, path, err ? err->status : CORE_ERR_NOMEM, err);
+    const double *tag = dem_tags(s);
+    for (size_t k = 0; k < n; k++) {
+        dem_clump_state c;
+        if ((st = dem_clump_get(s, k, &c, err)))
+            return vtk_file_finish(f, path, st, err);
+        conn[k] = (int64_t)k;
+        id[k] = (int64_t)k + 1;
+        m[k] = c.mass;
+        for (int d = 0; d < 3; d++) {
+            x[3 * k + d] = d < D ? c.x[d] : 0;
+            v[3 * k + d] = d < D ? c.v[d] : 0;
+            w[3 * k + d] = c.omega[d];
+            L[3 * k + d] = c.L[d];
+            in[3 * k + d] = c.moments[d];
+        }
+        if (D == 2)
+            q[k] = c.angle;
+        else
+            memcpy(q + 4 * k, c.q, sizeof c.q);
+        cnt[k] = (int64_t)c.count;
+        first[k] = particle_id(tag, c.first);
+    }
+    st = vtk_set_time(f, dem_time(s), dem_steps_done(s), err);
     if (!st)
         st = vtk_set_active(f, VTK_POINT_DATA, "Vectors", "velocity", err);
     return vtk_file_finish(f, path, st, err);

@@ -371,6 +371,10 @@ static int l_info(lua_State *L)
     lua_setfield(L, -2, "dim");
     lua_pushinteger(L, (lua_Integer)dem_count(s));
     lua_setfield(L, -2, "count");
+    if (dem_dim(s) == 2) {
+        lua_pushnumber(L, dem_thickness(s));
+        lua_setfield(L, -2, "thickness");
+    }
     lua_pushnumber(L, dem_time(s));
     lua_setfield(L, -2, "time");
     lua_pushinteger(L, dem_steps_done(s));
@@ -455,7 +459,8 @@ void bind_open_dem(lua_State *L)
          "of a LAMMPS data file with gaps): a number each particle keeps while ids shift on "
          "removals, and the id VTK and LAMMPS files give it."},
         {"info", l_info, "s:info()",
-         "dim, box, gravity, count, time, steps, force_evaluations, the laws."},
+         "dim, box, gravity, count, thickness (2D; 0: sphere masses), time, steps, "
+         "force_evaluations, the laws."},
         {NULL, NULL, NULL, NULL}};
     static const luaL_Reg meta[] = {
         {"__gc", l_gc}, {"__close", l_gc}, {"__tostring", l_tostring}, {NULL, NULL}};
@@ -483,4 +488,5 @@ void bind_open_dem(lua_State *L)
     bind_doc(L, -1, "dem", "dem",
              "Discrete elements: soft disks and spheres with contact laws, walls, integrators.");
     lua_setglobal(L, "dem");
+    ldem_open_clump(L);
 }

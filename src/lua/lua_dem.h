@@ -29,5 +29,6 @@ void ldem_open_contact(lua_State *L);
 void ldem_open_walls(lua_State *L);
 void ldem_open_run(lua_State *L);
 void ldem_open_measure(lua_State *L);
+void ldem_open_clump(lua_State *L); /* after the global dem exists */
 
 #endif

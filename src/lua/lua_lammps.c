@@ -449,12 +449,16 @@ void bind_open_lammps(lua_State *L)
          "s:write_lammps_data(path, { types = { [1] = m1, ... }, title = '...' })",
          "Writes the scene as a LAMMPS data file (atom_style sphere, with image flags and "
          "Velocities), whole. Atom type k is the scene's k-th material unless types maps them. "
-         "2D: z = 0 and zlo < 0 < zhi (read it with dimension 2)."},
+         "2D: z = 0 and zlo < 0 < zhi (read it with dimension 2). A scene with clumps is "
+         "written in atom_style hybrid sphere molecular (id type x y z diameter density mol) for "
+         "fix rigid/small molecule: mol is the clump id of a member of a clump of two or more "
+         "members, 0 for a loose grain or a one-sphere clump."},
         {"write_lammps_dump", l_write_dump,
          "s:write_lammps_dump(path, { types = {...}, append = false })",
          "Writes one `dump custom` frame (id type radius mass x y z vx vy vz fx fy fz omegax "
-         "omegay omegaz) for OVITO or LAMMPS's rerun: a new file, or with append = true added "
-         "to the end (from on_step for a time series)."},
+         "omegay omegaz; with clumps, mol after id, as in the data file) for OVITO or LAMMPS's "
+         "rerun: a new file, or with append = true added to the end (from on_step for a time "
+         "series)."},
         {NULL, NULL, NULL, NULL}};
     luaL_getmetatable(L, "dem.scene");
     lua_getfield(L, -1, "__index");

@@ -117,7 +117,7 @@ static int l_image_tostring(lua_State *L)
 }
 
 /* ---- scene options ----------------------------------------------------------------------- */
-static const char *const COLORS[] = {"grain", "speed", "rotation", "material", NULL};
+static const char *const COLORS[] = {"grain", "speed", "rotation", "material", "clump", NULL};
 const char *const bind_render_colormaps[] = {"viridis", "gray", NULL};
 static const char *const SHOW[] = {"force_chains", "rotation", "walls", "colorbar", "box",
                                    "displacement", NULL};
@@ -430,6 +430,19 @@ void bind_read_range(lua_State *L, int arg, const char *call, double range[2])
     lua_pop(L, 1);
 }
 
+/* Labels for color = 'clump' (kept below the top of the stack): a clump's members share its
+ * index, and each loose grain has one of its own after them. */
+static const int *clump_labels(lua_State *L, const dem_scene *s)
+{
+    const size_t n = dem_count(s), nc = dem_clump_count(s);
+    int *lab = bind_buffer_below_top(L, n * sizeof *lab);
+    for (size_t i = 0; i < n; i++) {
+        const long k = dem_particle_clump(s, i);
+        lab[i] = k >= 0 ? (int)k : (int)(nc + i);
+    }
+    return lab;
+}
+
 static const char *const SCENE_OPTS_FIELDS[] = {
     "width", "height", "color", "colormap", "range",  "show",         "title",
     "stamp", "label",  "walls", "frame",    "camera", "displacement", NULL};
@@ -479,20 +492,25 @@ static void read_scene_opts(lua_State *L, int scene, int arg, const char *call, 
         lua_pop(L, 1);
     } else if (t == LUA_TNIL || t == LUA_TSTRING) {
         static const render_color_by BY[] = {RENDER_COLOR_GRAIN, RENDER_COLOR_SPEED,
-                                             RENDER_COLOR_ROTATION, RENDER_COLOR_LABELS};
+                                             RENDER_COLOR_ROTATION, RENDER_COLOR_LABELS,
+                                             RENDER_COLOR_LABELS};
         int k = 0;
         while (t == LUA_TSTRING && COLORS[k] && strcmp(COLORS[k], lua_tostring(L, -1)) != 0)
             k++;
         if (!COLORS[k])
             bind_field_error(L, arg, call, "color",
-                             "one of 'grain', 'speed', 'rotation', 'material' or an array of numbers");
-        lua_pop(L, 1);
+                             "one of 'grain', 'speed', 'rotation', 'material', 'clump' or an "
+                             "array of numbers");
         d->color = BY[k];
-        if (d->color == RENDER_COLOR_LABELS)
+        if (d->color == RENDER_COLOR_LABELS && strcmp(COLORS[k], "clump") != 0)
             d->labels = dem_particle_materials(s);
+        else if (d->color == RENDER_COLOR_LABELS) /* a colour per clump, another per loose grain */
+            d->labels = clump_labels(L, s);
+        lua_pop(L, 1);
     } else {
         bind_field_error(L, arg, call, "color",
-                         "one of 'grain', 'speed', 'rotation', 'material' or an array of numbers");
+                         "one of 'grain', 'speed', 'rotation', 'material', 'clump' or an array of "
+                         "numbers");
     }
 
     bind_read_range(L, arg, call, d->range);
@@ -730,7 +748,8 @@ void bind_open_render(lua_State *L)
     static const bind_fn fns[] = {
         {"png", l_png,
          "render.png(scene, 'file.png', { width = 1024, height =, color = 'grain'|'speed'|"
-         "'rotation'|{values}, colormap = 'viridis'|'gray', range = {lo, hi}, show = "
+         "'rotation'|'material'|'clump'|{values}, colormap = 'viridis'|'gray', range = {lo, "
+         "hi}, show = "
          "{'force_chains', 'rotation', 'colorbar', 'box', 'displacement'}, title =, "
          "stamp = true|'text', displacement = { affine = {{..}, {..}}, center = {x, y}, scale = "
          "k }, "
@@ -740,8 +759,10 @@ void bind_open_render(lua_State *L)
          "Draws a DEM scene into a PNG written whole (temporary file + rename): 2D disks, or 3D "
          "shaded spheres seen by `camera` (degrees; up is against gravity). Width 1024 "
          "by default, height from the box's aspect; sizes in [16, 8192] pixels. color: grain "
-         "(well-separated colours by id), speed |v|, rotation (omega), or an array with one "
-         "number per grain, through the colour map with limits range (default: min and max). "
+         "(well-separated colours by id), speed |v|, rotation (omega), material, clump (one "
+         "colour per clump, shared by its members; loose grains each their own), or an array "
+         "with one number per grain, through the colour map with limits range (default: min and "
+         "max). "
          "walls (default true): the scene's walls where they are now (removed ones not), "
          "planes clipped to the box: in 2D a thick line on the wall's outer side, in 3D the "
          "outline of the wall's section of the box, drawn with the box's edges behind the "

@@ -30,22 +30,22 @@ static int scene_kind(lua_State *L, int idx)
 
 /* ---- options --------------------------------------------------------------------------------- */
 typedef struct write_opts {
-    int contacts, walls, grid, cells; /* -1: not given (the kind's default) */
+    int contacts, walls, grid, cells, clumps; /* -1: not given (the kind's default) */
 } write_opts;
 
 /* The options of each kind's write_vtk (the very lists the calls check), and all of them for a
  * series, whose kind is known at its first frame only. */
-static const char *const DEM_FIELDS[] = {"contacts", "walls", NULL};
+static const char *const DEM_FIELDS[] = {"contacts", "walls", "clumps", NULL};
 static const char *const MPM_FIELDS[] = {"grid", NULL};
 static const char *const DSMC_FIELDS[] = {"cells", NULL};
 static const char *const *const KIND_FIELDS[K_NKINDS] = {DEM_FIELDS, MPM_FIELDS, DSMC_FIELDS};
-static const char *const OPT_FIELDS[] = {"contacts", "walls", "grid", "cells", NULL};
+static const char *const OPT_FIELDS[] = {"contacts", "walls", "grid", "cells", "clumps", NULL};
 /* Which kind each option belongs to. */
-static const int OPT_KIND[] = {K_DEM, K_DEM, K_MPM, K_DSMC};
+static const int OPT_KIND[] = {K_DEM, K_DEM, K_MPM, K_DSMC, K_DEM};
 
 static write_opts read_opts(lua_State *L, int arg, const char *call, const char *const *fields)
 {
-    write_opts o = {-1, -1, -1, -1};
+    write_opts o = {-1, -1, -1, -1, -1};
     if (lua_isnoneornil(L, arg))
         return o;
     bind_check_table(L, arg, call);
@@ -54,13 +54,14 @@ static write_opts read_opts(lua_State *L, int arg, const char *call, const char 
     o.walls = bind_field_boolean(L, arg, call, "walls", -1);
     o.grid = bind_field_boolean(L, arg, call, "grid", -1);
     o.cells = bind_field_boolean(L, arg, call, "cells", -1);
+    o.clumps = bind_field_boolean(L, arg, call, "clumps", -1);
     return o;
 }
 
 /* Refuses options given for another kind of scene (a typo-like mistake: they would do nothing). */
 static void check_opts_kind(lua_State *L, const write_opts *o, int kind, const char *call)
 {
-    const int given[] = {o->contacts, o->walls, o->grid, o->cells};
+    const int given[] = {o->contacts, o->walls, o->grid, o->cells, o->clumps};
     for (int k = 0; OPT_FIELDS[k]; k++)
         if (given[k] >= 0 && OPT_KIND[k] != kind)
             luaL_error(L, "%s: option '%s' is for a %s, not a %s", call, OPT_FIELDS[k],
@@ -69,11 +70,12 @@ static void check_opts_kind(lua_State *L, const write_opts *o, int kind, const c
 
 /* ---- writing one frame ------------------------------------------------------------------------
  */
-#define MAX_PARTS 3
+#define MAX_PARTS 4
 #define PATH_MAX_LEN 4096
 
 typedef struct part {
-    const char *suffix; /* "" for the main file, else "contacts", "walls", "grid", "cells" */
+    const char *suffix; /* "" for the main file, else "contacts", "walls", "clumps", "grid",
+                         * "cells" */
     const char *ext;    /* "vtu" or "vti" */
     char path[PATH_MAX_LEN];
 } part;
@@ -122,6 +124,8 @@ static int write_frame(lua_State *L, int idx, int kind, const char *stem, long f
             parts[n++] = (part){.suffix = "contacts", .ext = "vtu"};
         if (o->walls > 0 || (o->walls < 0 && dem_wall_count(s) > 0))
             parts[n++] = (part){.suffix = "walls", .ext = "vtu"};
+        if (o->clumps > 0 || (o->clumps < 0 && dem_clump_count(s) > 0))
+            parts[n++] = (part){.suffix = "clumps", .ext = "vtu"};
     } else if (kind == K_MPM) {
         if (o->grid != 0)
             parts[n++] = (part){.suffix = "grid", .ext = "vti"};
@@ -137,6 +141,7 @@ static int write_frame(lua_State *L, int idx, int kind, const char *stem, long f
         if (kind == K_DEM)
             st = !*suf                      ? dem_vtk_particles(s, path, &err)
                  : !strcmp(suf, "contacts") ? dem_vtk_contacts(s, path, &err)
+                 : !strcmp(suf, "clumps")   ? dem_vtk_clumps(s, path, &err)
                                             : dem_vtk_walls(s, path, &err);
         else if (kind == K_MPM)
             st = !*suf ? mpm_vtk_points(s, path, &err) : mpm_vtk_grid(s, path, &err);
@@ -548,18 +553,23 @@ static int l_series_tostring(lua_State *L)
 /* ---- registration -----------------------------------------------------------------------------
  */
 static const char *const WRITE_USAGE[K_NKINDS] = {
-    "s:write_vtk(path.vtu, { contacts = true, walls = (scene has walls) })",
+    "s:write_vtk(path.vtu, { contacts = true, walls = (scene has walls), clumps = (scene has "
+    "clumps) })",
     "m:write_vtk(path.vtu, { grid = true })",
     "s:write_vtk(path.vtu, { cells = true })",
 };
 static const char *const WRITE_DOC[K_NKINDS] = {
     "VTK XML for ParaView, each file written whole. path.vtu: the particles as vertices with "
     "point data id, radius, velocity, angular_velocity, force (total, last evaluation), mass, "
-    "material (and angle in 2D with rotations); vectors have 3 components (z = 0 in 2D). "
+    "material (and angle in 2D with rotations; clump in a scene with clumps: the member's clump "
+    "id, 0 for a loose grain); vectors have 3 components (z = 0 in 2D). "
     "path_contacts.vtu: a line per contact (to j's centre, or the contact point on a wall) with "
     "cell data i, j (walls: minus the wall id), fn, ft, overlap, normal, force, normal_force, "
     "tangential_force. path_walls.vtu: the walls clipped to the box (lines in 2D, polygons in "
-    "3D) with id, normal, force. Returns the paths written.",
+    "3D) with id, normal, force. path_clumps.vtu: a vertex per clump at its centre of mass "
+    "with id, mass, velocity, angular_velocity, angular_momentum, orientation (2D: the angle; "
+    "3D: the quaternion w, x, y, z), inertia (principal moments), members, first_member. "
+    "Returns the paths written.",
     "VTK XML for ParaView. path.vtu: the material points with id, grain, material, mass, volume, "
     "velocity, displacement, stress and deformation_gradient (3 x 3, plane strain), pressure, "
     "eps_p. path_grid.vti: the grid nodes with mass and velocity (a linear-shape transfer of "
@@ -615,9 +625,10 @@ void bind_open_vtk(lua_State *L)
                   "A ParaView time series from grainlab.vtk.series: one .pvd per part.");
     static const bind_fn fns[] = {
         {"series", l_series,
-         "grainlab.vtk.series(path.pvd, { contacts =, walls =, grid =, cells = })",
+         "grainlab.vtk.series(path.pvd, { contacts =, walls =, clumps =, grid =, cells = })",
          "A time series for ParaView: call series:add(s) from on_step; open path.pvd (and "
-         "stem_contacts.pvd, stem_walls.pvd, stem_grid.pvd, stem_cells.pvd) in ParaView."},
+         "stem_contacts.pvd, stem_walls.pvd, stem_clumps.pvd, stem_grid.pvd, stem_cells.pvd) "
+         "in ParaView."},
         {NULL, NULL, NULL, NULL}};
     lua_getglobal(L, "grainlab");
     lua_newtable(L);

@@ -221,6 +221,29 @@ local calls = {
       args = function() return { "displacement", { affine = { { 0, 0 }, { 0, 0 } }, center = { 0, 0 } } } end,
       accept = { center = OPT, affine = OPT } },
   },
+  ["dem.clump_template"] = {
+    args = function() return { { members = { { offset = { 0, 0 }, radius = 0.01 },
+                                             { offset = { 0.015, 0 }, radius = 0.01 } },
+                                 resolution = 64 } } end,
+    opts = 1, accept = { members = { "short", "long" }, resolution = OPT },
+  },
+  ["dem.scene:add_clump"] = {
+    setup = scene2, self = self, opts = 1,
+    args = function() return { { members = { { offset = { 0, 0 }, radius = 0.01 },
+                                             { offset = { 0.015, 0 }, radius = 0.01 } },
+                                 material = mat, position = { 0.2, 0.2 }, orientation = 0.1,
+                                 velocity = { 1, 0 }, spin = 1, resolution = 64 } } end,
+    accept = { template = OPT, members = { "short", "long" }, material = OPT, position = {},
+               orientation = { "nil", "zero", "negative" }, velocity = OPT,
+               spin = { "nil", "zero", "negative" }, resolution = OPT },
+  },
+  ["dem.scene:clump"] = {
+    setup = function() local s = scene2()
+      s:add_clump{ members = { { offset = { 0, 0 }, radius = 0.01 } }, material = mat,
+                   position = { 0.2, 0.2 } }; return s end,
+    self = self, args = function() return { 1 } end, pos = { ID },
+  },
+  ["dem.scene:clump_count"] = { setup = scene2, self = self },
   ["dem.scene:particles"] = { setup = scene2, self = self },
   ["dem.scene:set_reference"] = { setup = scene2, self = self },
   ["dem.scene:clear_forces"] = { setup = scene2, self = self },
@@ -281,8 +304,8 @@ os.remove(vtkdir)
 os.execute("mkdir -p '" .. vtkdir .. "'")
 calls["dem.scene:write_vtk"] = {
   setup = scene2, self = self, opts = 2, opts_optional = true, pos = { {} },
-  args = function() return { vtkdir .. "/f.vtu", { contacts = true, walls = false } } end,
-  accept = { contacts = BOOL, walls = BOOL },
+  args = function() return { vtkdir .. "/f.vtu", { contacts = true, walls = false, clumps = true } } end,
+  accept = { contacts = BOOL, walls = BOOL, clumps = BOOL },
 }
 -- The methods lua_analysis.c registers on dem.scene have their own fuzz test.
 local elsewhere = "boundary-condition methods of lua_analysis.c: fuzzed by test_fuzz_analysis.lua"
@@ -292,7 +315,11 @@ local skip = { ["dem.scene:boundary"] = elsewhere, ["dem.scene:boundary_edges"] 
 for _, k in ipairs{ "dem.read_lammps_data", "dem.scene:read_lammps_data", "dem.scene:write_lammps_data",
                     "dem.scene:write_lammps_dump" } do skip[k] = "fuzzed by test_lammps_fuzz.lua" end
 
-fuzz.run{ modules = { dem = dem }, types = { ["dem.scene"] = scene2() }, calls = calls, skip = skip }
+local template = dem.clump_template{ members = { { offset = { 0, 0 }, radius = 0.01 } } }
+calls["dem.clump_template:info"] = { self = function() return template end }
+calls["dem.clump_template:members"] = { self = function() return template end }
+fuzz.run{ modules = { dem = dem }, types = { ["dem.scene"] = scene2(), ["dem.clump_template"] = template },
+          calls = calls, skip = skip }
 os.execute("rm -rf '" .. vtkdir .. "'")
 os.execute("rm -rf '" .. tmp .. "'")
 

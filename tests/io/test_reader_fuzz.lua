@@ -7,7 +7,8 @@
 --      lines; a data file cut in its Velocities section, inside its last number, inside a z;
 --      image flags on an axis that is not periodic and on z in 2D; +-1e308 as a coordinate or a
 --      box bound; a NUL byte; DEM, MPM and DSMC step counters near 2^63; a boundary spring joining particle
---      2^63 - 1; a checkpoint without its rolling-resistance section; MPM and DSMC grids inflated;
+--      2^63 - 1; a checkpoint without its rolling-resistance section, or its clumps; a clump count
+--      of 2^63 - 1; MPM and DSMC grids inflated;
 --      a FIFO, /dev/zero and a directory given to each reader;
 --   2. 300 generated mutations (seed 1): bit flips with and without the checksum, cuts at section
 --      boundaries and inside numbers, sections shortened, grown, deleted, duplicated and moved,
@@ -130,6 +131,10 @@ case("rolling section removed", "dem", forged(by.dem3_rolling, "rolling", functi
      "is incomplete: section 'rolling' (number 7 of the 7 its writer listed) is missing")
 case("flow section removed", "dem", forged(by.dem2_flow, "flow", function() return nil end),
      "is incomplete: section 'flow'")
+case("clumps section removed", "dem", forged(by.dem3_clumps, "clumps", function() return nil end),
+     "is incomplete: section 'clumps'")
+case("clump count 2^63 - 1", "dem", forged(by.dem3_clumps, "clumps", put_i64(0, math.maxinteger)),
+     "(section 'clumps': clump count = 9223372036854775807 is outside [0, ")
 case("MPM steps near 2^63", "mpm", forged(by.mpm, "mpm.clock", put_i64(8, math.maxinteger - 1)),
      "steps = 9223372036854775806 is outside [0, 9007199254740992]")
 case("DSMC steps near 2^63", "dsmc", forged(by.dsmc2, "dsmc.clock", put_i64(8, math.maxinteger)),

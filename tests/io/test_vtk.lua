@@ -1,6 +1,6 @@
 -- VTK XML output read back by VTK itself: this script writes every kind of file grainlab makes
--- (DEM particles, contacts and walls in 2D and 3D, Delaunay cells, MPM points and grid, DSMC
--- particles and cells, .pvd series) together with what each must contain according to
+-- (DEM particles, contacts and walls in 2D and 3D, clumps, Delaunay cells, MPM points and grid,
+-- DSMC particles and cells, .pvd series) together with what each must contain according to
 -- grainlab's own accessors (s:particles(), s:measure('contacts'), mesh:strain(), m:points(),
 -- m:field(), ...), then runs tests/io/vtk_read.py under Debian's /usr/bin/python3, which opens
 -- each file with vtkXMLUnstructuredGridReader / vtkXMLImageDataReader (the .pvd with Python's
@@ -23,12 +23,12 @@ s0:add_disk{ pos = { 0.5, 0.5 }, radius = 0.1 }
 check.errors(function() s0:write_vtk(P("x.txt")) end,
   "bad argument #1 to 'write_vtk' (file name ending in .vtu expected, got '", "extension")
 check.errors(function() s0:write_vtk(P("x.vtu"), { contact = true }) end,
-  "bad argument #2 to 'write_vtk' (unknown field 'contact'; did you mean 'contacts'? Valid fields: contacts, walls)",
+  "bad argument #2 to 'write_vtk' (unknown field 'contact'; did you mean 'contacts'? Valid fields: contacts, walls, clumps)",
   "typo in an option")
 check.errors(function() s0:write_vtk(P("x.vtu"), { walls = 1 }) end,
   "bad field 'walls' in argument #2 to 'write_vtk' (boolean expected, got 1)", "option type")
 check.errors(function() s0:write_vtk(P("x.vtu"), { grid = true }) end,
-  "bad argument #2 to 'write_vtk' (unknown field 'grid'; valid fields: contacts, walls)",
+  "bad argument #2 to 'write_vtk' (unknown field 'grid'; valid fields: contacts, walls, clumps)",
   "option of another engine")
 check.errors(function() grainlab.vtk.series(P("r.pvd"), { grid = false }):add(s0) end,
   "add: option 'grid' is for a mpm.scene, not a dem.scene", "series option of another engine")
@@ -402,6 +402,52 @@ do
   expect("open cg3.vti vti 24 6")
   expect("point cg3.vti density 9 0 %s", g17(F3.density[10]))
   expect("point cg3.vti fabric 9 0 %s", g17(F3.fabric.xx[10]))
+end
+
+-- ---- clumps: the members' clump id (0 for a loose grain) and a vertex per body, 2D and 3D -------
+for _, dim in ipairs{ 2, 3 } do
+  local box = dim == 2 and { { 0, 0 }, { 0.02, 0.02 } } or { { 0, 0, 0 }, { 0.02, 0.02, 0.02 } }
+  local s = dem.scene{ dim = dim, box = box, gravity = dim == 2 and { 0, -9.81 } or { 0, 0, -9.81 } }
+  local mat = grainlab.material{ density = 1500, young = 2e6, poisson = 0.3, friction = 0.5 }
+  s:contact{ tangential = "spring" }
+  local function v(x, y, z) if dim == 2 then return { x, y } else return { x, y, z } end end
+  local pair = { { offset = v(0, 0, 0), radius = 0.001 }, { offset = v(0.0012, 0, 0.0003), radius = 0.0008 } }
+  local loose = { pos = v(0.004, 0.01, 0.01), radius = 0.001, material = mat }
+  if dim == 2 then s:add_disk(loose) else s:add_sphere(loose) end
+  s:add_clump{ members = pair, material = mat, position = v(0.01, 0.01, 0.01), spin = dim == 2 and 3 or { 1, 2, 3 } }
+  s:add_clump{ members = pair, material = mat, position = v(0.01, 0.005, 0.005), velocity = v(0.1, 0, 0),
+               orientation = dim == 2 and 0.5 or { axis = { 0, 0, 1 }, angle = 0.5 } }
+  s:run{ steps = 5 }
+  local name = "clumps" .. dim
+  local files = s:write_vtk(P(name .. ".vtu"))
+  check.eq(files[#files], P(name .. "_clumps.vtu"), dim .. "D clumps: the bodies' file")
+  expect("type point %s.vtu clump Int64", name)
+  for i, k in ipairs{ 0, 1, 1, 2, 2 } do expect("point %s.vtu clump %d 0 %d", name, i - 1, k) end
+  expect("open %s_clumps.vtu vtu 2 2", name)
+  for k = 1, 2 do
+    local c = s:clump(k)
+    expect("point %s_clumps.vtu id %d 0 %d", name, k - 1, k)
+    expect("point %s_clumps.vtu mass %d 0 %s", name, k - 1, g17(c.mass))
+    expect("point %s_clumps.vtu members %d 0 2", name, k - 1)
+    expect("point %s_clumps.vtu first_member %d 0 %d", name, k - 1, c.members[1])
+    for d = 1, dim do
+      expect("coord %s_clumps.vtu %d %d %s", name, k - 1, d - 1, g17(c.position[d]))
+      expect("point %s_clumps.vtu velocity %d %d %s", name, k - 1, d - 1, g17(c.velocity[d]))
+    end
+    if dim == 2 then
+      expect("point %s_clumps.vtu orientation %d 0 %s", name, k - 1, g17(c.orientation))
+      expect("point %s_clumps.vtu angular_velocity %d 2 %s", name, k - 1, g17(c.spin))
+      expect("point %s_clumps.vtu inertia %d 2 %s", name, k - 1, g17(c.inertia))
+    else
+      expect("ncomp point %s_clumps.vtu orientation 4", name)
+      for q = 1, 4 do expect("point %s_clumps.vtu orientation %d %d %s", name, k - 1, q - 1, g17(c.orientation[q])) end
+      for d = 1, 3 do
+        expect("point %s_clumps.vtu angular_velocity %d %d %s", name, k - 1, d - 1, g17(c.spin[d]))
+        expect("point %s_clumps.vtu angular_momentum %d %d %s", name, k - 1, d - 1, g17(c.angular_momentum[d]))
+        expect("point %s_clumps.vtu inertia %d %d %s", name, k - 1, d - 1, g17(c.inertia[d]))
+      end
+    end
+  end
 end
 
 -- ---- VTK reads it all --------------------------------------------------------------------------

@@ -64,6 +64,16 @@ local calls = {
     accept = { n = {}, radius = OPT, region = OPT, seed = { "nil", "zero" }, material = OPT,
                max_tries = OPT, speed = { "nil", "zero" } },
   },
+  ["grainlab.pack.clumps"] = {
+    setup = scene, args = function(s)
+      local T = dem.clump_template{ members = { { offset = { 0, 0 }, radius = 1e-3 }, { offset = { 1e-3, 0 }, radius = 1e-3 } } }
+      return { s, { n = 2, template = T, region = { { 0, 0 }, { 0.02, 0.02 } }, seed = 1, material = quartz,
+                    max_tries = 1000, speed = 0.1 } }
+    end,
+    opts = 2, pos = { {} },
+    accept = { n = {}, template = {}, region = OPT, seed = { "nil", "zero" }, material = OPT,
+               max_tries = OPT, speed = { "nil", "zero" } },
+  },
   ["grainlab.pack.deposit"] = {
     setup = scene, args = function(s) return { s, { n = 2, radius = 1e-3, region = { { 0, 0 }, { 0.02, 0.02 } },
                                                     seed = 1, material = quartz, relax_steps = 0, drag = 1 } } end,
@@ -142,10 +152,11 @@ calls["grainlab.mpi.bcast"] = { args = function() return { { 1, 2 }, 0 } end,
 
 -- grainlab.vtk.series (lua_vtk.c): the options are checked at creation, nothing is written.
 calls["grainlab.vtk.series"] = {
-  args = function() return { "r.pvd", { contacts = true, walls = true, grid = true, cells = true } } end,
+  args = function() return { "r.pvd", { contacts = true, walls = true, grid = true, cells = true,
+                                        clumps = true } } end,
   opts = 2, opts_optional = true, pos = { {} },
   accept = { contacts = { "nil", "boolean" }, walls = { "nil", "boolean" }, grid = { "nil", "boolean" },
-             cells = { "nil", "boolean" } },
+             cells = { "nil", "boolean" }, clumps = { "nil", "boolean" } },
 }
 
 -- grainlab.report (report.lua): one report per run, so each case starts from a fresh module

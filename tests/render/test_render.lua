@@ -92,7 +92,7 @@ bad({ height = -5 }, "bad field 'height' in argument #3 to 'png' (integer in [16
   "negative height")
 bad({ colour = "speed" }, "bad argument #3 to 'png' (unknown field 'colour'; did you mean 'color'? Valid fields:", "unknown field")
 bad({ color = "texture" },
-  "bad field 'color' in argument #3 to 'png' (one of 'grain', 'speed', 'rotation', 'material' or an array of numbers expected, got 'texture')",
+  "bad field 'color' in argument #3 to 'png' (one of 'grain', 'speed', 'rotation', 'material', 'clump' or an array of numbers expected, got 'texture')",
   "unknown colour")
 bad({ color = { 1, 2 } }, "bad field 'color' in argument #3 to 'png' (array of 31 finite numbers (one per grain) expected",
   "short value array")

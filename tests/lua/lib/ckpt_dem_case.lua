@@ -159,4 +159,75 @@ function M.dump(s, nwalls)
   return table.concat(out, "\n")
 end
 
+-- The scene with clumps (tests/dem/test_dem_clump_io.lua, the reader fuzz's seed): dimers and
+-- trimers of disks (2D) or spheres (3D) with loose grains between them, dropped at angles and
+-- spins into a box with a floor and side walls, Hertz contacts with spring friction (contact
+-- history), so that clumps touch each other, loose grains and the walls within a few hundred
+-- steps. Runs with velocity Verlet or two timescales (M.run).
+function M.build_clumps(dim)
+  local mat = grainlab.material{ density = 1500, young = 2e6, poisson = 0.3, friction = 0.5 }
+  local L = 0.02
+  local box = dim == 2 and { { 0, 0 }, { L, 2 * L } } or { { 0, 0, 0 }, { L, L, 2 * L } }
+  local s = dem.scene{ dim = dim, box = box, gravity = dim == 2 and { 0, -9.81 } or { 0, 0, -9.81 } }
+  s:contact{ normal = "hertz", damping = "brilliantov", restitution = 0.6, impact_velocity = 0.5,
+             tangential = "spring" }
+  local function vec(x, y, z) if dim == 2 then return { x, y } else return { x, y, z } end end
+  s:add_wall{ point = vec(0, 0, 0), normal = dim == 2 and { 0, 1 } or { 0, 0, 1 } }
+  s:add_wall{ point = vec(0, 0, 0), normal = vec(1, 0, 0) }
+  s:add_wall{ point = vec(L, 0, 0), normal = vec(-1, 0, 0) }
+  if dim == 3 then
+    s:add_wall{ point = { 0, 0, 0 }, normal = { 0, 1, 0 } }
+    s:add_wall{ point = { 0, L, 0 }, normal = { 0, -1, 0 } }
+  end
+  local r = 0.001
+  local dimer = dem.clump_template{ members = { { offset = vec(-0.7 * r, 0, 0), radius = r },
+                                                { offset = vec(0.7 * r, 0, 0), radius = 0.8 * r } } }
+  local trimer = dem.clump_template{ members = {
+    { offset = vec(0, 0, 0), radius = r }, { offset = vec(1.2 * r, 0, 0), radius = 0.7 * r },
+    { offset = vec(0, 1.1 * r, 0.3 * r), radius = 0.8 * r } } }
+  local k = 0
+  local per, h = dim == 2 and 5 or 4, 0.0036
+  for a = 0, per - 1 do
+    for b = 0, (dim == 2 and 0 or per - 1) do
+      for c = 0, (dim == 2 and 5 or 2) do
+        k = k + 1
+        local jig = ((k * 7919) % 13) / 13 - 0.5
+        local x = 0.0025 + a * h + 0.0003 * jig
+        local y = 0.0025 + b * h
+        local z = 0.002 + c * h
+        local pos = dim == 2 and { x, z } or { x, y, z }
+        if k % 4 == 0 then -- a loose grain now and then
+          local p = { pos = pos, radius = 0.9 * r, material = mat, vel = vec(0.3 * jig, 0, -0.3) }
+          if dim == 2 then s:add_disk(p) else s:add_sphere(p) end
+        else
+          s:add_clump{ template = k % 2 == 0 and dimer or trimer, material = mat, position = pos,
+                       orientation = dim == 2 and 2.1 * k or { axis = { jig, 1, 0.5 }, angle = 0.9 * k },
+                       velocity = vec(0.6 * jig, 0.3 * jig, -0.3), spin = dim == 2 and 20 * jig or { 5, -10 * jig, 3 } }
+        end
+      end
+    end
+  end
+  return s
+end
+
+-- M.dump with every clump's state (its s:clump table, numbers in %a).
+function M.dump_clumps(s)
+  local out = { M.dump(s, s:info().dim == 2 and 3 or 5) }
+  local function fmt(v)
+    if type(v) ~= "table" then return math.type(v) == "float" and string.format("%a", v) or tostring(v) end
+    local t = {}
+    for i = 1, #v do t[i] = fmt(v[i]) end
+    return "{" .. table.concat(t, " ") .. "}"
+  end
+  for k = 1, s:clump_count() do
+    local c, keys = s:clump(k), {}
+    for key in pairs(c) do keys[#keys + 1] = key end
+    table.sort(keys)
+    local row = { "clump " .. k }
+    for _, key in ipairs(keys) do row[#row + 1] = key .. "=" .. fmt(c[key]) end
+    out[#out + 1] = table.concat(row, " ")
+  end
+  return table.concat(out, "\n")
+end
+
 return M

@@ -4,7 +4,7 @@
 -- by its number.
 --
 -- Seed files are written by the engines themselves (every optional checkpoint section: rolling
--- resistance, boundary conditions, inserters and outflows, shaped walls, DSMC identities; LAMMPS
+-- resistance, boundary conditions, clumps, inserters and outflows, shaped walls, DSMC identities; LAMMPS
 -- files with image flags, velocities and a Masses section, in 2D and 3D). A case mutates one:
 --   checkpoints: a flipped bit with the checksum recomputed, or without (refused); a cut at a
 --     section boundary, inside a section or anywhere (refused); a section shortened or grown
@@ -131,6 +131,7 @@ function M.make_seeds(dir)
   ckpt("dem2", "dem", C.build(2), 40)
   ckpt("dem3_rolling", "dem", C.build(3, "epsd"), 40)
   ckpt("dem2_boundary", "dem", C.build_boundary(), 40)
+  ckpt("dem3_clumps", "dem", C.build_clumps(3), 40) -- section "clumps"
   do -- inserters and outflows (section "flow", particle tags)
     local mat = grainlab.material{ density = 2500, young = 1e7, poisson = 0.3, friction = 0.4 }
     local s = dem.scene{ dim = 2, box = { { 0, 0 }, { 0.05, 0.1 } }, gravity = { 0, -9.81 } }
@@ -228,8 +229,8 @@ end
 -- Reads the seeds written by make_seeds (a worker does not make them again).
 function M.load_seeds(dir)
   local list = {}
-  for _, name in ipairs{ "dem2", "dem3_rolling", "dem2_boundary", "dem2_flow", "dem2_shapes", "mpm",
-                         "dsmc2", "dsmc3" } do
+  for _, name in ipairs{ "dem2", "dem3_rolling", "dem2_boundary", "dem3_clumps", "dem2_flow",
+                         "dem2_shapes", "mpm", "dsmc2", "dsmc3" } do
     local path = dir .. "/seed_" .. name .. ".ckpt"
     local bytes = F.read(path)
     list[#list + 1] = { name = name, kind = name:match("^%l+"), path = path,
