@@ -142,6 +142,7 @@ expect_rc 0 undamped-quiet; [ -z "$err" ] && ok || bad "undamped-quiet: printed"
 # shell starts with SIGINT ignored until grainlab's handler is in place, so a signal sent at a
 # fixed delay was lost whenever a loaded machine made the start-up slower than the delay.
 start_long() {
+  rm -f "$tmp/out" "$tmp/err" # else the wait below can find the last run's "running"
   "$@" >"$tmp/out" 2>"$tmp/err" &
   pid=$!
   for _ in $(seq 200); do grep -q running "$tmp/err" 2>/dev/null && break; sleep 0.05; done
