@@ -12,8 +12,8 @@
 -- the gate's removal), the same wall at x = 0 (slip: the disks roll and slide along a plain
 -- wall), a friction floor with the grains' mu = 0.5, and the DEM packing's density: rho_c = phi
 -- rho_s with phi the area fraction the disks fill in W0 x H0. The friction is the DEM packing's
--- macroscopic one: mu_s = tan theta_r with theta_r = 20.8 deg, the angle of repose these disks
--- form at mu = 0.5 (scripts/repose.lua, docs/dem.md); mu(I)'s mu_2 - mu_s = 0.26 and I_0 =
+-- macroscopic one: mu_s = tan theta_r with theta_r = 20.8 deg, within the scatter of the angle
+-- of repose these disks form at mu = 0.5 (19.1 +- 1.5 deg, scripts/repose.lua); mu(I)'s mu_2 - mu_s = 0.26 and I_0 =
 -- 0.279 are Jop et al.'s glass beads' (no measurement of them from grainlab's DEM), d = 1.5 mm
 -- the disks' mean diameter; Drucker-Prager takes sin phi = mu_s, psi = 0 (phi = 22.3 deg). G =
 -- 0.25 MPa, K = 0.5 MPa (elastic strain under the column 0.4 %). `cells` cells across W0 (2.7
