@@ -34,16 +34,27 @@
 -- then has moved more than 0.1 r with its orientation changed by less than 1 deg, else the
 -- rotating mode of the case (tip or roll).
 --
--- Tolerance. The onset is detected late: past the threshold the driving force grows as about
--- W (th - th_c) = W w t (w the ramp rate in rad/s), so the speed grows as v ~ g w t^2 / 2 for
--- sliding, reaching vth after t = sqrt(2 vth / (g w)), a lag of w t in tilt: 0.11 deg at
--- 1 deg/s, 0.05 deg at 0.2 deg/s. (Tipping and rolling accelerate more slowly per unit excess
--- angle, by the ratio of m h^2 (or m r^2) to the moment of inertia about the pivot, at most
--- ~2.5 here: lag up to ~0.17 deg.) The Hertz overlaps (~1e-4 r at E = 1e8 Pa) move the contact
--- point by that much: negligible. Tolerance params.tol = 0.3 deg.
+-- Tolerance. The onset is detected late. Sliding: past th_c = atan mu the body accelerates at
+-- g (sin th - mu cos th) ~ g (th - th_c) / cos th_c = g w t / cos th_c (w the ramp rate, rad/s),
+-- so v = g w t^2 / (2 cos th_c) reaches vth after t = sqrt(2 vth cos th_c / (g w)): a lag w t of
+-- 0.106 deg at 1 deg/s (0.150 deg at 2 deg/s). Tipping about a pivot at distance L from the centre
+-- of mass: the weight's moment grows as W L w t, so the centre moves at v = g w t^2 m L^2 / (2 I_p),
+-- I_p = I_c + m L^2, a lag larger by sqrt(I_p / (m L^2)): 1.26 for the dimer (I_c = 0.7375 m r^2,
+-- L^2 = 1.25 r^2), 0.14 deg at 1 deg/s; rolling about the contact line likewise, by
+-- sqrt(1 + I_c / (m r^2)). The lag scales as sqrt(w): halving the rate takes 30 % off it. The
+-- Hertz overlaps (~2e-4 r at E = 1e8 Pa) lower the centre by that much: tan th_c = b / h changes
+-- by 2e-4 relatively, 0.005 deg. Tolerance params.tol = 0.3 deg, twice the largest lag at the
+-- reduced run's 2 deg/s.
+-- Measured at 0.25, 1 and 2 deg/s, the onsets fit th_c + c + a sqrt(rate): sliding a = 0.106
+-- deg (rate in deg/s), c = 0.000 deg; rolling a = 0.130, c = -0.001; tipping a = 0.13-0.14 as
+-- above, c = -0.03 deg (dimer and trimer, E = 1e8 Pa): the body tips slightly early. Part of
+-- it is elastic: as the load moves onto the downhill member its overlap grows (to ~2.5 um) and
+-- the body leans by up to that over the members' spacing (~5e-4 rad, 0.03 deg); at E = 1e9 Pa
+-- the lean is 4.6 times smaller, and the onsets at 0.25 deg/s rise by 0.005 (dimer) and
+-- 0.009 deg (trimer).
 --
 --   grainlab scripts/clump_incline.lua [rate=1] [below=3] [vth=1e-3] [tol=0.3] [settle=0.3]
---                                      [after=0.3] [cases=1,2,3,4,5]
+--                                      [after=0.3] [young=1e8] [cases=1,2,3,4,5]
 
 local rate = params.rate or 1          -- deg/s of tilt
 local below = params.below or 3        -- deg below the expected onset where the slow ramp starts
@@ -51,8 +62,9 @@ local vth = params.vth or 1e-3         -- m/s: onset speed
 local tol = params.tol or 0.3          -- deg
 local settle = params.settle or 0.3    -- s at zero tilt
 local after = params.after or 0.3      -- s after the onset, to tell the mode
+local young = params.young or 1e8      -- Pa
 for name, v in pairs { rate = rate, below = below, vth = vth, tol = tol, settle = settle,
-                       after = after } do
+                       after = after, young = young } do
   assert(type(v) == "number" and v > 0, name .. " must be a positive number")
 end
 local only = nil
@@ -63,7 +75,7 @@ end
 
 grainlab.threads(1) -- a few particles: threads only add synchronisation
 
-local g, r, rho, young, nu = 9.81, 5e-3, 2650, 1e8, 0.3
+local g, r, rho, nu = 9.81, 5e-3, 2650, 0.3
 local deg = math.pi / 180
 local sqrt3 = math.sqrt(3)
 
