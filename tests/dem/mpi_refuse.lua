@@ -46,6 +46,20 @@ else
 end
 print("ok")
 
+-- Clumps do not run distributed yet: refused by name on every rank, run on one.
+local c = dem.scene{ dim = 2, box = { { 0, 0 }, { 0.01, 0.01 } }, gravity = { 0, -9.81 } }
+c:add_wall{ point = { 0, 0 }, normal = { 0, 1 } }
+c:add_clump{ members = { { offset = { -0.0004, 0 }, radius = 0.0005 }, { offset = { 0.0004, 0 }, radius = 0.0005 } },
+             material = m, position = { 0.005, 0.002 } }
+local okc, errc = pcall(c.run, c, { steps = 10, dt = 1e-7 })
+if ranks == 1 then
+  assert(okc, errc)
+else
+  assert(not okc, "a run with clumps went ahead on " .. ranks .. " ranks")
+  assert(tostring(errc):find("clumps do not yet run distributed", 1, true), errc)
+end
+print("ok")
+
 -- Tags alone (a LAMMPS data file whose ids have gaps) do run distributed: they travel with their
 -- particles, and the queries give them back. Files are written once (rank 0); every rank reads it.
 do

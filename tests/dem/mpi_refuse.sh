@@ -1,5 +1,5 @@
 #!/bin/bash
-# A scene with a boundary condition (springs), or a wall beyond planes (a circle), runs on one
+# A scene with a boundary condition (springs), a wall beyond planes (a circle) or clumps runs on one
 # rank and stops with an error naming it on 2 ranks (tests/dem/mpi_refuse.lua checks the message
 # on every rank); an instability one rank finds stops every rank with the one-rank message at the
 # same step.
