@@ -1,7 +1,8 @@
 -- The pile in a box of Herrmann & Mueller Sec. 3, shared by scripts/repose.lua (the angle of
 -- repose: the gate removed) and scripts/marginal_stability.lua (the angle of marginal stability:
--- the box tilted), their variants with rolling resistance and with liquid bridges
--- (scripts/repose_rolling.lua, scripts/repose_cohesive.lua), and their tests. Not a scenario;
+-- the box tilted), their variants with rolling resistance, with liquid bridges and with clumps
+-- (scripts/repose_rolling.lua, scripts/repose_cohesive.lua, scripts/repose_clumps.lua), and
+-- their tests. Not a scenario;
 -- load it with
 --   local heap_box = dofile((arg[0]:match("^(.*)/") or ".") .. "/lib/heap_box.lua")
 --
