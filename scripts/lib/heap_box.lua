@@ -1,7 +1,8 @@
 -- The pile in a box of Herrmann & Mueller Sec. 3, shared by scripts/repose.lua (the angle of
 -- repose: the gate removed) and scripts/marginal_stability.lua (the angle of marginal stability:
--- the box tilted), their variants with rolling resistance and with liquid bridges
--- (scripts/repose_rolling.lua, scripts/repose_cohesive.lua), and their tests. Not a scenario;
+-- the box tilted), their variants with rolling resistance, with liquid bridges and with clumps
+-- (scripts/repose_rolling.lua, scripts/repose_cohesive.lua, scripts/repose_clumps.lua), and
+-- their tests. Not a scenario;
 -- load it with
 --   local heap_box = dofile((arg[0]:match("^(.*)/") or ".") .. "/lib/heap_box.lua")
 --
@@ -20,6 +21,14 @@
 --          at 2 m/s.
 --   settle 0.1 s with a background drag of 20/s, then without, in slices of 0.02 s, until the
 --          fastest grain is below v_rest (at most 0.6 s).
+-- shape = "dimer" | "trimer" (default "disk": the disks above) fills the box with rigid clumps
+-- (docs/dem.md "Clumps") of equal member disks of radius r, r taking `sizes` values evenly over
+-- [rmin, rmax] (a template each, drawn at random): a dimer two members r apart (aspect ratio
+-- 1.5), a trimer three at the corners of a triangle of side r. As many clumps as hold the N disks'
+-- area (the same box W), rounded; poured by random sequential addition (grainlab.pack.clumps)
+-- into the box up to a height that they fill at area fraction 0.3, then falling with the drag on
+-- until the fastest is below 5 cm/s (at most 1 s), then settled as above. b.grains is then the
+-- number of clumps, b.members their members (the scene's particles after the floor).
 -- The returned box b has b.s (the scene), b.nf (the floor disks, the scene's first particles),
 -- b.W, b.h_init (top of the settled packing), b.dt, b.t_relax, and the methods below.
 local heap_box = {}
@@ -27,6 +36,12 @@ local heap_box = {}
 local g, rho, nu = 9.81, 2650, 0.3
 local v_imp = 2.0 -- m/s, the impact velocity the time step is chosen for
 heap_box.gravity, heap_box.density, heap_box.poisson = g, rho, nu
+
+-- The clumps' members' offsets in units of the member radius r: centres r apart.
+local clump_shapes = {
+  dimer = { { -0.5, 0 }, { 0.5, 0 } },
+  trimer = { { 0, 1 / math.sqrt(3) }, { -0.5, -0.5 / math.sqrt(3) }, { 0.5, -0.5 / math.sqrt(3) } },
+}
 
 -- The friction coefficients of a script's `mus` parameter ("0.1,0.8" or one number), sorted;
 -- `default` when it is not given.
@@ -97,6 +112,26 @@ function heap_box.new(o)
   b.rf = rmin -- floor disks
   b.depth, b.length = 0.6 * b.W, 3 * b.W
   b.top = 1.6 * b.h0 + 4 * rmax
+  b.shape = o.shape or "disk"
+  b.grains, b.members = b.n, b.n
+  if b.shape ~= "disk" then
+    local unit = clump_shapes[b.shape]
+    assert(unit, "heap_box: shape must be \"disk\", \"dimer\" or \"trimer\"")
+    local sizes, a_mean = o.sizes or 6, 0
+    b.templates = {}
+    for k = 1, sizes do
+      local r = rmin + (k - 0.5) * (rmax - rmin) / sizes
+      local members = {}
+      for q, u in ipairs(unit) do members[q] = { offset = { u[1] * r, u[2] * r }, radius = r } end
+      b.templates[k] = dem.clump_template{ members = members }
+      a_mean = a_mean + b.templates[k]:info().disks.area / sizes
+    end
+    -- the N disks' solid area, 0.82 of the packing's
+    b.grains = math.floor(b.n * 0.82 * area / a_mean + 0.5)
+    b.members = b.grains * #unit
+    b.fill_top = 0.82 * b.h0 / 0.3 -- the pouring region's top: area fraction 0.3
+    b.top = b.fill_top + 4 * rmax
+  end
   b.bw = 2 * rmax -- surface bins
   b.nb = math.floor(b.W / b.bw)
   if o.geometry_only then return b end -- the sizes only, no scene
@@ -116,9 +151,14 @@ function heap_box.new(o)
     s:add_disk{ pos = { b.rf + 2 * b.rf * k, -b.rf }, radius = b.rf, material = mat, fixed = true }
     b.nf = b.nf + 1
   end
-  grainlab.pack.deposit(s, { n = b.n, radius = { rmin, rmax }, seed = b.seed, material = mat,
-                             region = { { 0, -2 * b.rf }, { b.W, b.top - 2 * rmax } },
-                             relax_steps = 0 })
+  if b.shape == "disk" then
+    grainlab.pack.deposit(s, { n = b.n, radius = { rmin, rmax }, seed = b.seed, material = mat,
+                               region = { { 0, -2 * b.rf }, { b.W, b.top - 2 * rmax } },
+                               relax_steps = 0 })
+  else
+    grainlab.pack.clumps(s, { n = b.grains, template = b.templates, seed = b.seed, material = mat,
+                              region = { { 0, 0 }, { b.W, b.fill_top } } })
+  end
   local bridge = o.bridge or {} -- nil: dry grains, the law above and nothing more
   s:contact{ normal = "hertz", damping = "brilliantov", restitution = b.e_rest, impact_velocity = 1,
              tangential = "spring", rolling_resistance = b.mu_r and "epsd" or nil,
@@ -128,6 +168,13 @@ function heap_box.new(o)
   b.dt = b.dt_factor * s:timestep{ impact_velocity = v_imp }.limit
 
   s:drag(20)
+  b.t_fall = 0
+  if b.shape ~= "disk" then -- the poured clumps fall onto the floor first
+    repeat
+      b:advance(0.02)
+      b.t_fall = b.t_fall + 0.02
+    until b:state() < 0.05 or b.t_fall >= 1 - 1e-9
+  end
   b:advance(0.1)
   s:drag(0)
   b.t_relax = 0.1
@@ -229,7 +276,7 @@ end
 function heap_box:collapse(T_max, on_slice)
   local s = self.s
   s:remove_wall(self.gate)
-  local t, vmax, left = 0, math.huge, self.n
+  local t, vmax, left = 0, math.huge, self.members
   while t < T_max - 1e-9 do
     self:advance(0.05)
     t = t + 0.05
