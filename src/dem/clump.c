@@ -382,8 +382,7 @@ long dem_add_clump(dem_scene *s, const dem_clump_def *c, core_error *err)
     const dem_clump_shape *sh = c->shape;
     const int planar = s->dim == 2 && s->thickness > 0;
     if (!sh) {
-        if (dem_clump_shape_compute(c->members, c->n, s->dim, planar, planar ? 4096 : s->dim == 2 ? 1024 : 512,
-                                    &own, err))
+        if (dem_clump_shape_compute(c->members, c->n, s->dim, planar, 0, &own, err))
             return -1;
         sh = &own;
     }

@@ -220,6 +220,8 @@ core_status dem_clump_shape_compute(const dem_clump_member *m, int n, int dim, i
                          DEM_CLUMP_MAX_MEMBERS, n);
     if (dim != 2 && dim != 3)
         return core_fail(err, CORE_ERR_ARG, "dim must be 2 or 3, got %d", dim);
+    if (resolution == 0)
+        resolution = planar && dim == 2 ? 4096 : dim == 2 ? 1024 : 512;
     if (resolution < 16 || resolution > 1 << 16)
         return core_fail(err, CORE_ERR_ARG, "resolution must be in [16, 65536], got %d",
                          resolution);

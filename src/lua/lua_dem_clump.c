@@ -11,10 +11,9 @@
 #include "lua/lua_dem.h"
 
 static const char *TEMPLATE = "dem.clump_template";
-enum { RES_PLANAR = 4096, RES_SOLID_2D = 1024, RES_SOLID_3D = 512 };
 
 typedef struct ltemplate {
-    int dim, n, resolution; /* resolution 0: the defaults above */
+    int dim, n, resolution; /* resolution 0: dem_clump_shape_compute's default */
     dem_clump_member m[DEM_CLUMP_MAX_MEMBERS];
     int have[2];              /* shapes computed: [0] spheres, [1] planar disks */
     dem_clump_shape shape[2];
@@ -84,11 +83,8 @@ static const dem_clump_shape *template_shape(lua_State *L, ltemplate *t, int pla
 {
     if (t->have[planar])
         return &t->shape[planar];
-    int res = t->resolution;
-    if (!res)
-        res = planar ? RES_PLANAR : t->dim == 2 ? RES_SOLID_2D : RES_SOLID_3D;
-    core_error err;
-    if (dem_clump_shape_compute(t->m, t->n, t->dim, planar, res, &t->shape[planar], &err))
+    core_error err; /* resolution 0: the engine's default for this kind of shape */
+    if (dem_clump_shape_compute(t->m, t->n, t->dim, planar, t->resolution, &t->shape[planar], &err))
         bind_raise(L, call, &err);
     t->have[planar] = 1;
     return &t->shape[planar];
