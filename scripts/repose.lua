@@ -164,10 +164,7 @@ for i, r in ipairs(results) do
   metrics["settle_time_s_" .. id] = r.t
   metrics["wall_s_" .. id] = r.wall_s
   checks[#checks + 1] = { name = "theta_r_in_0_45_deg_" .. id, pass = r.theta > 0 and r.theta < 45 }
-  checks[#checks + 1] = { name = "fit_rms_over_d_" .. id, value = r.rms, limit = rms_limit }
-  checks[#checks + 1] = { name = "at_rest_v_max_m_per_s_" .. id, value = r.vmax, limit = v_rest,
-                          op = "<" }
-  checks[#checks + 1] = { name = "basin_clear_top_m_" .. id, value = r.basin_top, limit = -2 * rf }
+  heap_box.pile_checks(checks, id, r, rms_limit, v_rest, rf)
   -- Rising "within the noise": the packing-to-packing scatter of theta_r is about 1 degree
   -- (4 packings per mu), so no step may fall by more than 1.5 degrees.
   if i > 1 and r.theta < results[i - 1].theta - 1.5 then rises = false end

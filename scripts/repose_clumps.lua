@@ -176,10 +176,7 @@ for _, r in ipairs(results) do
   metrics["max_overlap_over_r_" .. id] = r.overlap
   metrics["wall_s_" .. id] = r.wall_s
   checks[#checks + 1] = { name = "theta_r_in_0_60_deg_" .. id, pass = r.theta > 0 and r.theta < 60 }
-  checks[#checks + 1] = { name = "fit_rms_over_d_" .. id, value = r.rms, limit = rms_limit }
-  checks[#checks + 1] = { name = "at_rest_v_max_m_per_s_" .. id, value = r.vmax, limit = v_rest,
-                          op = "<" }
-  checks[#checks + 1] = { name = "basin_clear_top_m_" .. id, value = r.basin_top, limit = -2 * rf }
+  heap_box.pile_checks(checks, id, r, rms_limit, v_rest, rf)
   checks[#checks + 1] = { name = "max_overlap_over_r_" .. id, value = r.overlap, limit = 0.1 }
 end
 local disk = by.disk

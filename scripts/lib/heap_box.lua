@@ -374,4 +374,14 @@ function heap_box:marginal(o)
   return coarse[1], coarse[2], coarse[3], holds, true
 end
 
+-- The checks every gate-removal pile carries, appended to `checks` for run tag id: the surface
+-- fit's rms (in mean diameters) within rms_limit, the pile at rest (fastest grain in the box
+-- below v_rest) and the basin heap below the box floor by two floor radii (rf).
+function heap_box.pile_checks(checks, id, r, rms_limit, v_rest, rf)
+  checks[#checks + 1] = { name = "fit_rms_over_d_" .. id, value = r.rms, limit = rms_limit }
+  checks[#checks + 1] = { name = "at_rest_v_max_m_per_s_" .. id, value = r.vmax, limit = v_rest,
+                          op = "<" }
+  checks[#checks + 1] = { name = "basin_clear_top_m_" .. id, value = r.basin_top, limit = -2 * rf }
+end
+
 return heap_box
